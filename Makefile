@@ -1,0 +1,37 @@
+# mbcc: build, test, demo.  `make` builds build/mbcc and the runtime library.
+CC      ?= cc
+CFLAGS  ?= -O2 -g
+WARN    := -Wall -Wextra -Werror
+STD     := -std=c11
+ROOT    := $(CURDIR)
+LIBS    := -lyaml -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig -llapack -lblas -lm
+
+RT_SRC  := runtime/model_generic.c runtime/solver_klu.c runtime/solver_dense.c \
+           runtime/integrate.c runtime/driver.c
+RT_HDR  := $(wildcard runtime/*.h)
+CC_SRC  := compiler/main.c compiler/reader.c compiler/diag.c compiler/lower.c \
+           compiler/assemble.c compiler/emit.c
+CC_HDR  := $(wildcard compiler/*.h)
+B       := build
+
+.PHONY: all test demo clean sanitize docs
+all: $(B)/mbcc $(B)/libmbrt.a
+
+$(B)/rt/%.o: runtime/%.c $(RT_HDR)
+	@mkdir -p $(B)/rt
+	$(CC) $(STD) $(WARN) $(CFLAGS) -Iruntime -c $< -o $@
+
+$(B)/libmbrt.a: $(patsubst runtime/%.c,$(B)/rt/%.o,$(RT_SRC))
+	rm -f $@ && ar rcs $@ $^
+
+$(B)/mbcc: $(CC_SRC) $(CC_HDR) $(B)/libmbrt.a
+	$(CC) $(STD) $(WARN) $(CFLAGS) -Icompiler -Iruntime -DMBCC_ROOT='"$(ROOT)"' \
+	  $(CC_SRC) $(B)/libmbrt.a $(LIBS) -o $@
+
+demo: all
+	$(B)/mbcc run models/slider_crank.yaml
+
+include tests/tests.mk
+
+clean:
+	rm -rf $(B) generated/*/ results

@@ -1,0 +1,76 @@
+/* diag.c: see diag.h. */
+#include "diag.h"
+
+#include <stdbool.h>
+#include <stdio.h>
+
+static int error_count;
+static int warning_count;
+/* Notes follow the fate of the error or warning they explain. */
+static bool last_message_hidden;
+
+static void print(const char *file, ir_loc loc, const char *severity,
+                  const char *fmt, va_list ap) {
+  if (file == NULL)
+    fputs("mbcc", stderr);
+  else
+    fputs(file, stderr);
+  if (loc.line > 0)
+    fprintf(stderr, ":%d:%d", loc.line, loc.col > 0 ? loc.col : 1);
+  fprintf(stderr, ": %s: ", severity);
+  vfprintf(stderr, fmt, ap);
+  fputc('\n', stderr);
+}
+
+void diag_verror(const char *file, ir_loc loc, const char *fmt, va_list ap) {
+  error_count++;
+  last_message_hidden = error_count > DIAG_MAX_SHOWN_ERRORS;
+  if (!last_message_hidden) {
+    print(file, loc, "error", fmt, ap);
+  } else if (error_count == DIAG_MAX_SHOWN_ERRORS + 1) {
+    fprintf(stderr, "%s: note: too many errors; the remaining ones are not shown\n",
+            file ? file : "mbcc");
+  }
+}
+
+void diag_vwarning(const char *file, ir_loc loc, const char *fmt, va_list ap) {
+  warning_count++;
+  last_message_hidden = error_count > DIAG_MAX_SHOWN_ERRORS;
+  if (!last_message_hidden)
+    print(file, loc, "warning", fmt, ap);
+}
+
+void diag_vnote(const char *file, ir_loc loc, const char *fmt, va_list ap) {
+  if (!last_message_hidden)
+    print(file, loc, "note", fmt, ap);
+}
+
+void diag_error(const char *file, ir_loc loc, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  diag_verror(file, loc, fmt, ap);
+  va_end(ap);
+}
+
+void diag_warning(const char *file, ir_loc loc, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  diag_vwarning(file, loc, fmt, ap);
+  va_end(ap);
+}
+
+void diag_note(const char *file, ir_loc loc, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  diag_vnote(file, loc, fmt, ap);
+  va_end(ap);
+}
+
+int diag_errors(void) { return error_count; }
+int diag_warnings(void) { return warning_count; }
+
+void diag_reset(void) {
+  error_count = 0;
+  warning_count = 0;
+  last_message_hidden = false;
+}

@@ -1,0 +1,36 @@
+/* diag.h: GNU-style diagnostics ("file:line:col: error: message") on stderr,
+ * with a process-wide error counter. */
+#ifndef MBCC_DIAG_H
+#define MBCC_DIAG_H
+
+#include <stdarg.h>
+
+#include "ir.h"
+
+/* After this many errors further diagnostics are counted but not printed,
+ * so one broken file cannot flood the terminal. */
+#define DIAG_MAX_SHOWN_ERRORS 20
+
+#if defined(__GNUC__) || defined(__clang__)
+#define DIAG_PRINTF(fmt_index, first_arg) \
+  __attribute__((format(printf, fmt_index, first_arg)))
+#else
+#define DIAG_PRINTF(fmt_index, first_arg)
+#endif
+
+/* 'file' may be NULL (the message is then prefixed "mbcc:"); a loc with
+ * line <= 0 prints no line/column. */
+void diag_error(const char *file, ir_loc loc, const char *fmt, ...) DIAG_PRINTF(3, 4);
+void diag_warning(const char *file, ir_loc loc, const char *fmt, ...) DIAG_PRINTF(3, 4);
+/* A note belongs to the preceding error or warning and is hidden with it. */
+void diag_note(const char *file, ir_loc loc, const char *fmt, ...) DIAG_PRINTF(3, 4);
+
+void diag_verror(const char *file, ir_loc loc, const char *fmt, va_list ap) DIAG_PRINTF(3, 0);
+void diag_vwarning(const char *file, ir_loc loc, const char *fmt, va_list ap) DIAG_PRINTF(3, 0);
+void diag_vnote(const char *file, ir_loc loc, const char *fmt, va_list ap) DIAG_PRINTF(3, 0);
+
+int diag_errors(void);   /* errors reported so far (shown or not) */
+int diag_warnings(void); /* warnings reported so far */
+void diag_reset(void);   /* zero both counters (e.g. between test cases) */
+
+#endif

@@ -1,0 +1,531 @@
+/* emit.c: writes generated/<model>/: <model>.h, <model>.c (element tables,
+ * the pattern of K, and the specialized straight-line evaluation that fills
+ * only the varying entries of K each step) and main.c (the simulator).
+ * Output is byte-reproducible: no timestamps, doubles printed with %.17g. */
+#define _POSIX_C_SOURCE 200809L
+#include <ctype.h>
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "diag.h"
+#include "lower.h"
+
+/* out = a/b; nonzero if it does not fit */
+static int join(char *out, size_t n, const char *a, const char *b) {
+  int k = snprintf(out, n, "%s/%s", a, b);
+  return k < 0 || (size_t)k >= n;
+}
+
+static void num(FILE *f, double x) {
+  if (x == 0) x = 0; /* no "-0" */
+  fprintf(f, "%.17g", x);
+}
+
+static void vec(FILE *f, const double *x, int n) {
+  fputc('{', f);
+  for (int i = 0; i < n; i++) {
+    if (i) fputs(", ", f);
+    num(f, x[i]);
+  }
+  fputc('}', f);
+}
+
+static void ivec(FILE *f, const int *x, int n) {
+  fputc('{', f);
+  for (int i = 0; i < n; i++) fprintf(f, "%s%d", i ? ", " : "", x[i]);
+  fputc('}', f);
+}
+
+/* a long int array, 16 per line */
+static void int_array(FILE *f, const char *name, const int *x, int n) {
+  fprintf(f, "static const int %s[%d] = {", name, n);
+  for (int i = 0; i < n; i++) fprintf(f, "%s%d", i % 16 ? ", " : (i ? ",\n  " : "\n  "), x[i]);
+  fprintf(f, "\n};\n");
+}
+
+static void real_array(FILE *f, const char *name, const double *x, int n) {
+  fprintf(f, "static const mb_real %s[%d] = {", name, n);
+  for (int i = 0; i < n; i++) {
+    fputs(i % 4 ? ", " : (i ? ",\n  " : "\n  "), f);
+    num(f, x[i]);
+  }
+  fprintf(f, "\n};\n");
+}
+
+static void upper(char *dst, const char *src, size_t n) {
+  size_t i = 0;
+  for (; src[i] && i + 1 < n; i++) dst[i] = (char)toupper((unsigned char)src[i]);
+  dst[i] = 0;
+}
+
+static void loc_comment(FILE *f, const lmodel *L, ir_loc loc) {
+  fprintf(f, "%s:%d:%d", L->ir->path, loc.line, loc.col);
+}
+
+/* the tables: bodies, markers, rows, forces, profiles, outputs */
+static void emit_tables(FILE *f, const lmodel *L) {
+  const mb_model *m = &L->m;
+  fprintf(f, "/* --- element tables (also used for outputs and energy) --- */\n");
+  for (int k = 0; k < m->nprofile; k++) {
+    const mb_profile *p = &L->profile[k];
+    if (p->kind != MB_PROFILE_TABLE) continue;
+    char nm[64];
+    snprintf(nm, sizeof nm, "profile%d_table", k);
+    real_array(f, nm, p->table, 2 * p->ntable);
+    snprintf(nm, sizeof nm, "profile%d_spline", k);
+    real_array(f, nm, p->spline, p->ntable);
+  }
+  for (int k = 0; k < m->nforce; k++) {
+    const mb_forcedef *d = &L->force[k];
+    const mb_law *laws[2] = {&d->stiffness, &d->damping};
+    for (int l = 0; l < 2; l++)
+      if (laws[l]->kind == MB_LAW_TABLE) {
+        char nm[64];
+        snprintf(nm, sizeof nm, "force%d_law%d_table", k, l);
+        real_array(f, nm, laws[l]->table, 2 * laws[l]->ntable);
+      }
+  }
+  if (m->nbody) {
+    fprintf(f, "static const mb_body bodies[%d] = {\n", m->nbody);
+    for (int b = 0; b < m->nbody; b++) {
+      const mb_body *B = &L->body[b];
+      fprintf(f, "  /* body '%s' (", B->name);
+      loc_comment(f, L, L->ir->bodies[b + 1].loc);
+      fprintf(f, ") */\n  {\"%s\", %s, ", B->name, B->kind == MB_BODY_VIRTUAL ? "MB_BODY_VIRTUAL" : "MB_BODY_RIGID");
+      num(f, B->mass);
+      fputs(", ", f);
+      vec(f, B->J, 9);
+      fprintf(f, ", %d, %d, ", B->qadr, B->vadr);
+      ivec(f, B->mslot, 12);
+      fputs("},\n", f);
+    }
+    fputs("};\n", f);
+  }
+  if (m->nmarker) {
+    fprintf(f, "static const mb_markerdef markers[%d] = {\n", m->nmarker);
+    for (int k = 0; k < m->nmarker; k++) {
+      const mb_markerdef *d = &L->marker[k];
+      fprintf(f, "  /* %d: %s */\n  {%d, ", k, L->marker_desc[k], d->body);
+      vec(f, d->s, 3);
+      fputs(", ", f);
+      vec(f, d->C, 9);
+      fputs("},\n", f);
+    }
+    fputs("};\n", f);
+  }
+  if (m->nrow) {
+    fprintf(f, "static const mb_rowdef rows[%d] = {\n", m->nrow);
+    for (int r = 0; r < m->nrow; r++) {
+      const mb_rowdef *R = &L->row[r];
+      fprintf(f, "  /* %d: %s */\n  {%d, %d, %d, %d, %d, ", r, L->row_desc[r], R->kind, R->m0, R->m1, R->a, R->b);
+      num(f, R->L);
+      fprintf(f, ", %d, {", R->profile);
+      ivec(f, R->slot[0], 6); fputs(", ", f); ivec(f, R->slot[1], 6);
+      fputs("}, {", f);
+      ivec(f, R->slotT[0], 6); fputs(", ", f); ivec(f, R->slotT[1], 6);
+      fputs("}, {", f);
+      for (int s = 0; s < 2; s++) {
+        int c[6];
+        for (int j = 0; j < 6; j++) c[j] = R->constant[s][j];
+        if (s) fputs(", ", f);
+        ivec(f, c, 6);
+      }
+      fprintf(f, "}, %d, %d},\n", R->joint, R->driver);
+    }
+    fputs("};\n", f);
+  }
+  if (m->nforce) {
+    fprintf(f, "static const mb_forcedef forces[%d] = {\n", m->nforce);
+    for (int k = 0; k < m->nforce; k++) {
+      const mb_forcedef *d = &L->force[k];
+      const ir_force *F = &L->ir->forces[L->force_ir[k]];
+      fprintf(f, "  /* force '%s' (", F->name);
+      loc_comment(f, L, F->loc);
+      fprintf(f, ") */\n  {%d, %d, %d, ", d->kind, d->m0, d->m1);
+      vec(f, d->vec, 3);
+      fprintf(f, ", %d, %d, ", d->body_frame, d->profile);
+      const mb_law *laws[2] = {&d->stiffness, &d->damping};
+      for (int l = 0; l < 2; l++) {
+        fprintf(f, "{%d, ", laws[l]->kind);
+        num(f, laws[l]->coef);
+        fputs(", ", f);
+        num(f, laws[l]->exponent);
+        if (laws[l]->kind == MB_LAW_TABLE)
+          fprintf(f, ", %d, force%d_law%d_table}, ", laws[l]->ntable, k, l);
+        else
+          fputs(", 0, 0}, ", f);
+      }
+      num(f, d->L0); fputs(", ", f); num(f, d->preload); fputs(", ", f);
+      vec(f, d->k6, 6); fputs(", ", f); vec(f, d->c6, 6); fputs(", ", f); vec(f, d->pre6, 6);
+      fputs("},\n", f);
+    }
+    fputs("};\n", f);
+  }
+  if (m->nprofile) {
+    fprintf(f, "static const mb_profile profiles[%d] = {\n", m->nprofile);
+    for (int k = 0; k < m->nprofile; k++) {
+      const mb_profile *p = &L->profile[k];
+      fprintf(f, "  {%d, ", p->kind);
+      vec(f, p->c, 8);
+      if (p->kind == MB_PROFILE_TABLE)
+        fprintf(f, ", %d, %d, profile%d_table, profile%d_spline},\n", p->nc, p->ntable, k, k);
+      else
+        fprintf(f, ", %d, 0, 0, 0},\n", p->nc);
+    }
+    fputs("};\n", f);
+  }
+  if (m->noutput) {
+    fprintf(f, "static const mb_outputdef outputs[%d] = {\n", m->noutput);
+    for (int k = 0; k < m->noutput; k++) {
+      const mb_outputdef *o = &L->output[k];
+      fprintf(f, "  /* output '%s' (", L->ir->outputs[k].name);
+      loc_comment(f, L, L->ir->outputs[k].loc);
+      fprintf(f, ") */\n  {%d, %d, ", o->kind, o->body);
+      vec(f, o->s, 3); fputs(", ", f); vec(f, o->axis, 3); fputs(", ", f); vec(f, o->u, 3);
+      fputs(", ", f); vec(f, o->axis_g, 3); fputs(", ", f); vec(f, o->u_g, 3);
+      fprintf(f, ", %d, %d, %d, %d, %d, %d, ", o->component, o->joint, o->reaction_marker,
+              o->driver_row, o->driver_marker, o->driver_rotation);
+      num(f, o->scale);
+      fprintf(f, ", %d, %d},\n", o->ncols, o->col);
+    }
+    fputs("};\n", f);
+  }
+  if (m->njoint) {
+    fprintf(f, "static const char *const joint_names[%d] = {", m->njoint);
+    for (int j = 0; j < m->njoint; j++) fprintf(f, "%s\"%s\"", j ? ", " : "", L->joint_name[j]);
+    fputs("};\n", f);
+  }
+  if (m->ncols) {
+    fprintf(f, "static const char *const col_names[%d] = {", m->ncols);
+    for (int j = 0; j < m->ncols; j++) fprintf(f, "%s\"%s\"", j ? ", " : "", L->col_name[j]);
+    fputs("};\n", f);
+  }
+}
+
+/* rhs[va..va+5] += c */
+static void add_cols(FILE *f, int vadr) {
+  for (int j = 0; j < 6; j++) fprintf(f, "    rhs[%d] += c[%d];\n", vadr + j, j);
+}
+
+static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
+  const mb_model *m = &L->m;
+  fprintf(f,
+          "\n/* Fill the varying entries of K, rhs = [f; gamma], phi and nu at (t, q, v). */\n"
+          "void %s_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,\n"
+          "    mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *nu, void *work) {\n"
+          "  static const mb_real zero3[3] = {0, 0, 0};\n"
+          "  mb_frame f[%d];\n  mb_marker k[%d];\n  mb_row r;\n  mb_real c[6], x[3];\n"
+          "  (void)m; (void)work; (void)t; (void)x; (void)c; (void)r; (void)zero3;\n",
+          nm, m->nbody ? m->nbody : 1, m->nmarker ? m->nmarker : 1);
+  fprintf(f, "\n  /* body frames */\n");
+  for (int b = 0; b < m->nbody; b++)
+    fprintf(f, "  mb_frame_rigid(q + %d, v + %d, &f[%d]); /* body '%s' */\n", L->body[b].qadr,
+            L->body[b].vadr, b, L->body[b].name);
+  fprintf(f, "\n  /* markers */\n");
+  for (int k = 0; k < m->nmarker; k++) {
+    const mb_markerdef *d = &L->marker[k];
+    fprintf(f, "  /* %s */\n", L->marker_desc[k]);
+    if (d->body < 0) {
+      fprintf(f, "  mb_marker_ground(markers[%d].s, markers[%d].C, &k[%d]);\n", k, k, k);
+    } else {
+      fprintf(f, "  mb_marker_rigid(&f[%d], (const mb_real[3])", d->body);
+      vec(f, d->s, 3);
+      fputs(",\n      (const mb_real[9])", f);
+      vec(f, d->C, 9);
+      fprintf(f, ", &k[%d]);\n", k);
+    }
+  }
+  fprintf(f, "\n  /* body forces: gravity and the quadratic-velocity (gyroscopic) terms */\n");
+  for (int b = 0; b < m->nbody; b++) {
+    const mb_body *B = &L->body[b];
+    fprintf(f, "  /* body '%s' */\n", B->name);
+    for (int j = 0; j < 3; j++) {
+      fprintf(f, "  rhs[%d] = ", B->vadr + j);
+      num(f, B->mass * m->gravity[j]);
+      fputs(";\n", f);
+    }
+    int zeroJ = 1;
+    for (int j = 0; j < 9; j++) zeroJ &= B->J[j] == 0;
+    if (zeroJ) {
+      fprintf(f, "  rhs[%d] = rhs[%d] = rhs[%d] = 0;\n", B->vadr + 3, B->vadr + 4, B->vadr + 5);
+    } else {
+      fprintf(f, "  mb_rigid_gyro((const mb_real[9])");
+      vec(f, B->J, 9);
+      fprintf(f, ", f[%d].wl, rhs + %d);\n", b, B->vadr + 3);
+    }
+  }
+  if (m->nforce) fprintf(f, "\n  /* force elements */\n");
+  for (int k = 0; k < m->nforce; k++) {
+    const mb_forcedef *d = &L->force[k];
+    const ir_force *F = &L->ir->forces[L->force_ir[k]];
+    int b0 = L->marker[d->m0].body, b1 = d->m1 >= 0 ? L->marker[d->m1].body : -1;
+    fprintf(f, "  { /* force '%s' (", F->name);
+    loc_comment(f, L, F->loc);
+    fputs(") */\n", f);
+    switch (d->kind) {
+    case MB_FORCE_POINT:
+    case MB_FORCE_TORQUE: {
+      if (b0 < 0) { fputs("    /* on the ground: no effect */\n  }\n", f); continue; }
+      fputs("    mb_real s = 1, val[3];\n", f);
+      if (d->profile >= 0) fprintf(f, "    mb_profile_eval(&profiles[%d], t, x);\n    s = x[0];\n", d->profile);
+      for (int j = 0; j < 3; j++) {
+        fprintf(f, "    val[%d] = s * ", j);
+        num(f, d->vec[j]);
+        fputs(";\n", f);
+      }
+      if (d->body_frame) fprintf(f, "    mb_mul3(f[%d].A, val, val);\n", b0);
+      fprintf(f, "    mb_rigid_cols(&f[%d], k[%d].P, %s, %s, c);\n", b0, d->m0,
+              d->kind == MB_FORCE_POINT ? "val" : "zero3", d->kind == MB_FORCE_POINT ? "zero3" : "val");
+      add_cols(f, L->body[b0].vadr);
+      break;
+    }
+    case MB_FORCE_SPRING:
+      fprintf(f, "    mb_real F0[3], F1[3];\n"
+                 "    mb_force_spring(&k[%d], &k[%d], &forces[%d].stiffness, &forces[%d].damping, ",
+              d->m0, d->m1, k, k);
+      num(f, d->L0);
+      fputs(", ", f);
+      num(f, d->preload);
+      fputs(", F0, F1);\n", f);
+      if (b0 >= 0) {
+        fprintf(f, "    mb_rigid_cols(&f[%d], k[%d].P, F0, zero3, c);\n", b0, d->m0);
+        add_cols(f, L->body[b0].vadr);
+      }
+      if (b1 >= 0) {
+        fprintf(f, "    mb_rigid_cols(&f[%d], k[%d].P, F1, zero3, c);\n", b1, d->m1);
+        add_cols(f, L->body[b1].vadr);
+      }
+      break;
+    case MB_FORCE_BUSHING:
+      fprintf(f, "    mb_real F[3], T[3], mF[3], mT[3];\n"
+                 "    mb_force_bushing(&k[%d], &k[%d], forces[%d].k6, forces[%d].c6, forces[%d].pre6, F, T);\n"
+                 "    mF[0] = -F[0]; mF[1] = -F[1]; mF[2] = -F[2];\n"
+                 "    mT[0] = -T[0]; mT[1] = -T[1]; mT[2] = -T[2];\n",
+              d->m0, d->m1, k, k, k);
+      if (b1 >= 0) {
+        fprintf(f, "    mb_rigid_cols(&f[%d], k[%d].P, F, T, c);\n", b1, d->m1);
+        add_cols(f, L->body[b1].vadr);
+      }
+      if (b0 >= 0) {
+        fprintf(f, "    mb_rigid_cols(&f[%d], k[%d].P, mF, mT, c); /* reaction at the same point */\n", b0, d->m1);
+        add_cols(f, L->body[b0].vadr);
+      }
+      break;
+    }
+    fputs("  }\n", f);
+  }
+  fprintf(f, "\n  /* constraint rows: D in both triangles of K, gamma, phi, nu */\n");
+  static const char *prim[] = {"", "sph", "dot1", "dot2", "dist", "rot", "trans"};
+  for (int r = 0; r < m->nrow; r++) {
+    const mb_rowdef *R = &L->row[r];
+    fprintf(f, "  /* row %d: %s (", r, L->row_desc[r]);
+    loc_comment(f, L, L->row_loc[r]);
+    fputs(") */\n", f);
+    switch (R->kind) {
+    case MB_PRIM_SPH: fprintf(f, "  mb_prim_sph(&k[%d], &k[%d], %d, &r);\n", R->m0, R->m1, R->a); break;
+    case MB_PRIM_DOT1: fprintf(f, "  mb_prim_dot1(&k[%d], &k[%d], %d, %d, &r);\n", R->m0, R->m1, R->a, R->b); break;
+    case MB_PRIM_DOT2: fprintf(f, "  mb_prim_dot2(&k[%d], &k[%d], %d, zero3, &r);\n", R->m0, R->m1, R->a); break;
+    case MB_PRIM_DIST:
+      fprintf(f, "  mb_prim_dist(&k[%d], &k[%d], ", R->m0, R->m1);
+      num(f, R->L);
+      fputs(", &r);\n", f);
+      break;
+    case MB_PRIM_ROT:
+      fprintf(f, "  mb_profile_eval(&profiles[%d], t, x);\n  mb_prim_rot(&k[%d], &k[%d], x, &r);\n", R->profile, R->m0, R->m1);
+      break;
+    case MB_PRIM_TRANS:
+      fprintf(f, "  mb_profile_eval(&profiles[%d], t, x);\n  mb_prim_dot2(&k[%d], &k[%d], 2, x, &r);\n", R->profile, R->m0, R->m1);
+      break;
+    default: fprintf(f, "  /* unknown primitive %s */\n", prim[0]); break;
+    }
+    fprintf(f, "  phi[%d] = r.phi;\n  nu[%d] = r.nu;\n  rhs[%d] = mb_row_gamma(&r, &k[%d], &k[%d]);\n", r, r,
+            m->nv + r, R->m0, R->m1);
+    for (int s = 0; s < 2; s++) {
+      int mk = s ? R->m1 : R->m0, b = L->marker[mk].body, any = 0;
+      if (b < 0) continue;
+      for (int j = 0; j < 6; j++) any |= R->slot[s][j] >= 0 && !R->constant[s][j];
+      if (!any) continue;
+      fprintf(f, "  mb_rigid_cols(&f[%d], k[%d].P, r.dV[%d], r.dW[%d], c);\n", b, mk, s, s);
+      for (int j = 0; j < 6; j++)
+        if (R->slot[s][j] >= 0 && !R->constant[s][j])
+          fprintf(f, "  Kx[%d] = Kx[%d] = c[%d];\n", R->slot[s][j], R->slotT[s][j], j);
+    }
+  }
+  fputs("}\n", f);
+}
+
+static void emit_init(FILE *f, const lmodel *L, const char *nm) {
+  const mb_model *m = &L->m;
+  fprintf(f, "\n/* The constant entries of K (mass matrix, constant Jacobian entries); all else 0. */\n"
+             "void %s_init(const mb_model *m, mb_real *Kx) {\n  (void)m;\n"
+             "  for (int i = 0; i < %d; i++) Kx[i] = 0;\n", nm, m->nnz);
+  for (int b = 0; b < m->nbody; b++) {
+    const mb_body *B = &L->body[b];
+    if (B->kind != MB_BODY_RIGID) continue;
+    fprintf(f, "  /* body '%s': mass and inertia */\n", B->name);
+    for (int j = 0; j < 12; j++)
+      if (B->mslot[j] >= 0) {
+        fprintf(f, "  Kx[%d] = ", B->mslot[j]);
+        num(f, j < 3 ? B->mass : B->J[j - 3]);
+        fputs(";\n", f);
+      }
+  }
+  for (int r = 0; r < m->nrow; r++) {
+    const mb_rowdef *R = &L->row[r];
+    for (int s = 0; s < 2; s++)
+      for (int j = 0; j < 6; j++)
+        if (R->constant[s][j] && R->slot[s][j] >= 0)
+          fprintf(f, "  Kx[%d] = Kx[%d] = %d; /* row %d: %s */\n", R->slot[s][j], R->slotT[s][j],
+                  s ? 1 : -1, r, L->row_desc[r]);
+  }
+  fputs("}\n", f);
+}
+
+static int write_file(const char *dir, const char *name, const lmodel *L,
+                      void (*body)(FILE *, const lmodel *, const char *), char *final_paths,
+                      size_t cap) {
+  char path[4096];
+  if (join(path, sizeof path, dir, name)) return -1;
+  FILE *f = fopen(path, "w");
+  if (!f) return -1;
+  body(f, L, L->m.name);
+  int bad = ferror(f);
+  if (fclose(f) || bad) return -1;
+  (void)final_paths; (void)cap;
+  return 0;
+}
+
+static void emit_header(FILE *f, const lmodel *L, const char *nm) {
+  char U[256];
+  upper(U, nm, sizeof U);
+  const mb_model *m = &L->m;
+  fprintf(f, "/* %s.h: generated by mbcc from %s%s%s. Do not edit. */\n", nm, L->ir->path,
+          L->ir->scene ? ", scene " : "", L->ir->scene ? L->ir->scene : "");
+  fprintf(f, "#ifndef %s_H\n#define %s_H\n\n#include \"mb_model.h\"\n\n", U, U);
+  fprintf(f, "#define %s_NQ %d   /* position coordinates */\n", U, m->nq);
+  fprintf(f, "#define %s_NV %d   /* velocity coordinates */\n", U, m->nv);
+  fprintf(f, "#define %s_NC %d   /* constraint rows */\n", U, m->nc);
+  fprintf(f, "#define %s_N %d    /* dimension of K */\n", U, m->n);
+  fprintf(f, "#define %s_NNZ %d  /* nonzeros of K */\n", U, m->nnz);
+  fprintf(f, "#define %s_NCOLS %d /* output columns */\n\n", U, m->ncols);
+  fprintf(f, "extern const mb_model %s_model;\n", nm);
+  fprintf(f, "void %s_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,\n"
+             "    mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *nu, void *work);\n", nm);
+  fprintf(f, "void %s_init(const mb_model *m, mb_real *Kx);\n\n#endif\n", nm);
+}
+
+static void emit_source(FILE *f, const lmodel *L, const char *nm) {
+  char U[256];
+  upper(U, nm, sizeof U);
+  const mb_model *m = &L->m;
+  fprintf(f, "/* %s.c: generated by mbcc from %s%s%s. Do not edit.\n", nm, L->ir->path,
+          L->ir->scene ? ", scene " : "", L->ir->scene ? L->ir->scene : "");
+  fprintf(f, " * %d bodies, %d constraint rows (%d redundant removed), %d degrees of freedom;\n"
+             " * K = [M D^T; D 0] is %d x %d with %d nonzeros. */\n",
+          m->nbody, m->nc, L->nredundant, L->dof, m->n, m->n, m->nnz);
+  fprintf(f, "#include \"%s.h\"\n\n", nm);
+  fprintf(f, "/* --- CSC pattern of K (both triangles) --- */\n");
+  int_array(f, "Kp", L->Kp, m->n + 1);
+  if (m->nnz) int_array(f, "Ki", L->Ki, m->nnz);
+  fprintf(f, "\n/* --- assembled, consistent initial state --- */\n");
+  if (m->nq) real_array(f, "q0", L->q0, m->nq);
+  if (m->nv) real_array(f, "v0", L->v0, m->nv);
+  fputc('\n', f);
+  emit_tables(f, L);
+  emit_init(f, L, nm);
+  emit_eval(f, L, nm);
+  fprintf(f, "\nconst mb_model %s_model = {\n", nm);
+  fprintf(f, "  .name = \"%s\",\n  .nbody = %d, .nmarker = %d, .nrow = %d, .nforce = %d,\n"
+             "  .nprofile = %d, .noutput = %d, .njoint = %d,\n"
+             "  .nq = %s_NQ, .nv = %s_NV, .nc = %s_NC, .n = %s_N, .nnz = %s_NNZ,\n",
+          nm, m->nbody, m->nmarker, m->nrow, m->nforce, m->nprofile, m->noutput, m->njoint, U, U,
+          U, U, U);
+  fprintf(f, "  .body = %s, .marker = %s, .row = %s, .force = %s,\n  .profile = %s, .output = %s, .joint_name = %s,\n",
+          m->nbody ? "bodies" : "0", m->nmarker ? "markers" : "0", m->nrow ? "rows" : "0",
+          m->nforce ? "forces" : "0", m->nprofile ? "profiles" : "0",
+          m->noutput ? "outputs" : "0", m->njoint ? "joint_names" : "0");
+  fputs("  .gravity = ", f);
+  vec(f, m->gravity, 3);
+  fprintf(f, ",\n  .Kp = Kp, .Ki = %s, .q0 = %s, .v0 = %s,\n", m->nnz ? "Ki" : "0",
+          m->nq ? "q0" : "0", m->nv ? "v0" : "0");
+  fprintf(f, "  .ncols = %s_NCOLS, .col_name = %s,\n  .eval = %s_eval, .init = %s_init,\n};\n", U,
+          m->ncols ? "col_names" : "0", nm, nm);
+}
+
+static void emit_main(FILE *f, const lmodel *L, const char *nm) {
+  const ir_sim *s = &L->ir->sim;
+  fprintf(f, "/* main.c: generated by mbcc: the simulator for model %s. Do not edit. */\n", nm);
+  fprintf(f, "#include \"mb_driver.h\"\n#include \"%s.h\"\n\n", nm);
+  fprintf(f, "int main(int argc, char **argv) {\n  mb_settings s;\n  mb_settings_default(&s);\n");
+  fprintf(f, "  s.integrator = %s;\n", s->integrator == INTEGRATOR_RK4 ? "MB_RK4" : "MB_DOPRI5");
+  fputs("  s.end_time = ", f); num(f, s->end_time);
+  fputs(";\n  s.output_step = ", f); num(f, s->output_step);
+  fputs(";\n  s.step = ", f); num(f, s->step);
+  fputs(";\n  s.rtol = ", f); num(f, s->rtol);
+  fputs(";\n  s.atol = ", f); num(f, s->atol);
+  fputs(";\n  s.min_step = ", f); num(f, s->min_step);
+  fputs(";\n  s.max_step = ", f); num(f, s->max_step);
+  fprintf(f, ";\n  s.stabilization = %s;\n",
+          s->stabilization == STAB_PROJECTION ? "MB_STAB_PROJECTION"
+          : s->stabilization == STAB_BAUMGARTE ? "MB_STAB_BAUMGARTE" : "MB_STAB_NONE");
+  fputs("  s.alpha = ", f); num(f, s->baumgarte_alpha);
+  fputs(";\n  s.beta = ", f); num(f, s->baumgarte_beta);
+  fprintf(f, ";\n  return mb_main(argc, argv, &%s_model, &s, \"%s\");\n}\n", nm,
+          s->solver == SOLVER_DENSE ? "dense" : "klu");
+}
+
+static int rm_tree_files(const char *dir) {
+  /* the generated directory holds only files we write: remove them by name */
+  static const char *names[] = {"main.c", NULL};
+  char path[4096];
+  for (int i = 0; names[i]; i++) {
+    if (join(path, sizeof path, dir, names[i])) return -1;
+    remove(path);
+  }
+  return 0;
+}
+
+int emit_model(const lmodel *L, const char *dir) {
+  const char *nm = L->m.name;
+  char tmp[4096], hname[300], cname[300];
+  snprintf(tmp, sizeof tmp, "%s.tmp", dir);
+  snprintf(hname, sizeof hname, "%s.h", nm);
+  snprintf(cname, sizeof cname, "%s.c", nm);
+  /* write everything into DIR.tmp, then swap it in: nothing half-written */
+  char cmd_path[4096];
+  if (join(cmd_path, sizeof cmd_path, tmp, hname)) return -1;
+  remove(cmd_path);
+  if (join(cmd_path, sizeof cmd_path, tmp, cname)) return -1;
+  remove(cmd_path);
+  rm_tree_files(tmp);
+  rmdir(tmp);
+  if (mkdir(tmp, 0777) && errno != EEXIST) {
+    diag_error(NULL, (ir_loc){0, 0}, "cannot create directory '%s': %s", tmp, strerror(errno));
+    return 2;
+  }
+  if (write_file(tmp, hname, L, emit_header, NULL, 0) ||
+      write_file(tmp, cname, L, emit_source, NULL, 0) ||
+      write_file(tmp, "main.c", L, emit_main, NULL, 0)) {
+    diag_error(NULL, (ir_loc){0, 0}, "cannot write generated code in '%s'", tmp);
+    return 2;
+  }
+  /* replace the old directory's files */
+  mkdir(dir, 0777);
+  const char *files[3] = {hname, cname, "main.c"};
+  for (int i = 0; i < 3; i++) {
+    char from[4096], to[4096];
+    if (join(from, sizeof from, tmp, files[i])) return -1;
+    if (join(to, sizeof to, dir, files[i])) return -1;
+    if (rename(from, to)) {
+      diag_error(NULL, (ir_loc){0, 0}, "cannot move '%s' to '%s': %s", from, to, strerror(errno));
+      return 2;
+    }
+  }
+  rmdir(tmp);
+  return 0;
+}

@@ -1,0 +1,221 @@
+/* ir.h: the in-memory model (intermediate representation) that the YAML
+ * reader produces and the later compiler stages (scene, lowering, pattern,
+ * emit) consume.  Units are SI; every vector given in the model is global
+ * and describes the assembled configuration at t = 0. */
+#ifndef MBCC_IR_H
+#define MBCC_IR_H
+
+#include <stdbool.h>
+
+/* A source location, 1-based (libyaml marks are 0-based: add 1). */
+typedef struct {
+  int line, col;
+} ir_loc;
+
+/* --- time functions (drivers, forces given in time) ---------------------- */
+typedef enum {
+  PROFILE_NONE = 0,
+  PROFILE_CONSTANT,          /* x = value                                   */
+  PROFILE_CONSTANT_VELOCITY, /* x = initial + velocity * t                  */
+  PROFILE_POLYNOMIAL,        /* x = sum c[k] t^k, k < nc (nc <= 8)           */
+  PROFILE_RAMP,              /* cubic step from (t0, x0) to (t1, x1), as
+                                Adams STEP: flat before t0 and after t1     */
+  PROFILE_SINE,              /* x = offset + amplitude sin(2 pi f t + phase) */
+  PROFILE_TABLE              /* natural cubic spline through (t_k, x_k),
+                                held constant outside the table            */
+} ir_profile_kind;
+
+typedef struct {
+  ir_profile_kind kind;
+  double c[8];   /* CONSTANT: c[0]=value.  CONSTANT_VELOCITY: c[0]=initial,
+                    c[1]=velocity.  POLYNOMIAL: c[0..nc-1].  RAMP: c[0]=t0,
+                    c[1]=x0, c[2]=t1, c[3]=x1.  SINE: c[0]=amplitude,
+                    c[1]=frequency (Hz), c[2]=phase (rad), c[3]=offset      */
+  int nc;
+  double *table; /* TABLE: ntable pairs t0,x0,t1,x1,... (t strictly rising) */
+  int ntable;
+  ir_loc loc;
+} ir_profile;
+
+/* --- bodies ----------------------------------------------------------------- */
+typedef enum { BODY_GROUND, BODY_RIGID, BODY_VIRTUAL, BODY_FLEXIBLE } ir_body_kind;
+
+struct ir_flex; /* the FE / modal description of a flexible body (flexible-bodies issue) */
+
+typedef struct {
+  char *name;
+  ir_loc loc;                 /* of the body's key */
+  ir_body_kind kind;
+  double mass;                /* 0 for virtual and ground */
+  double inertia[9];          /* about the centre of mass, in body axes, row-major */
+  double position[3];         /* body frame origin (centre of mass), global */
+  double orientation[4];      /* Euler parameters e0..e3, normalized */
+  double velocity[3];         /* initial, global (made consistent at assembly) */
+  double angular_velocity[3]; /* initial, global */
+  struct ir_flex *flex;       /* NULL unless kind == BODY_FLEXIBLE */
+} ir_body;
+
+/* --- joints ------------------------------------------------------------------ */
+typedef enum {
+  JOINT_SPHERICAL,
+  JOINT_REVOLUTE,    /* rotation about axis */
+  JOINT_CYLINDRICAL, /* rotation about and translation along axis */
+  JOINT_PRISMATIC,   /* translation along axis */
+  JOINT_UNIVERSAL,   /* axis[0] fixed in body 0, axis[1] fixed in body 1, perpendicular */
+  JOINT_FIXED,
+  JOINT_DISTANCE     /* |point[1]-point[0]| held at its initial length */
+} ir_joint_kind;
+
+typedef struct {
+  char *name;
+  ir_loc loc;
+  ir_joint_kind kind;
+  int body[2];        /* indices into ir_model.bodies (0 is ground) */
+  ir_loc body_loc[2];
+  int node[2];        /* FE node on a flexible body, or -1 */
+  double point[2][3]; /* global joint point on each side (equal except distance) */
+  double axis[2][3];  /* unit joint axis on each side (equal except universal) */
+  double ref[3];      /* unit reference direction perpendicular to axis[0] (the
+                         marker x axis; angles of a driver are measured about
+                         axis[0] from it); chosen by the reader if not given */
+  bool active;        /* false when a scene deactivates it */
+} ir_joint;
+
+/* --- drivers ------------------------------------------------------------------- */
+typedef enum { DRIVER_ROTATION, DRIVER_TRANSLATION } ir_driver_dof;
+
+typedef struct {
+  char *name;
+  ir_loc loc;
+  int joint;          /* index into ir_model.joints */
+  ir_driver_dof dof;  /* relative rotation about / translation along the joint axis,
+                         measured from the configuration at t = 0 */
+  ir_profile motion;
+  bool active;
+} ir_driver;
+
+/* --- forces ---------------------------------------------------------------------- */
+typedef enum {
+  FORCE_POINT_FORCE,   /* a force at a point of one body */
+  FORCE_POINT_TORQUE,  /* a torque on one body */
+  FORCE_SPRING_DAMPER, /* along the line between two points */
+  FORCE_BUSHING        /* 6 diagonal stiffness and damping terms in a frame */
+} ir_force_kind;
+
+typedef enum { LAW_NONE = 0, LAW_LINEAR, LAW_POWER, LAW_TABLE } ir_law_kind;
+
+/* Force law F(x): LINEAR F = coef x; POWER F = coef sign(x) |x|^exponent;
+ * TABLE: piecewise linear through (x_k, F_k), extrapolated linearly. */
+typedef struct {
+  ir_law_kind kind;
+  double coef, exponent;
+  double *table;  /* ntable pairs x0,F0,x1,F1,... (x strictly rising) */
+  int ntable;
+  ir_loc loc;
+} ir_law;
+
+typedef enum { FRAME_GLOBAL, FRAME_BODY } ir_frame;
+
+typedef struct {
+  char *name;
+  ir_loc loc;
+  ir_force_kind kind;
+  int body[2];        /* POINT_FORCE/TORQUE use body[0]; body[1] = -1 */
+  ir_loc body_loc[2];
+  int node[2];        /* FE node on a flexible body, or -1 */
+  double point[2][3]; /* global application points (spring ends; bushing: both = point) */
+  /* point force / torque: value(t) = vector * scale(t) (scale: constant 1 if absent) */
+  double vector[3];
+  ir_frame frame;     /* vector fixed in global axes or in the body's axes */
+  ir_profile scale;
+  /* spring-damper: tension T = stiffness(L - free_length) + damping(dL/dt) + preload */
+  ir_law stiffness, damping;
+  double free_length; /* defaults to the initial length */
+  double preload;
+  /* bushing: in the frame 'axes' (rows are the global x, y, z axes of the
+     bushing frame at t = 0; default identity), forces -k x - c v + preload */
+  double k6[6], c6[6], preload6[6];
+  double axes[9];
+  bool active;
+} ir_force;
+
+/* --- outputs ----------------------------------------------------------------------- */
+typedef enum {
+  OUT_POSITION,             /* body (or point on it) position, global: 3 columns or one */
+  OUT_ORIENTATION,          /* Euler parameters: 4 columns */
+  OUT_ANGLE,                /* rotation angle about 'axis' (global), unwrapped: 1 column */
+  OUT_VELOCITY,             /* global, 3 or 1 */
+  OUT_ANGULAR_VELOCITY,     /* global, 3 or 1 */
+  OUT_ACCELERATION,         /* global, 3 or 1 */
+  OUT_ANGULAR_ACCELERATION, /* global, 3 or 1 */
+  OUT_REACTION,             /* joint: force (3) and torque (3) on body[1] at its point, global */
+  OUT_EFFORT,               /* driver: torque or force along the joint axis: 1 */
+  OUT_KINETIC_ENERGY,       /* system: 1 */
+  OUT_POTENTIAL_ENERGY,     /* system, gravity and springs: 1 */
+  OUT_TOTAL_ENERGY,         /* system: 1 */
+  OUT_DEFLECTION            /* flexible body node deflection (flexible-bodies issue) */
+} ir_output_kind;
+
+typedef struct {
+  char *name;
+  ir_loc loc;
+  ir_output_kind kind;
+  int body;          /* or -1 */
+  int joint;         /* or -1 */
+  int driver;        /* or -1 */
+  int node;          /* or -1 */
+  bool has_point;
+  double point[3];   /* global point on the body at t = 0 */
+  double axis[3];    /* OUT_ANGLE: unit axis */
+  int component;     /* -1: all components; 0, 1, 2: x, y, z only */
+  double scale;      /* multiply the output by this (default 1) */
+} ir_output;
+
+/* --- simulation settings --------------------------------------------------------------- */
+typedef enum { INTEGRATOR_RK4, INTEGRATOR_DOPRI5 } ir_integrator;
+typedef enum { SOLVER_KLU, SOLVER_DENSE } ir_solver;
+typedef enum { STAB_PROJECTION, STAB_BAUMGARTE, STAB_NONE } ir_stab;
+typedef enum { JOF_DIRECT, JOF_VIRTUAL } ir_jof;
+
+typedef struct {
+  double end_time;      /* default 1 */
+  double output_step;   /* default end_time / 100 */
+  double step;          /* RK4 step, DOPRI5 initial step; default output_step / 10 */
+  double rtol, atol;    /* DOPRI5; defaults 1e-6, 1e-8 */
+  double min_step, max_step; /* DOPRI5; defaults 1e-12, output_step */
+  ir_integrator integrator;  /* default dopri5 */
+  ir_solver solver;          /* default klu */
+  ir_stab stabilization;     /* default projection */
+  double baumgarte_alpha, baumgarte_beta; /* defaults 10, 10 */
+  ir_jof joints_on_flexible; /* default direct */
+} ir_sim;
+
+/* --- the model ------------------------------------------------------------------------- */
+typedef struct {
+  char *path;        /* the file read */
+  char *name;
+  char *scene;       /* the scene applied, or NULL */
+  double gravity[3]; /* default 0 */
+  ir_body *bodies;   /* bodies[0] is the implicit ground */
+  int nbodies;
+  ir_joint *joints;
+  int njoints;
+  ir_driver *drivers;
+  int ndrivers;
+  ir_force *forces;
+  int nforces;
+  ir_output *outputs;
+  int noutputs;
+  ir_sim sim;
+} ir_model;
+
+/* Read and validate a model, applying scene 'scene' (NULL: the base model).
+ * On any error, prints GNU-style diagnostics "file:line:col: error: ..." to
+ * stderr and returns NULL. */
+ir_model *ir_read(const char *path, const char *scene);
+void ir_free(ir_model *m);
+
+int ir_find_body(const ir_model *m, const char *name);   /* -1 if absent */
+int ir_find_joint(const ir_model *m, const char *name);
+
+#endif

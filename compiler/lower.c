@@ -1,0 +1,580 @@
+/* lower.c: lowers the IR to coordinates, markers, constraint rows, force and
+ * output tables, and works out the fixed CSC pattern of K = [M D^T; D 0]. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "diag.h"
+#include "lower.h"
+
+static char *xstrdup_printf(const char *fmt, const char *a, const char *b, const char *c) {
+  char buf[512];
+  snprintf(buf, sizeof buf, fmt, a, b, c);
+  return strdup(buf);
+}
+
+/* global axes frame (columns x, y, z) from a z axis and an x reference */
+static void frame_from_axes(const double z[3], const double xref[3], double C[9]) {
+  double x[3], y[3];
+  double d = mb_dot3(xref, z);
+  for (int k = 0; k < 3; k++) x[k] = xref[k] - d * z[k];
+  double n = sqrt(mb_dot3(x, x));
+  for (int k = 0; k < 3; k++) x[k] /= n;
+  mb_cross3(z, x, y);
+  for (int k = 0; k < 3; k++) {
+    C[3 * k + 0] = x[k];
+    C[3 * k + 1] = y[k];
+    C[3 * k + 2] = z[k];
+  }
+}
+
+/* any unit vector perpendicular to a */
+static void perpendicular(const double a[3], double u[3]) {
+  int k = 0;
+  for (int j = 1; j < 3; j++)
+    if (fabs(a[j]) < fabs(a[k])) k = j;
+  double e[3] = {0, 0, 0};
+  e[k] = 1;
+  double d = mb_dot3(e, a);
+  for (int j = 0; j < 3; j++) u[j] = e[j] - d * a[j];
+  double n = sqrt(mb_dot3(u, u));
+  for (int j = 0; j < 3; j++) u[j] /= n;
+}
+
+/* natural cubic spline second derivatives through ntable (t, x) pairs */
+static void natural_spline(const double *d, int n, double *m2) {
+  double *u = calloc((size_t)n, sizeof(double));
+  m2[0] = m2[n - 1] = 0;
+  if (u) {
+    u[0] = 0;
+    for (int i = 1; i < n - 1; i++) {
+      double sig = (d[2 * i] - d[2 * i - 2]) / (d[2 * i + 2] - d[2 * i - 2]);
+      double p = sig * m2[i - 1] + 2;
+      m2[i] = (sig - 1) / p;
+      double du = (d[2 * i + 3] - d[2 * i + 1]) / (d[2 * i + 2] - d[2 * i]) -
+                  (d[2 * i + 1] - d[2 * i - 1]) / (d[2 * i] - d[2 * i - 2]);
+      u[i] = (6 * du / (d[2 * i + 2] - d[2 * i - 2]) - sig * u[i - 1]) / p;
+    }
+    for (int i = n - 2; i >= 0; i--) m2[i] = m2[i] * m2[i + 1] + u[i];
+    free(u);
+  }
+}
+
+static int add_profile(lmodel *L, const ir_profile *p, int driver, int force) {
+  int k = L->m.nprofile++;
+  mb_profile *P = &L->profile[k];
+  memset(P, 0, sizeof *P);
+  P->kind = (int)p->kind; /* the IR and runtime enumerations agree */
+  for (int j = 0; j < 8; j++) P->c[j] = p->c[j];
+  P->nc = p->nc;
+  L->profile_driver[k] = driver;
+  L->profile_force[k] = force;
+  if (p->kind == PROFILE_TABLE) {
+    L->table[k] = malloc(sizeof(double) * 2 * (size_t)p->ntable);
+    L->spline[k] = malloc(sizeof(double) * (size_t)p->ntable);
+    if (!L->table[k] || !L->spline[k]) return -1;
+    memcpy(L->table[k], p->table, sizeof(double) * 2 * (size_t)p->ntable);
+    natural_spline(p->table, p->ntable, L->spline[k]);
+    P->ntable = p->ntable;
+    P->table = L->table[k];
+    P->spline = L->spline[k];
+  }
+  return k;
+}
+
+/* a marker on IR body ib at global point P with global axes Cg */
+static int add_marker(lmodel *L, int ib, const double P[3], const double Cg[9], char *desc) {
+  int k = L->m.nmarker++;
+  mb_markerdef *d = &L->marker[k];
+  L->marker_desc[k] = desc;
+  d->body = ib - 1;
+  if (ib == 0) {
+    memcpy(d->s, P, sizeof(double) * 3);
+    memcpy(d->C, Cg, sizeof(double) * 9);
+    return k;
+  }
+  const ir_body *B = &L->ir->bodies[ib];
+  double A[9], rel[3];
+  mb_euler_to_A(B->orientation, A);
+  for (int j = 0; j < 3; j++) rel[j] = P[j] - B->position[j];
+  mb_mul3t(A, rel, d->s);
+  /* C = A^T Cg */
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      d->C[3 * i + j] = A[i] * Cg[j] + A[3 + i] * Cg[3 + j] + A[6 + i] * Cg[6 + j];
+  return k;
+}
+
+static const char *joint_kind_name(ir_joint_kind k) {
+  static const char *n[] = {"spherical", "revolute", "cylindrical", "prismatic",
+                            "universal", "fixed", "distance"};
+  return n[k];
+}
+
+static void add_row(lmodel *L, int kind, int m0, int m1, int a, int b, const char *what,
+                    int joint, int driver, ir_loc loc, const char *elem, const char *ekind) {
+  int r = L->m.nrow++;
+  mb_rowdef *R = &L->row[r];
+  memset(R, 0, sizeof *R);
+  R->kind = kind;
+  R->m0 = m0;
+  R->m1 = m1;
+  R->a = a;
+  R->b = b;
+  R->profile = -1;
+  R->joint = joint;
+  R->driver = driver;
+  L->row_desc[r] = xstrdup_printf("%s '%s': %s", ekind, elem, what);
+  L->row_loc[r] = loc;
+}
+
+static const char *axis_name[3] = {"x", "y", "z"};
+
+/* the rows of a joint between markers m0 and m1 (joint frames z = axis) */
+static void joint_rows(lmodel *L, int j, int m0, int m1) {
+  const ir_joint *J = &L->ir->joints[j];
+  char what[64];
+  ir_loc loc = J->loc;
+  const char *nm = J->name, *kn = joint_kind_name(J->kind);
+  int sph = 0, perp_z = 0, dot2 = 0, noroll = 0;
+  switch (J->kind) {
+  case JOINT_SPHERICAL: sph = 1; break;
+  case JOINT_REVOLUTE: sph = 1; perp_z = 1; break;
+  case JOINT_CYLINDRICAL: perp_z = 1; dot2 = 1; break;
+  case JOINT_PRISMATIC: perp_z = 1; dot2 = 1; noroll = 1; break;
+  case JOINT_UNIVERSAL: sph = 1; break;
+  case JOINT_FIXED: sph = 1; break;
+  case JOINT_DISTANCE: {
+    double d[3];
+    for (int k = 0; k < 3; k++) d[k] = J->point[1][k] - J->point[0][k];
+    add_row(L, MB_PRIM_DIST, m0, m1, 0, 0, "distance", j, -1, loc, nm, kn);
+    L->row[L->m.nrow - 1].L = sqrt(mb_dot3(d, d));
+    return;
+  }
+  }
+  if (sph)
+    for (int k = 0; k < 3; k++) {
+      snprintf(what, sizeof what, "coincident points, %s", axis_name[k]);
+      add_row(L, MB_PRIM_SPH, m0, m1, k, 0, what, j, -1, loc, nm, kn);
+    }
+  if (perp_z) {
+    add_row(L, MB_PRIM_DOT1, m0, m1, 0, 2, "axis z1 perpendicular to x0", j, -1, loc, nm, kn);
+    add_row(L, MB_PRIM_DOT1, m0, m1, 1, 2, "axis z1 perpendicular to y0", j, -1, loc, nm, kn);
+  }
+  if (dot2) {
+    add_row(L, MB_PRIM_DOT2, m0, m1, 0, 0, "point 1 on axis, x0 offset", j, -1, loc, nm, kn);
+    add_row(L, MB_PRIM_DOT2, m0, m1, 1, 0, "point 1 on axis, y0 offset", j, -1, loc, nm, kn);
+  }
+  if (noroll)
+    add_row(L, MB_PRIM_DOT1, m0, m1, 0, 1, "no rotation about axis (x0 . y1)", j, -1, loc, nm, kn);
+  if (J->kind == JOINT_UNIVERSAL)
+    add_row(L, MB_PRIM_DOT1, m0, m1, 2, 2, "cross axes perpendicular (z0 . z1)", j, -1, loc, nm,
+            kn);
+  if (J->kind == JOINT_FIXED) {
+    add_row(L, MB_PRIM_DOT1, m0, m1, 0, 1, "no rotation about z (x0 . y1)", j, -1, loc, nm, kn);
+    add_row(L, MB_PRIM_DOT1, m0, m1, 1, 2, "no rotation about x (y0 . z1)", j, -1, loc, nm, kn);
+    add_row(L, MB_PRIM_DOT1, m0, m1, 2, 0, "no rotation about y (z0 . x1)", j, -1, loc, nm, kn);
+  }
+}
+
+static int output_columns(const ir_output *o) {
+  switch (o->kind) {
+  case OUT_POSITION: case OUT_VELOCITY: case OUT_ANGULAR_VELOCITY: case OUT_ACCELERATION:
+  case OUT_ANGULAR_ACCELERATION:
+    return o->component >= 0 ? 1 : 3;
+  case OUT_ORIENTATION: return 4;
+  case OUT_REACTION: return 6;
+  default: return 1;
+  }
+}
+
+static const int out_kind_map[] = {
+    [OUT_POSITION] = MB_OUT_POSITION, [OUT_ORIENTATION] = MB_OUT_ORIENTATION,
+    [OUT_ANGLE] = MB_OUT_ANGLE, [OUT_VELOCITY] = MB_OUT_VELOCITY,
+    [OUT_ANGULAR_VELOCITY] = MB_OUT_ANGULAR_VELOCITY, [OUT_ACCELERATION] = MB_OUT_ACCELERATION,
+    [OUT_ANGULAR_ACCELERATION] = MB_OUT_ANGULAR_ACCELERATION, [OUT_REACTION] = MB_OUT_REACTION,
+    [OUT_EFFORT] = MB_OUT_EFFORT, [OUT_KINETIC_ENERGY] = MB_OUT_KINETIC_ENERGY,
+    [OUT_POTENTIAL_ENERGY] = MB_OUT_POTENTIAL_ENERGY, [OUT_TOTAL_ENERGY] = MB_OUT_TOTAL_ENERGY};
+
+lmodel *lower_model(const ir_model *ir) {
+  lmodel *L = calloc(1, sizeof *L);
+  if (!L) return NULL;
+  L->ir = ir;
+  int nb = ir->nbodies - 1;
+  int maxmk = 2 * ir->njoints + 2 * ir->nforces + 1;
+  int maxrow = 6 * ir->njoints + ir->ndrivers + 1;
+  int maxprof = ir->ndrivers + ir->nforces + 1;
+  L->body = calloc((size_t)nb + 1, sizeof *L->body);
+  L->marker = calloc((size_t)maxmk, sizeof *L->marker);
+  L->marker_desc = calloc((size_t)maxmk, sizeof(char *));
+  L->row = calloc((size_t)maxrow, sizeof *L->row);
+  L->row_desc = calloc((size_t)maxrow, sizeof(char *));
+  L->row_loc = calloc((size_t)maxrow, sizeof(ir_loc));
+  L->force = calloc((size_t)ir->nforces + 1, sizeof *L->force);
+  L->force_ir = calloc((size_t)ir->nforces + 1, sizeof(int));
+  L->profile = calloc((size_t)maxprof, sizeof *L->profile);
+  L->profile_driver = calloc((size_t)maxprof, sizeof(int));
+  L->profile_force = calloc((size_t)maxprof, sizeof(int));
+  L->spline = calloc((size_t)maxprof, sizeof(double *));
+  L->table = calloc((size_t)maxprof, sizeof(double *));
+  L->output = calloc((size_t)ir->noutputs + 1, sizeof *L->output);
+  L->q0 = calloc(7 * (size_t)nb + 1, sizeof(double));
+  L->v0 = calloc(6 * (size_t)nb + 1, sizeof(double));
+  L->joint_name = calloc((size_t)ir->njoints + 1, sizeof(char *));
+  int ncols = 0;
+  for (int k = 0; k < ir->noutputs; k++) ncols += output_columns(&ir->outputs[k]);
+  L->col_name = calloc((size_t)ncols + 1, sizeof(char *));
+  if (!L->body || !L->marker || !L->marker_desc || !L->row || !L->row_desc || !L->row_loc ||
+      !L->force || !L->force_ir || !L->profile || !L->profile_driver || !L->profile_force ||
+      !L->spline || !L->table || !L->output || !L->q0 || !L->v0 || !L->joint_name ||
+      !L->col_name) {
+    lower_free(L);
+    return NULL;
+  }
+  mb_model *m = &L->m;
+  m->name = ir->name;
+  memcpy(m->gravity, ir->gravity, sizeof m->gravity);
+
+  /* bodies: 7 position and 6 velocity coordinates each */
+  for (int b = 0; b < nb; b++) {
+    const ir_body *B = &ir->bodies[b + 1];
+    mb_body *d = &L->body[b];
+    d->name = B->name;
+    d->kind = B->kind == BODY_VIRTUAL ? MB_BODY_VIRTUAL : MB_BODY_RIGID;
+    d->mass = B->mass;
+    memcpy(d->J, B->inertia, sizeof d->J);
+    d->qadr = 7 * b;
+    d->vadr = 6 * b;
+    double A[9];
+    mb_euler_to_A(B->orientation, A);
+    memcpy(L->q0 + 7 * b, B->position, sizeof(double) * 3);
+    memcpy(L->q0 + 7 * b + 3, B->orientation, sizeof(double) * 4);
+    memcpy(L->v0 + 6 * b, B->velocity, sizeof(double) * 3);
+    mb_mul3t(A, B->angular_velocity, L->v0 + 6 * b + 3);
+  }
+  m->nbody = nb;
+  m->nq = 7 * nb;
+  m->nv = 6 * nb;
+
+  /* joints: two markers each (frames z = axis), then their rows */
+  int *jm0 = calloc((size_t)ir->njoints + 1, sizeof(int));
+  int *jm1 = calloc((size_t)ir->njoints + 1, sizeof(int));
+  if (!jm0 || !jm1) { free(jm0); free(jm1); lower_free(L); return NULL; }
+  for (int j = 0; j < ir->njoints; j++) {
+    const ir_joint *J = &ir->joints[j];
+    L->joint_name[j] = J->name;
+    if (!J->active) { jm0[j] = jm1[j] = -1; continue; }
+    double C0[9], C1[9];
+    frame_from_axes(J->axis[0], J->ref, C0);
+    if (J->kind == JOINT_UNIVERSAL)
+      frame_from_axes(J->axis[1], J->axis[0], C1); /* x1 along the other cross axis */
+    else
+      memcpy(C1, C0, sizeof C1);
+    jm0[j] = add_marker(L, J->body[0], J->point[0], C0,
+                        xstrdup_printf("joint '%s', on body '%s'%s", J->name,
+                                       ir->bodies[J->body[0]].name, ""));
+    jm1[j] = add_marker(L, J->body[1], J->point[1], C1,
+                        xstrdup_printf("joint '%s', on body '%s'%s", J->name,
+                                       ir->bodies[J->body[1]].name, ""));
+    joint_rows(L, j, jm0[j], jm1[j]);
+  }
+  for (int d = 0; d < ir->ndrivers; d++) {
+    const ir_driver *D = &ir->drivers[d];
+    if (!D->active || !ir->joints[D->joint].active) continue;
+    int p = add_profile(L, &D->motion, d, -1);
+    if (p < 0) { free(jm0); free(jm1); lower_free(L); return NULL; }
+    int rot = D->dof == DRIVER_ROTATION;
+    add_row(L, rot ? MB_PRIM_ROT : MB_PRIM_TRANS, jm0[D->joint], jm1[D->joint], 2, 0,
+            rot ? "rotation about the joint axis follows the motion"
+                : "translation along the joint axis follows the motion",
+            -1, d, D->loc, D->name, "driver");
+    L->row[m->nrow - 1].profile = p;
+  }
+
+  /* forces */
+  static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  for (int e = 0; e < ir->nforces; e++) {
+    const ir_force *F = &ir->forces[e];
+    if (!F->active) continue;
+    int k = m->nforce++;
+    mb_forcedef *d = &L->force[k];
+    L->force_ir[k] = e;
+    d->profile = -1;
+    d->m1 = -1;
+    switch (F->kind) {
+    case FORCE_POINT_FORCE:
+    case FORCE_POINT_TORQUE:
+      d->kind = F->kind == FORCE_POINT_FORCE ? MB_FORCE_POINT : MB_FORCE_TORQUE;
+      d->m0 = add_marker(L, F->body[0], F->point[0], I3,
+                         xstrdup_printf("force '%s', on body '%s'%s", F->name,
+                                        ir->bodies[F->body[0]].name, ""));
+      memcpy(d->vec, F->vector, sizeof d->vec);
+      d->body_frame = F->frame == FRAME_BODY;
+      if (F->scale.kind != PROFILE_NONE) d->profile = add_profile(L, &F->scale, -1, e);
+      break;
+    case FORCE_SPRING_DAMPER:
+    case FORCE_BUSHING: {
+      double Cg[9];
+      for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) Cg[3 * i + j] = F->axes[3 * j + i]; /* columns = axes rows */
+      int spring = F->kind == FORCE_SPRING_DAMPER;
+      d->kind = spring ? MB_FORCE_SPRING : MB_FORCE_BUSHING;
+      for (int s = 0; s < 2; s++) {
+        int mk = add_marker(L, F->body[s], F->point[s], spring ? I3 : Cg,
+                            xstrdup_printf("force '%s', on body '%s'%s", F->name,
+                                           ir->bodies[F->body[s]].name, ""));
+        if (s) d->m1 = mk; else d->m0 = mk;
+      }
+      if (spring) {
+        const ir_law *laws[2] = {&F->stiffness, &F->damping};
+        mb_law *out[2] = {&d->stiffness, &d->damping};
+        for (int l = 0; l < 2; l++) {
+          out[l]->kind = (int)laws[l]->kind;
+          out[l]->coef = laws[l]->coef;
+          out[l]->exponent = laws[l]->exponent;
+          out[l]->ntable = laws[l]->ntable;
+          out[l]->table = laws[l]->table; /* owned by the IR, which outlives L */
+        }
+        d->L0 = F->free_length;
+        d->preload = F->preload;
+      } else {
+        memcpy(d->k6, F->k6, sizeof d->k6);
+        memcpy(d->c6, F->c6, sizeof d->c6);
+        memcpy(d->pre6, F->preload6, sizeof d->pre6);
+      }
+      break;
+    }
+    }
+  }
+
+  /* outputs */
+  int col = 0;
+  for (int k = 0; k < ir->noutputs; k++) {
+    const ir_output *o = &ir->outputs[k];
+    mb_outputdef *d = &L->output[k];
+    d->kind = out_kind_map[o->kind];
+    d->body = o->body >= 0 ? o->body - 1 : -1;
+    d->component = o->component;
+    d->scale = o->scale;
+    d->joint = o->joint;
+    d->driver_row = -1;
+    d->reaction_marker = -1;
+    d->driver_marker = -1;
+    d->ncols = output_columns(o);
+    d->col = col;
+    if (d->body >= 0) {
+      const ir_body *B = &ir->bodies[o->body];
+      double A[9], rel[3];
+      mb_euler_to_A(B->orientation, A);
+      if (o->has_point) {
+        for (int j = 0; j < 3; j++) rel[j] = o->point[j] - B->position[j];
+        mb_mul3t(A, rel, d->s);
+      }
+      if (o->kind == OUT_ANGLE) {
+        memcpy(d->axis_g, o->axis, sizeof d->axis_g);
+        perpendicular(o->axis, d->u_g);
+        mb_mul3t(A, d->axis_g, d->axis);
+        mb_mul3t(A, d->u_g, d->u);
+      }
+    }
+    if (o->kind == OUT_REACTION) d->reaction_marker = jm1[o->joint];
+    if (o->kind == OUT_EFFORT) {
+      const ir_driver *D = &ir->drivers[o->driver];
+      d->driver_marker = jm0[D->joint];
+      d->driver_rotation = D->dof == DRIVER_ROTATION;
+      for (int r = 0; r < m->nrow; r++)
+        if (L->row[r].driver == o->driver) d->driver_row = r;
+    }
+    static const char *xyz[3] = {"x", "y", "z"}, *e4[4] = {"e0", "e1", "e2", "e3"},
+                      *rc[6] = {"fx", "fy", "fz", "tx", "ty", "tz"};
+    for (int j = 0; j < d->ncols; j++) {
+      const char *suffix = NULL;
+      if (d->ncols == 3) suffix = xyz[j];
+      else if (d->ncols == 4) suffix = e4[j];
+      else if (d->ncols == 6) suffix = rc[j];
+      L->col_name[col + j] = suffix ? xstrdup_printf("%s.%s%s", o->name, suffix, "")
+                                    : strdup(o->name);
+    }
+    col += d->ncols;
+  }
+  m->noutput = ir->noutputs;
+  m->ncols = col;
+  m->njoint = ir->njoints;
+  free(jm0);
+  free(jm1);
+
+  m->body = L->body;
+  m->marker = L->marker;
+  m->row = L->row;
+  m->force = L->force;
+  m->profile = L->profile;
+  m->output = L->output;
+  m->q0 = L->q0;
+  m->v0 = L->v0;
+  m->col_name = (const char *const *)L->col_name;
+  m->joint_name = (const char *const *)L->joint_name;
+  m->eval = mb_generic_eval;
+  m->init = mb_generic_init;
+  if (lower_pattern(L)) { lower_free(L); return NULL; }
+  return L;
+}
+
+/* --- the CSC pattern of K ---------------------------------------------------- */
+typedef struct { int row, col; } entry;
+
+static int entry_cmp(const void *a, const void *b) {
+  const entry *x = a, *y = b;
+  if (x->col != y->col) return x->col < y->col ? -1 : 1;
+  return (x->row > y->row) - (x->row < y->row);
+}
+
+/* which of a row's 6 columns on side s are structurally nonzero, and which constant */
+static void row_structure(const lmodel *L, const mb_rowdef *R, int s, int nz[6], int cst[6]) {
+  const mb_markerdef *md = &L->marker[s ? R->m1 : R->m0];
+  int offset = fabs(md->s[0]) + fabs(md->s[1]) + fabs(md->s[2]) > 0;
+  for (int j = 0; j < 6; j++) nz[j] = cst[j] = 0;
+  switch (R->kind) {
+  case MB_PRIM_SPH:
+    nz[R->a] = cst[R->a] = 1;
+    if (offset) nz[3] = nz[4] = nz[5] = 1;
+    break;
+  case MB_PRIM_DIST:
+    nz[0] = nz[1] = nz[2] = 1;
+    if (offset) nz[3] = nz[4] = nz[5] = 1;
+    break;
+  case MB_PRIM_DOT1:
+  case MB_PRIM_ROT:
+    nz[3] = nz[4] = nz[5] = 1;
+    break;
+  default: /* DOT2, TRANS */
+    for (int j = 0; j < 6; j++) nz[j] = 1;
+    break;
+  }
+}
+
+static int find_slot(const int *Kp, const int *Ki, int row, int col) {
+  for (int p = Kp[col]; p < Kp[col + 1]; p++)
+    if (Ki[p] == row) return p;
+  return -1;
+}
+
+int lower_pattern(lmodel *L) {
+  mb_model *m = &L->m;
+  m->nc = m->nrow;
+  m->n = m->nv + m->nc;
+  size_t cap = 12 * (size_t)m->nbody + 24 * (size_t)m->nrow + 1;
+  entry *E = malloc(cap * sizeof *E);
+  if (!E) return -1;
+  size_t ne = 0;
+  for (int b = 0; b < m->nbody; b++) {
+    const mb_body *B = &L->body[b];
+    if (B->kind != MB_BODY_RIGID) continue;
+    for (int j = 0; j < 3; j++) E[ne++] = (entry){B->vadr + j, B->vadr + j};
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++)
+        if (B->J[3 * i + j] != 0) E[ne++] = (entry){B->vadr + 3 + i, B->vadr + 3 + j};
+  }
+  for (int r = 0; r < m->nrow; r++) {
+    const mb_rowdef *R = &L->row[r];
+    for (int s = 0; s < 2; s++) {
+      int b = L->marker[s ? R->m1 : R->m0].body, nz[6], cst[6];
+      if (b < 0) continue;
+      row_structure(L, R, s, nz, cst);
+      for (int j = 0; j < 6; j++)
+        if (nz[j]) {
+          E[ne++] = (entry){m->nv + r, L->body[b].vadr + j};
+          E[ne++] = (entry){L->body[b].vadr + j, m->nv + r};
+        }
+    }
+  }
+  qsort(E, ne, sizeof *E, entry_cmp);
+  free(L->Kp);
+  free(L->Ki);
+  L->Kp = calloc((size_t)m->n + 1, sizeof(int));
+  L->Ki = malloc((ne + 1) * sizeof(int));
+  if (!L->Kp || !L->Ki) { free(E); return -1; }
+  size_t nnz = 0;
+  for (size_t k = 0; k < ne; k++) {
+    if (k > 0 && E[k].row == E[k - 1].row && E[k].col == E[k - 1].col) continue;
+    L->Ki[nnz++] = E[k].row;
+    L->Kp[E[k].col + 1]++;
+  }
+  for (int j = 0; j < m->n; j++) L->Kp[j + 1] += L->Kp[j];
+  free(E);
+  m->nnz = (int)nnz;
+  m->Kp = L->Kp;
+  m->Ki = L->Ki;
+
+  /* slots */
+  for (int b = 0; b < m->nbody; b++) {
+    mb_body *B = &L->body[b];
+    for (int j = 0; j < 12; j++) B->mslot[j] = -1;
+    if (B->kind != MB_BODY_RIGID) continue;
+    for (int j = 0; j < 3; j++) B->mslot[j] = find_slot(L->Kp, L->Ki, B->vadr + j, B->vadr + j);
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++)
+        B->mslot[3 + 3 * i + j] = find_slot(L->Kp, L->Ki, B->vadr + 3 + i, B->vadr + 3 + j);
+  }
+  for (int r = 0; r < m->nrow; r++) {
+    mb_rowdef *R = &L->row[r];
+    for (int s = 0; s < 2; s++) {
+      int b = L->marker[s ? R->m1 : R->m0].body, nz[6], cst[6];
+      for (int j = 0; j < 6; j++) {
+        R->slot[s][j] = R->slotT[s][j] = -1;
+        R->constant[s][j] = 0;
+      }
+      if (b < 0) continue;
+      row_structure(L, R, s, nz, cst);
+      for (int j = 0; j < 6; j++)
+        if (nz[j]) {
+          int c = L->body[b].vadr + j;
+          R->slot[s][j] = find_slot(L->Kp, L->Ki, m->nv + r, c);
+          R->slotT[s][j] = find_slot(L->Kp, L->Ki, c, m->nv + r);
+          R->constant[s][j] = (unsigned char)cst[j];
+        }
+    }
+  }
+  return 0;
+}
+
+int lower_remove_rows(lmodel *L, const int *keep) {
+  mb_model *m = &L->m;
+  int *newidx = malloc(sizeof(int) * ((size_t)m->nrow + 1));
+  if (!newidx) return -1;
+  int k = 0;
+  for (int r = 0; r < m->nrow; r++) {
+    newidx[r] = keep[r] ? k : -1;
+    if (keep[r]) {
+      L->row[k] = L->row[r];
+      char *desc = L->row_desc[r];
+      L->row_desc[r] = NULL;
+      L->row_desc[k] = desc;
+      L->row_loc[k] = L->row_loc[r];
+      k++;
+    } else {
+      free(L->row_desc[r]);
+      L->row_desc[r] = NULL;
+    }
+  }
+  for (int o = 0; o < m->noutput; o++)
+    if (L->output[o].driver_row >= 0) L->output[o].driver_row = newidx[L->output[o].driver_row];
+  free(newidx);
+  m->nrow = k;
+  return lower_pattern(L);
+}
+
+void lower_free(lmodel *L) {
+  if (!L) return;
+  for (int k = 0; k < L->m.nmarker; k++) free(L->marker_desc[k]);
+  for (int r = 0; r < L->m.nrow; r++) free(L->row_desc[r]);
+  for (int k = 0; k < L->m.nprofile; k++) { free(L->spline[k]); free(L->table[k]); }
+  for (int c = 0; c < L->m.ncols; c++) free(L->col_name[c]);
+  free(L->body); free(L->marker); free(L->marker_desc); free(L->row); free(L->row_desc);
+  free(L->row_loc); free(L->force); free(L->force_ir); free(L->profile);
+  free(L->profile_driver); free(L->profile_force); free(L->spline); free(L->table);
+  free(L->output); free(L->q0); free(L->v0); free(L->col_name); free(L->joint_name);
+  free(L->Kp); free(L->Ki);
+  free(L);
+}

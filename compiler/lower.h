@@ -1,0 +1,54 @@
+/* lower.h: the lowered model: the IR turned into coordinates, markers,
+ * constraint rows, force and output tables, and the fixed CSC pattern of
+ * K = [M D^T; D 0] -- an mb_model (runtime/mb_model.h) that owns its tables,
+ * plus where each entry came from (for diagnostics and generated comments). */
+#ifndef MBCC_LOWER_H
+#define MBCC_LOWER_H
+
+#include "ir.h"
+#include "mb_model.h"
+
+typedef struct {
+  mb_model m;                /* tables below; eval = mb_generic_eval */
+  const ir_model *ir;
+  mb_body *body;             /* m.nbody: IR body b+1 is mb body b */
+  mb_markerdef *marker;
+  mb_rowdef *row;
+  mb_forcedef *force;
+  mb_profile *profile;
+  mb_outputdef *output;
+  int *Kp, *Ki;
+  double *q0, *v0;
+  char **col_name;
+  char **joint_name;
+  /* provenance */
+  char **marker_desc;        /* "joint 'pin' on body 'crank'" */
+  char **row_desc;           /* "joint 'pin' (revolute): spherical x" */
+  ir_loc *row_loc;
+  int *force_ir;             /* IR force index of each force */
+  int *profile_driver;       /* IR driver (or -1) / force (>= 0 in profile_force) */
+  int *profile_force;
+  double **spline;           /* owned spline and table arrays of table profiles */
+  double **table;
+  int nredundant;            /* rows removed at assembly */
+  int dof;
+} lmodel;
+
+/* Build the tables and pattern from the IR (positions as given).  Returns
+ * NULL and reports on error. */
+lmodel *lower_model(const ir_model *ir);
+/* (Re)build the CSC pattern and every slot from the current rows. */
+int lower_pattern(lmodel *L);
+/* Remove constraint rows whose keep[r] is 0, then rebuild the pattern. */
+int lower_remove_rows(lmodel *L, const int *keep);
+void lower_free(lmodel *L);
+
+/* Assembly analysis at t = 0 (assemble.c): Newton onto the position
+ * constraints, redundant rows removed (warnings), consistent velocities,
+ * singularity check.  Returns 0, or 2 after reporting an error. */
+int assemble_model(lmodel *L, int verbose);
+
+/* Emit generated/<name>/ (emit.c).  Returns 0 or reports and returns 2. */
+int emit_model(const lmodel *L, const char *dir);
+
+#endif

@@ -1,0 +1,332 @@
+/* main.c: the mbcc command line: check, compile, run, plot. */
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "diag.h"
+#include "lower.h"
+#include "mb_driver.h"
+
+#ifndef MBCC_ROOT
+#define MBCC_ROOT "."
+#endif
+
+static const char *root_dir(void) {
+  const char *r = getenv("MBCC_ROOT");
+  return r && *r ? r : MBCC_ROOT;
+}
+
+static void usage(void) {
+  fprintf(stderr,
+          "usage: mbcc check M.yaml [--scene S]\n"
+          "       mbcc compile M.yaml [--scene S] [-o DIR]\n"
+          "       mbcc run M.yaml [--scene S] [--path generated|generic] [--solver klu|dense]\n"
+          "                [--integrator rk4|dopri5] [-o results.csv] [--plot out.png|none]\n"
+          "                [--end T] [--output-step H] [--step H] [--rtol R] [--atol A]\n"
+          "                [--stabilization projection|baumgarte|none] [--quiet]\n"
+          "       mbcc plot results.csv [-o out.png] [--columns a,b,...]\n");
+}
+
+typedef struct {
+  const char *model, *scene, *outdir, *csv, *plot, *path;
+  const char *sim_args[32];
+  int nsim;
+  int quiet;
+} options;
+
+static int parse_options(int argc, char **argv, options *o) {
+  memset(o, 0, sizeof *o);
+  o->path = "generated";
+  for (int i = 2; i < argc; i++) {
+    const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+    if (a[0] != '-') {
+      if (o->model) { fprintf(stderr, "mbcc: error: more than one model given ('%s')\n", a); return 2; }
+      o->model = a;
+      continue;
+    }
+    if (!strcmp(a, "--quiet")) { o->quiet = 1; o->sim_args[o->nsim++] = a; continue; }
+    if (!v) { fprintf(stderr, "mbcc: error: option '%s' needs a value\n", a); return 2; }
+    i++;
+    if (!strcmp(a, "--scene")) o->scene = v;
+    else if (!strcmp(a, "-o")) { o->outdir = v; o->csv = v; }
+    else if (!strcmp(a, "--plot")) o->plot = v;
+    else if (!strcmp(a, "--path")) o->path = v;
+    else if (!strcmp(a, "--solver") || !strcmp(a, "--integrator") || !strcmp(a, "--end") ||
+             !strcmp(a, "--output-step") || !strcmp(a, "--step") || !strcmp(a, "--rtol") ||
+             !strcmp(a, "--atol") || !strcmp(a, "--stabilization") || !strcmp(a, "--columns")) {
+      if (o->nsim + 2 > 30) { fprintf(stderr, "mbcc: error: too many options\n"); return 2; }
+      o->sim_args[o->nsim++] = a;
+      o->sim_args[o->nsim++] = v;
+    } else {
+      fprintf(stderr, "mbcc: error: unknown option '%s'\n", a);
+      usage();
+      return 2;
+    }
+  }
+  if (!o->model) { usage(); return 2; }
+  if (strcmp(o->path, "generated") && strcmp(o->path, "generic")) {
+    fprintf(stderr, "mbcc: error: unknown path '%s' (expected generated or generic)\n", o->path);
+    return 2;
+  }
+  return 0;
+}
+
+/* read, lower and assemble; NULL after reporting */
+static lmodel *build(const options *o, ir_model **irp, int verbose) {
+  ir_model *ir = ir_read(o->model, o->scene);
+  if (!ir) return NULL;
+  lmodel *L = lower_model(ir);
+  if (!L) {
+    if (!diag_errors()) diag_error(o->model, (ir_loc){0, 0}, "out of memory while lowering");
+    ir_free(ir);
+    return NULL;
+  }
+  if (assemble_model(L, verbose)) {
+    lower_free(L);
+    ir_free(ir);
+    return NULL;
+  }
+  *irp = ir;
+  return L;
+}
+
+static int cmd_check(const options *o) {
+  ir_model *ir;
+  lmodel *L = build(o, &ir, 1);
+  if (!L) return 2;
+  const mb_model *m = &L->m;
+  int nrigid = 0, nvirtual = 0;
+  for (int b = 0; b < m->nbody; b++) {
+    if (m->body[b].kind == MB_BODY_VIRTUAL) nvirtual++;
+    else nrigid++;
+  }
+  printf("model %s%s%s: ok\n", m->name, ir->scene ? ", scene " : "", ir->scene ? ir->scene : "");
+  printf("  bodies            %d (%d rigid, %d virtual) + ground\n", m->nbody, nrigid, nvirtual);
+  printf("  coordinates       %d position, %d velocity\n", m->nq, m->nv);
+  printf("  joints            %d, drivers %d, forces %d, outputs %d (%d columns)\n", ir->njoints,
+         ir->ndrivers, ir->nforces, ir->noutputs, m->ncols);
+  printf("  constraint rows   %d (%d redundant removed)\n", m->nc, L->nredundant);
+  printf("  degrees of freedom %d\n", L->dof);
+  printf("  system dimension  %d (K = [M D^T; D 0])\n", m->n);
+  printf("  nnz(K)            %d (%.2f%% dense)\n", m->nnz, m->n ? 100.0 * m->nnz / ((double)m->n * m->n) : 0.0);
+  lower_free(L);
+  ir_free(ir);
+  return 0;
+}
+
+static void default_dir(const lmodel *L, const ir_model *ir, char *dir, size_t n) {
+  if (ir->scene)
+    snprintf(dir, n, "generated/%s-%s", L->m.name, ir->scene);
+  else
+    snprintf(dir, n, "generated/%s", L->m.name);
+}
+
+static int cmd_compile(const options *o, char *dir_out, size_t n, lmodel **Lp, ir_model **irp) {
+  ir_model *ir;
+  lmodel *L = build(o, &ir, 0);
+  if (!L) return 2;
+  char dir[4096];
+  if (o->outdir && !dir_out) snprintf(dir, sizeof dir, "%s", o->outdir);
+  else default_dir(L, ir, dir, sizeof dir);
+  mkdir("generated", 0777);
+  int st = emit_model(L, dir);
+  if (!st && !dir_out)
+    printf("wrote %s/%s.c, %s/%s.h and %s/main.c\n", dir, L->m.name, dir, L->m.name, dir);
+  if (dir_out) snprintf(dir_out, n, "%s", dir);
+  if (Lp) { *Lp = L; *irp = ir; }
+  else { lower_free(L); ir_free(ir); }
+  return st;
+}
+
+static int run_command(char *const argv[]) {
+  fflush(stdout);
+  fflush(stderr);
+  pid_t pid = fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    execvp(argv[0], argv);
+    fprintf(stderr, "mbcc: error: cannot run '%s': %s\n", argv[0], strerror(errno));
+    _exit(127);
+  }
+  int status = 0;
+  if (waitpid(pid, &status, 0) < 0) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+}
+
+static int plot_csv(const char *csv, const char *png, const char *columns) {
+  /* a gnuplot script: one panel per column (at most 8), against time */
+  FILE *in = fopen(csv, "r");
+  if (!in) { fprintf(stderr, "mbcc: error: cannot read '%s'\n", csv); return 2; }
+  char header[8192];
+  if (!fgets(header, sizeof header, in)) { fclose(in); fprintf(stderr, "%s:1:1: error: empty CSV file\n", csv); return 2; }
+  fclose(in);
+  header[strcspn(header, "\r\n")] = 0;
+  char *names[64];
+  int nn = 0;
+  for (char *tok = strtok(header, ","); tok && nn < 64; tok = strtok(NULL, ",")) names[nn++] = tok;
+  int pick[8], np = 0;
+  for (int c = 1; c < nn && np < 8; c++) {
+    if (columns) {
+      char list[1024];
+      snprintf(list, sizeof list, ",%s,", columns);
+      char key[300];
+      snprintf(key, sizeof key, ",%s,", names[c]);
+      if (!strstr(list, key)) continue;
+    }
+    pick[np++] = c;
+  }
+  if (np == 0) { fprintf(stderr, "mbcc: error: no columns to plot in '%s'\n", csv); return 2; }
+  char script[4096];
+  snprintf(script, sizeof script, "%s.gp", png);
+  FILE *g = fopen(script, "w");
+  if (!g) { fprintf(stderr, "mbcc: error: cannot write '%s'\n", script); return 2; }
+  int rows = (np + 1) / 2, cols = np > 1 ? 2 : 1;
+  fprintf(g, "set terminal pngcairo size %d,%d noenhanced font ',9'\nset output '%s'\n", 520 * cols, 300 * rows, png);
+  fprintf(g, "set datafile separator ','\nset key off\nset grid\nset multiplot layout %d,%d\n", rows, cols);
+  for (int k = 0; k < np; k++)
+    fprintf(g, "set title '%s'\nset xlabel 't [s]'\nplot '%s' every ::1 using 1:%d with lines lw 1.5\n", names[pick[k]], csv, pick[k] + 1);
+  fprintf(g, "unset multiplot\n");
+  fclose(g);
+  char *argv[] = {"gnuplot", script, NULL};
+  int st = run_command(argv);
+  remove(script);
+  if (st) { fprintf(stderr, "mbcc: error: gnuplot failed (status %d)\n", st); return 2; }
+  return 0;
+}
+
+static int cmd_run(const options *o) {
+  char dir[4096];
+  lmodel *L = NULL;
+  ir_model *ir = NULL;
+  char csv[4096];
+  if (o->csv) snprintf(csv, sizeof csv, "%s", o->csv);
+  int rc;
+  if (!strcmp(o->path, "generic")) {
+    /* in-process, without code generation: the generic path */
+    L = NULL;
+    ir = NULL;
+    options o2 = *o;
+    o2.outdir = NULL;
+    lmodel *Lg = build(&o2, &ir, 0);
+    if (!Lg) return 2;
+    if (!o->csv) {
+      mkdir("results", 0777);
+      snprintf(csv, sizeof csv, "results/%s%s%s.csv", Lg->m.name, ir->scene ? "-" : "", ir->scene ? ir->scene : "");
+    }
+    const ir_sim *s = &ir->sim;
+    mb_settings set;
+    mb_settings_default(&set);
+    set.integrator = s->integrator == INTEGRATOR_RK4 ? MB_RK4 : MB_DOPRI5;
+    set.end_time = s->end_time; set.output_step = s->output_step; set.step = s->step;
+    set.rtol = s->rtol; set.atol = s->atol; set.min_step = s->min_step; set.max_step = s->max_step;
+    set.stabilization = (int)s->stabilization;
+    set.alpha = s->baumgarte_alpha; set.beta = s->baumgarte_beta;
+    char *args[40];
+    int na = 0;
+    args[na++] = "mbcc-generic";
+    args[na++] = "-o";
+    args[na++] = csv;
+    for (int i = 0; i < o->nsim; i++)
+      if (strcmp(o->sim_args[i], "--columns")) args[na++] = (char *)o->sim_args[i];
+      else i++;
+    args[na] = NULL;
+    rc = mb_main(na, args, &Lg->m, &set, s->solver == SOLVER_DENSE ? "dense" : "klu");
+    lower_free(Lg);
+  } else {
+    options o2 = *o;
+    o2.outdir = NULL;
+    rc = cmd_compile(&o2, dir, sizeof dir, &L, &ir);
+    if (rc) return rc;
+    if (!o->csv) {
+      mkdir("results", 0777);
+      snprintf(csv, sizeof csv, "results/%s%s%s.csv", L->m.name, ir->scene ? "-" : "", ir->scene ? ir->scene : "");
+    }
+    /* compile the generated code against the runtime library */
+    char exe[8400], src_c[8400], src_main[8400], inc[8400], lib[8400];
+    snprintf(exe, sizeof exe, "%s/%s_sim", dir, L->m.name);
+    snprintf(src_c, sizeof src_c, "%s/%s.c", dir, L->m.name);
+    snprintf(src_main, sizeof src_main, "%s/main.c", dir);
+    snprintf(inc, sizeof inc, "-I%s/runtime", root_dir());
+    snprintf(lib, sizeof lib, "%s/build/libmbrt.a", root_dir());
+    const char *cc = getenv("CC");
+    char *ccargs[] = {(char *)(cc && *cc ? cc : "cc"), "-std=c99", "-O2", inc, "-o", exe, src_c, src_main, lib,
+                      "-lklu", "-lamd", "-lcolamd", "-lbtf", "-lsuitesparseconfig", "-llapack",
+                      "-lblas", "-lm", NULL};
+    if (!o->quiet) fprintf(stderr, "mbcc: compiling %s\n", src_c);
+    if (run_command(ccargs)) {
+      fprintf(stderr, "mbcc: error: the C compiler failed on %s\n", src_c);
+      lower_free(L);
+      ir_free(ir);
+      return 2;
+    }
+    char *args[40];
+    int na = 0;
+    args[na++] = exe;
+    args[na++] = "-o";
+    args[na++] = csv;
+    for (int i = 0; i < o->nsim; i++)
+      if (strcmp(o->sim_args[i], "--columns")) args[na++] = (char *)o->sim_args[i];
+      else i++;
+    args[na] = NULL;
+    rc = run_command(args);
+    lower_free(L);
+  }
+  ir_free(ir);
+  if (rc) return rc;
+  if (!o->plot || strcmp(o->plot, "none")) {
+    char png[4096];
+    if (o->plot) snprintf(png, sizeof png, "%s", o->plot);
+    else {
+      snprintf(png, sizeof png, "%s", csv);
+      char *dot = strrchr(png, '.');
+      if (dot && !strcmp(dot, ".csv")) strcpy(dot, ".png");
+      else strncat(png, ".png", sizeof png - strlen(png) - 1);
+    }
+    const char *columns = NULL;
+    for (int i = 0; i + 1 < o->nsim; i++)
+      if (!strcmp(o->sim_args[i], "--columns")) columns = o->sim_args[i + 1];
+    if (plot_csv(csv, png, columns)) return 2;
+    if (!o->quiet) printf("wrote %s\n", png);
+  }
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
+    usage();
+    return argc < 2 ? 2 : 0;
+  }
+  const char *cmd = argv[1];
+  options o;
+  if (!strcmp(cmd, "plot")) {
+    if (parse_options(argc, argv, &o)) return 2;
+    char png[4096];
+    if (o.outdir) snprintf(png, sizeof png, "%s", o.outdir);
+    else {
+      snprintf(png, sizeof png, "%s", o.model);
+      char *dot = strrchr(png, '.');
+      if (dot) strcpy(dot, ".png");
+      else strncat(png, ".png", sizeof png - strlen(png) - 1);
+    }
+    const char *columns = NULL;
+    for (int i = 0; i + 1 < o.nsim; i++)
+      if (!strcmp(o.sim_args[i], "--columns")) columns = o.sim_args[i + 1];
+    int st = plot_csv(o.model, png, columns);
+    if (!st) printf("wrote %s\n", png);
+    return st;
+  }
+  if (strcmp(cmd, "check") && strcmp(cmd, "compile") && strcmp(cmd, "run")) {
+    fprintf(stderr, "mbcc: error: unknown command '%s'\n", cmd);
+    usage();
+    return 2;
+  }
+  if (parse_options(argc, argv, &o)) return 2;
+  if (!strcmp(cmd, "check")) return cmd_check(&o);
+  if (!strcmp(cmd, "compile")) return cmd_compile(&o, NULL, 0, NULL, NULL);
+  return cmd_run(&o);
+}

@@ -1,0 +1,325 @@
+/* integrate.c: RK4 and Dormand-Prince 5(4) on y = [q; v], with the
+ * accelerations from K [vdot; lambda] = [f; gamma] on the fixed pattern. */
+#define _POSIX_C_SOURCE 199309L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include "mb_sim.h"
+
+static double now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void mb_settings_default(mb_settings *s) {
+  s->integrator = MB_DOPRI5;
+  s->end_time = 1;
+  s->output_step = 0.01;
+  s->step = 1e-3;
+  s->rtol = 1e-6;
+  s->atol = 1e-8;
+  s->min_step = 1e-12;
+  s->max_step = 0.01;
+  s->stabilization = MB_STAB_PROJECTION;
+  s->alpha = 10;
+  s->beta = 10;
+  s->projection_tol = 1e-10;
+}
+
+static int fail(mb_sim *s, double t, int status, const char *what) {
+  s->fail_time = t;
+  snprintf(s->fail_detail, sizeof s->fail_detail, "%s: %s", what, mb_status_text(status));
+  return status;
+}
+
+int mb_sim_init(mb_sim *s, const mb_model *m, mb_solver *ls, const mb_settings *set) {
+  memset(s, 0, sizeof *s);
+  s->m = m;
+  s->ls = ls;
+  s->set = *set;
+  size_t ny = (size_t)(m->nq + m->nv);
+  s->q = calloc((size_t)m->nq + 1, sizeof(double));
+  s->v = calloc((size_t)m->nv + 1, sizeof(double));
+  s->Kx = calloc((size_t)m->nnz + 1, sizeof(double));
+  s->rhs = calloc((size_t)m->n + 1, sizeof(double));
+  s->x = calloc((size_t)m->n + 1, sizeof(double));
+  s->phi = calloc((size_t)m->nc + 1, sizeof(double));
+  s->nu = calloc((size_t)m->nc + 1, sizeof(double));
+  s->y = calloc(ny + 1, sizeof(double));
+  s->ytmp = calloc(ny + 1, sizeof(double));
+  for (int i = 0; i < 7; i++) s->k[i] = calloc(ny + 1, sizeof(double));
+  s->qsave = calloc((size_t)m->nq + 1, sizeof(double));
+  s->dv = calloc((size_t)m->n + 1, sizeof(double));
+  s->work = malloc(mb_model_worksize(m) + 16);
+  if (!s->q || !s->v || !s->Kx || !s->rhs || !s->x || !s->phi || !s->nu || !s->y || !s->ytmp ||
+      !s->qsave || !s->dv || !s->work)
+    return MB_ERR_NOMEM;
+  for (int i = 0; i < 7; i++)
+    if (!s->k[i]) return MB_ERR_NOMEM;
+  memcpy(s->q, m->q0, sizeof(double) * (size_t)m->nq);
+  memcpy(s->v, m->v0, sizeof(double) * (size_t)m->nv);
+  m->init(m, s->Kx);
+  if (set->end_time <= 0 || set->output_step <= 0 || set->step <= 0) return MB_ERR_INVALID;
+  return MB_OK;
+}
+
+void mb_sim_free(mb_sim *s) {
+  free(s->q); free(s->v); free(s->Kx); free(s->rhs); free(s->x); free(s->phi); free(s->nu);
+  free(s->y); free(s->ytmp); free(s->qsave); free(s->dv); free(s->work);
+  for (int i = 0; i < 7; i++) free(s->k[i]);
+  memset(s, 0, sizeof *s);
+}
+
+/* evaluate K and the right side at (t, q, v); factor unless q is the one
+ * already factored (K depends on q only) */
+static int assemble_factor(mb_sim *s, double t, const double *q, const double *v) {
+  const mb_model *m = s->m;
+  double t0 = now();
+  m->eval(m, t, q, v, s->Kx, s->rhs, s->phi, s->nu, s->work);
+  s->stats.evals++;
+  double t1 = now();
+  s->stats.t_assembly += t1 - t0;
+  if (s->factored_valid && !memcmp(q, s->qsave, sizeof(double) * (size_t)m->nq)) return MB_OK;
+  int st = s->ls->factor(s->ls, s->Kx);
+  s->stats.t_solve += now() - t1;
+  if (st) { s->factored_valid = 0; return st; }
+  memcpy(s->qsave, q, sizeof(double) * (size_t)m->nq);
+  s->factored_valid = 1;
+  return MB_OK;
+}
+
+static int solve(mb_sim *s, double *b) {
+  double t0 = now();
+  int st = s->ls->solve(s->ls, b);
+  s->stats.solves++;
+  s->stats.t_solve += now() - t0;
+  for (int i = 0; i < s->m->n; i++)
+    if (!isfinite(b[i])) return MB_ERR_NONFINITE;
+  return st;
+}
+
+/* D v, from the constraint rows of K (columns 0..nv-1, rows nv..n-1) */
+static void D_times(const mb_model *m, const double *Kx, const double *v, double *out) {
+  for (int r = 0; r < m->nc; r++) out[r] = 0;
+  for (int j = 0; j < m->nv; j++)
+    for (int p = m->Kp[j]; p < m->Kp[j + 1]; p++)
+      if (m->Ki[p] >= m->nv) out[m->Ki[p] - m->nv] += Kx[p] * v[j];
+}
+
+int mb_sim_accel(mb_sim *s, double t, const double *q, const double *v, double *vd,
+                 double *lambda) {
+  const mb_model *m = s->m;
+  int st = assemble_factor(s, t, q, v);
+  if (st) return fail(s, t, st, "factorization of K");
+  if (s->set.stabilization == MB_STAB_BAUMGARTE) {
+    /* gamma - 2 alpha phidot - beta^2 phi, phidot = D v - nu */
+    D_times(m, s->Kx, v, s->dv);
+    for (int r = 0; r < m->nc; r++)
+      s->rhs[m->nv + r] -= 2 * s->set.alpha * (s->dv[r] - s->nu[r]) +
+                           s->set.beta * s->set.beta * s->phi[r];
+  }
+  memcpy(s->x, s->rhs, sizeof(double) * (size_t)m->n);
+  st = solve(s, s->x);
+  if (st) return fail(s, t, st, "solution for the accelerations");
+  memcpy(vd, s->x, sizeof(double) * (size_t)m->nv);
+  if (lambda) memcpy(lambda, s->x + m->nv, sizeof(double) * (size_t)m->nc);
+  return MB_OK;
+}
+
+static double max_abs(const double *a, int n) {
+  double mx = 0;
+  for (int i = 0; i < n; i++)
+    if (fabs(a[i]) > mx || a[i] != a[i]) mx = (a[i] != a[i]) ? INFINITY : fabs(a[i]);
+  return mx;
+}
+
+int mb_sim_project(mb_sim *s, double t, double *q, double *v) {
+  const mb_model *m = s->m;
+  int n = m->n, nv = m->nv;
+  mb_model_normalize(m, q);
+  /* positions: Newton on phi(q) = 0 with the mass-weighted least correction,
+     K [dq; mu] = [0; -phi] */
+  for (int it = 0;; it++) {
+    int st = assemble_factor(s, t, q, v);
+    if (st) return fail(s, t, st, "projection");
+    if (max_abs(s->phi, m->nc) <= s->set.projection_tol) break;
+    if (it >= 8) return fail(s, t, MB_ERR_PROJECTION, "position projection");
+    for (int i = 0; i < nv; i++) s->dv[i] = 0;
+    for (int r = 0; r < m->nc; r++) s->dv[nv + r] = -s->phi[r];
+    st = solve(s, s->dv);
+    if (st) return fail(s, t, st, "position projection");
+    mb_model_qincrement(m, q, s->dv);
+    mb_model_normalize(m, q);
+    s->stats.projections++;
+  }
+  /* velocities: K [dv; mu] = [0; nu - D v] (K is factored at this q) */
+  D_times(m, s->Kx, v, s->dv + nv);
+  for (int i = 0; i < nv; i++) s->dv[i] = 0;
+  for (int r = 0; r < m->nc; r++) s->dv[nv + r] = s->nu[r] - s->dv[nv + r];
+  int st = solve(s, s->dv);
+  if (st) return fail(s, t, st, "velocity projection");
+  for (int i = 0; i < nv; i++) v[i] += s->dv[i];
+  (void)n;
+  return MB_OK;
+}
+
+/* dy = f(t, y): y = [q; v], dy = [G(q) v; vdot] */
+static int deriv(mb_sim *s, double t, const double *y, double *dy) {
+  const mb_model *m = s->m;
+  const double *q = y, *v = y + m->nq;
+  int st = mb_sim_accel(s, t, q, v, dy + m->nq, NULL);
+  if (st) return st;
+  mb_model_qdot(m, q, v, dy);
+  return MB_OK;
+}
+
+/* after a step: stabilize and check the state */
+static int finish_step(mb_sim *s, double t) {
+  const mb_model *m = s->m;
+  if (s->set.stabilization == MB_STAB_PROJECTION) {
+    int st = mb_sim_project(s, t, s->q, s->v);
+    if (st) return st;
+  } else {
+    mb_model_normalize(m, s->q);
+  }
+  for (int i = 0; i < m->nq; i++)
+    if (!isfinite(s->q[i])) return fail(s, t, MB_ERR_NONFINITE, "positions");
+  for (int i = 0; i < m->nv; i++)
+    if (!isfinite(s->v[i])) return fail(s, t, MB_ERR_NONFINITE, "velocities");
+  return MB_OK;
+}
+
+/* Dormand-Prince 5(4) tableau */
+static const double DP_C[7] = {0, 1.0 / 5, 3.0 / 10, 4.0 / 5, 8.0 / 9, 1, 1};
+static const double DP_A[7][6] = {
+    {0},
+    {1.0 / 5},
+    {3.0 / 40, 9.0 / 40},
+    {44.0 / 45, -56.0 / 15, 32.0 / 9},
+    {19372.0 / 6561, -25360.0 / 2187, 64448.0 / 6561, -212.0 / 729},
+    {9017.0 / 3168, -355.0 / 33, 46732.0 / 5247, 49.0 / 176, -5103.0 / 18656},
+    {35.0 / 384, 0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84}};
+/* error weights: b5 - b4 */
+static const double DP_E[7] = {71.0 / 57600, 0, -71.0 / 16695, 71.0 / 1920, -17253.0 / 339200,
+                               22.0 / 525, -1.0 / 40};
+
+/* one explicit stage combination: ytmp = y + h sum a_j k_j */
+static void combine(int ny, const double *y, double h, const double *a, double *const *k, int nk,
+                    double *out) {
+  for (int i = 0; i < ny; i++) {
+    double acc = 0;
+    for (int j = 0; j < nk; j++) acc += a[j] * k[j][i];
+    out[i] = y[i] + h * acc;
+  }
+}
+
+int mb_sim_run(mb_sim *s, mb_output_fn out, void *user) {
+  const mb_model *m = s->m;
+  const mb_settings *set = &s->set;
+  int nq = m->nq, nv = m->nv, ny = nq + nv;
+  double t0w = now();
+  double *vd = malloc(sizeof(double) * (size_t)(nv + 1));
+  double *lam = malloc(sizeof(double) * (size_t)(m->nc + 1));
+  if (!vd || !lam) { free(vd); free(lam); return MB_ERR_NOMEM; }
+  int st = MB_OK;
+  s->t = 0;
+  long nout = (long)floor(set->end_time / set->output_step + 1e-9);
+  double h = set->integrator == MB_RK4 ? set->step : fmin(set->step, set->max_step);
+  long iout = 0;
+
+  if (set->stabilization == MB_STAB_PROJECTION && (st = mb_sim_project(s, 0, s->q, s->v))) goto done;
+  while (1) {
+    double tout = (double)iout * set->output_step;
+    /* the stage-1 derivative at (t, y): also gives the outputs at output times */
+    memcpy(s->y, s->q, sizeof(double) * (size_t)nq);
+    memcpy(s->y + nq, s->v, sizeof(double) * (size_t)nv);
+    if ((st = mb_sim_accel(s, s->t, s->q, s->v, vd, lam))) goto done;
+    memcpy(s->k[0] + nq, vd, sizeof(double) * (size_t)nv);
+    mb_model_qdot(m, s->q, s->v, s->k[0]);
+    if (fabs(s->t - tout) <= 1e-9 * set->output_step) {
+      double mx = max_abs(s->phi, m->nc);
+      if (mx > s->stats.max_phi) s->stats.max_phi = mx;
+      if (out && out(user, s->t, s->q, s->v, vd, lam)) goto done;
+      iout++;
+      if (iout > nout) break;
+      tout = (double)iout * set->output_step;
+    }
+    double hmax = tout - s->t;
+    if (set->integrator == MB_RK4) {
+      /* fixed step that divides the output step */
+      double nsub = ceil(set->output_step / set->step - 1e-9);
+      double hs = set->output_step / nsub;
+      h = hs < hmax * (1 + 1e-12) ? hs : hmax;
+      if (hmax - h < 1e-9 * hs) h = hmax;
+      static const double a2[1] = {0.5}, a3[2] = {0, 0.5}, a4[3] = {0, 0, 1};
+      combine(ny, s->y, h, a2, s->k, 1, s->ytmp);
+      if ((st = deriv(s, s->t + h / 2, s->ytmp, s->k[1]))) goto done;
+      combine(ny, s->y, h, a3, s->k, 2, s->ytmp);
+      if ((st = deriv(s, s->t + h / 2, s->ytmp, s->k[2]))) goto done;
+      combine(ny, s->y, h, a4, s->k, 3, s->ytmp);
+      if ((st = deriv(s, s->t + h, s->ytmp, s->k[3]))) goto done;
+      static const double b[4] = {1.0 / 6, 1.0 / 3, 1.0 / 3, 1.0 / 6};
+      combine(ny, s->y, h, b, s->k, 4, s->ytmp);
+      memcpy(s->q, s->ytmp, sizeof(double) * (size_t)nq);
+      memcpy(s->v, s->ytmp + nq, sizeof(double) * (size_t)nv);
+      s->t = (h == hmax) ? tout : s->t + h;
+      s->stats.steps++;
+      if ((st = finish_step(s, s->t))) goto done;
+    } else {
+      /* adaptive Dormand-Prince 5(4); steps end on output times */
+      for (;;) {
+        double hh = fmin(h, hmax);
+        if (hmax - hh < 1e-9 * set->output_step) hh = hmax;
+        for (int j = 1; j < 7; j++) {
+          combine(ny, s->y, hh, DP_A[j], s->k, j, s->ytmp);
+          if ((st = deriv(s, s->t + DP_C[j] * hh, s->ytmp, s->k[j]))) {
+            /* a failed stage (e.g. a singular matrix far from the path):
+               retry with a smaller step before giving up */
+            if (hh > 4 * set->min_step) { st = MB_OK; h = hh / 4; goto retry; }
+            goto done;
+          }
+        }
+        /* ytmp holds the 5th-order solution (FSAL stage); error estimate */
+        double err = 0;
+        for (int i = 0; i < ny; i++) {
+          double e = 0;
+          for (int j = 0; j < 7; j++) e += DP_E[j] * s->k[j][i];
+          e *= hh;
+          double sc = set->atol + set->rtol * fmax(fabs(s->y[i]), fabs(s->ytmp[i]));
+          err += (e / sc) * (e / sc);
+        }
+        err = sqrt(err / ny);
+        if (!isfinite(err)) err = 1e10;
+        double fac = err > 0 ? 0.9 * pow(err, -0.2) : 5;
+        fac = fmin(5, fmax(0.2, fac));
+        if (err <= 1) {
+          memcpy(s->q, s->ytmp, sizeof(double) * (size_t)nq);
+          memcpy(s->v, s->ytmp + nq, sizeof(double) * (size_t)nv);
+          s->t = (hh == hmax) ? tout : s->t + hh;
+          s->stats.steps++;
+          h = fmin(hh * fac, set->max_step);
+          if (hh == hmax && hh < h) h = fmax(h, hh); /* a short step to an output time */
+          break;
+        }
+        s->stats.rejected++;
+        h = hh * fmax(0.2, fac);
+      retry:
+        if (h < set->min_step) {
+          st = fail(s, s->t, MB_ERR_STEP_TOO_SMALL, "adaptive step");
+          goto done;
+        }
+      }
+      if ((st = finish_step(s, s->t))) goto done;
+    }
+  }
+done:
+  s->stats.factorizations = s->ls->factorizations;
+  s->stats.full_factorizations = s->ls->full_factorizations;
+  s->stats.t_total = now() - t0w;
+  free(vd);
+  free(lam);
+  return st;
+}

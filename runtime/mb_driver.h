@@ -1,0 +1,13 @@
+/* mb_driver.h: the command-line simulator around a compiled model (hosted). */
+#ifndef MB_DRIVER_H
+#define MB_DRIVER_H
+
+#include "mb_sim.h"
+
+/* Parse options, simulate, write CSV, print a summary.  'defaults' are the
+ * model's simulation settings; 'solver' its default solver name.
+ * Returns 0 on success, 1 on a numerical failure, 2 on bad options. */
+int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *defaults,
+            const char *solver);
+
+#endif

@@ -1,0 +1,444 @@
+/* mb_kernels.h: the element kernels, written once and used by both drivers:
+ * the generated code calls them with literal constants (so the C compiler
+ * folds them), the generic path calls them in loops over element tables.
+ *
+ * Conventions (docs/formulation.md):
+ *   body i: position r, Euler parameters p, rotation matrix A (row-major),
+ *   velocities rd (global) and w' (body axes); w = A w' (global).
+ *   A marker is a frame on a body: point P, axes R = A C (columns: x, y, z),
+ *   point velocity V, angular velocity W (global), and the velocity-dependent
+ *   parts aP, aW of its accelerations (dV/dt = J vdot + aP, likewise W).
+ *   A constraint row gives phi, its derivatives with respect to the marker
+ *   velocities (dV, dW for each side) and 'quad', the part of phi'' that
+ *   depends on marker velocities only; gamma follows from them. */
+#ifndef MB_KERNELS_H
+#define MB_KERNELS_H
+
+#include <math.h>
+#include "mb_types.h"
+
+/* --- small vector algebra --------------------------------------------------- */
+static inline mb_real mb_dot3(const mb_real a[3], const mb_real b[3]) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+static inline void mb_cross3(const mb_real a[3], const mb_real b[3], mb_real c[3]) {
+  mb_real c0 = a[1] * b[2] - a[2] * b[1];
+  mb_real c1 = a[2] * b[0] - a[0] * b[2];
+  mb_real c2 = a[0] * b[1] - a[1] * b[0];
+  c[0] = c0; c[1] = c1; c[2] = c2;
+}
+/* y = A x and y = A^T x for row-major 3x3 A */
+static inline void mb_mul3(const mb_real A[9], const mb_real x[3], mb_real y[3]) {
+  mb_real y0 = A[0] * x[0] + A[1] * x[1] + A[2] * x[2];
+  mb_real y1 = A[3] * x[0] + A[4] * x[1] + A[5] * x[2];
+  mb_real y2 = A[6] * x[0] + A[7] * x[1] + A[8] * x[2];
+  y[0] = y0; y[1] = y1; y[2] = y2;
+}
+static inline void mb_mul3t(const mb_real A[9], const mb_real x[3], mb_real y[3]) {
+  mb_real y0 = A[0] * x[0] + A[3] * x[1] + A[6] * x[2];
+  mb_real y1 = A[1] * x[0] + A[4] * x[1] + A[7] * x[2];
+  mb_real y2 = A[2] * x[0] + A[5] * x[1] + A[8] * x[2];
+  y[0] = y0; y[1] = y1; y[2] = y2;
+}
+/* C = A B, row-major 3x3 */
+static inline void mb_matmul3(const mb_real A[9], const mb_real B[9], mb_real C[9]) {
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      C[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
+}
+/* column k of a row-major 3x3 (a marker axis) */
+static inline void mb_col3(const mb_real R[9], int k, mb_real a[3]) {
+  a[0] = R[k]; a[1] = R[3 + k]; a[2] = R[6 + k];
+}
+
+/* Rotation matrix of Euler parameters p (normalized here, so that a state
+ * whose p drifted off the unit sphere still gives a rotation). */
+static inline void mb_euler_to_A(const mb_real p_in[4], mb_real A[9]) {
+  mb_real n = sqrt(p_in[0] * p_in[0] + p_in[1] * p_in[1] + p_in[2] * p_in[2] + p_in[3] * p_in[3]);
+  mb_real e0 = p_in[0] / n, e1 = p_in[1] / n, e2 = p_in[2] / n, e3 = p_in[3] / n;
+  A[0] = 2 * (e0 * e0 + e1 * e1) - 1; A[1] = 2 * (e1 * e2 - e0 * e3); A[2] = 2 * (e1 * e3 + e0 * e2);
+  A[3] = 2 * (e1 * e2 + e0 * e3); A[4] = 2 * (e0 * e0 + e2 * e2) - 1; A[5] = 2 * (e2 * e3 - e0 * e1);
+  A[6] = 2 * (e1 * e3 - e0 * e2); A[7] = 2 * (e2 * e3 + e0 * e1); A[8] = 2 * (e0 * e0 + e3 * e3) - 1;
+}
+
+/* pd = 1/2 L(p)^T w' : Euler-parameter rates from the body angular velocity */
+static inline void mb_euler_rates(const mb_real p[4], const mb_real wl[3], mb_real pd[4]) {
+  pd[0] = 0.5 * (-p[1] * wl[0] - p[2] * wl[1] - p[3] * wl[2]);
+  pd[1] = 0.5 * (p[0] * wl[0] - p[3] * wl[1] + p[2] * wl[2]);
+  pd[2] = 0.5 * (p[3] * wl[0] + p[0] * wl[1] - p[1] * wl[2]);
+  pd[3] = 0.5 * (-p[2] * wl[0] + p[1] * wl[1] + p[0] * wl[2]);
+}
+
+/* p <- p (x) exp(dtheta'/2): rotate by a body-axes rotation vector, exactly */
+static inline void mb_euler_rotate(mb_real p[4], const mb_real dth[3]) {
+  mb_real a = sqrt(dth[0] * dth[0] + dth[1] * dth[1] + dth[2] * dth[2]);
+  mb_real c = cos(0.5 * a), s = (a > 1e-12) ? sin(0.5 * a) / a : 0.5;
+  mb_real q0 = c, q1 = s * dth[0], q2 = s * dth[1], q3 = s * dth[2];
+  mb_real e0 = p[0], e1 = p[1], e2 = p[2], e3 = p[3];
+  p[0] = e0 * q0 - e1 * q1 - e2 * q2 - e3 * q3;
+  p[1] = e0 * q1 + e1 * q0 + e2 * q3 - e3 * q2;
+  p[2] = e0 * q2 - e1 * q3 + e2 * q0 + e3 * q1;
+  p[3] = e0 * q3 + e1 * q2 - e2 * q1 + e3 * q0;
+}
+
+/* --- bodies ---------------------------------------------------------------- */
+typedef struct {
+  mb_real r[3];  /* origin (centre of mass), global */
+  mb_real A[9];  /* rotation, body to global, row-major */
+  mb_real rd[3]; /* origin velocity, global */
+  mb_real wl[3]; /* angular velocity, body axes */
+  mb_real w[3];  /* angular velocity, global */
+} mb_frame;
+
+/* frame of a rigid (or virtual) body from its 7 position and 6 velocity coordinates */
+static inline void mb_frame_rigid(const mb_real *q, const mb_real *v, mb_frame *f) {
+  f->r[0] = q[0]; f->r[1] = q[1]; f->r[2] = q[2];
+  mb_euler_to_A(q + 3, f->A);
+  f->rd[0] = v[0]; f->rd[1] = v[1]; f->rd[2] = v[2];
+  f->wl[0] = v[3]; f->wl[1] = v[4]; f->wl[2] = v[5];
+  mb_mul3(f->A, f->wl, f->w);
+}
+
+/* quadratic-velocity force of a rigid body, body axes: s = -w' x (J w') */
+static inline void mb_rigid_gyro(const mb_real J[9], const mb_real wl[3], mb_real s[3]) {
+  mb_real h[3];
+  mb_mul3(J, wl, h);
+  mb_cross3(wl, h, s);
+  s[0] = -s[0]; s[1] = -s[1]; s[2] = -s[2];
+}
+
+/* kinetic energy of a rigid body */
+static inline mb_real mb_rigid_kinetic(mb_real m, const mb_real J[9], const mb_frame *f) {
+  mb_real h[3];
+  mb_mul3(J, f->wl, h);
+  return 0.5 * m * mb_dot3(f->rd, f->rd) + 0.5 * mb_dot3(f->wl, h);
+}
+
+/* --- markers ----------------------------------------------------------------- */
+typedef struct {
+  mb_real P[3], R[9]; /* point and axes (columns), global */
+  mb_real V[3], W[3]; /* point velocity, angular velocity, global */
+  mb_real aP[3], aW[3]; /* velocity-dependent parts of the accelerations */
+} mb_marker;
+
+/* marker fixed on the ground: s and C are its global point and axes */
+static inline void mb_marker_ground(const mb_real s[3], const mb_real C[9], mb_marker *m) {
+  for (int k = 0; k < 3; k++) {
+    m->P[k] = s[k]; m->V[k] = 0; m->W[k] = 0; m->aP[k] = 0; m->aW[k] = 0;
+  }
+  for (int k = 0; k < 9; k++) m->R[k] = C[k];
+}
+
+/* marker on a rigid body at body-axes point s with body-axes axes C */
+static inline void mb_marker_rigid(const mb_frame *f, const mb_real s[3], const mb_real C[9],
+                                   mb_marker *m) {
+  mb_real u[3], wu[3];
+  mb_mul3(f->A, s, u);
+  mb_matmul3(f->A, C, m->R);
+  mb_cross3(f->w, u, wu);
+  mb_cross3(f->w, wu, m->aP);
+  for (int k = 0; k < 3; k++) {
+    m->P[k] = f->r[k] + u[k];
+    m->V[k] = f->rd[k] + wu[k];
+    m->W[k] = f->w[k];
+    m->aW[k] = 0;
+  }
+}
+
+/* Map a force-like pair at a marker of a rigid body (dV: force or the row's
+ * derivative with respect to the point velocity; dW: torque or derivative with
+ * respect to the angular velocity, global) to the body's 6 velocity
+ * coordinates [rd; w']:  c = [dV; A^T((P - r) x dV + dW)]. */
+static inline void mb_rigid_cols(const mb_frame *f, const mb_real P[3], const mb_real dV[3],
+                                 const mb_real dW[3], mb_real c[6]) {
+  mb_real u[3] = {P[0] - f->r[0], P[1] - f->r[1], P[2] - f->r[2]}, t[3];
+  mb_cross3(u, dV, t);
+  t[0] += dW[0]; t[1] += dW[1]; t[2] += dW[2];
+  c[0] = dV[0]; c[1] = dV[1]; c[2] = dV[2];
+  mb_mul3t(f->A, t, c + 3);
+}
+
+/* --- time functions ------------------------------------------------------------- */
+enum {
+  MB_PROFILE_CONSTANT = 1, MB_PROFILE_CONSTANT_VELOCITY, MB_PROFILE_POLYNOMIAL,
+  MB_PROFILE_RAMP, MB_PROFILE_SINE, MB_PROFILE_TABLE
+};
+
+typedef struct {
+  int kind;
+  mb_real c[8];
+  int nc;
+  int ntable;
+  const mb_real *table;  /* ntable pairs (t, x) */
+  const mb_real *spline; /* ntable second derivatives of the natural cubic spline */
+} mb_profile;
+
+/* x(t), x'(t), x''(t) */
+static inline void mb_profile_eval(const mb_profile *p, mb_real t, mb_real x[3]) {
+  x[0] = x[1] = x[2] = 0;
+  switch (p->kind) {
+  case MB_PROFILE_CONSTANT:
+    x[0] = p->c[0];
+    break;
+  case MB_PROFILE_CONSTANT_VELOCITY:
+    x[0] = p->c[0] + p->c[1] * t;
+    x[1] = p->c[1];
+    break;
+  case MB_PROFILE_POLYNOMIAL:
+    for (int k = p->nc - 1; k >= 0; k--) { /* Horner, with derivatives */
+      x[2] = x[2] * t + 2 * x[1];
+      x[1] = x[1] * t + x[0];
+      x[0] = x[0] * t + p->c[k];
+    }
+    break;
+  case MB_PROFILE_RAMP: { /* cubic step, as Adams STEP */
+    mb_real t0 = p->c[0], x0 = p->c[1], t1 = p->c[2], x1 = p->c[3];
+    if (t <= t0) { x[0] = x0; break; }
+    if (t >= t1) { x[0] = x1; break; }
+    mb_real T = t1 - t0, s = (t - t0) / T, h = x1 - x0;
+    x[0] = x0 + h * s * s * (3 - 2 * s);
+    x[1] = h * 6 * s * (1 - s) / T;
+    x[2] = h * (6 - 12 * s) / (T * T);
+    break;
+  }
+  case MB_PROFILE_SINE: {
+    mb_real om = 2 * MB_PI * p->c[1], ph = om * t + p->c[2];
+    x[0] = p->c[3] + p->c[0] * sin(ph);
+    x[1] = p->c[0] * om * cos(ph);
+    x[2] = -p->c[0] * om * om * sin(ph);
+    break;
+  }
+  case MB_PROFILE_TABLE: {
+    const mb_real *d = p->table, *m = p->spline;
+    int n = p->ntable;
+    if (t <= d[0]) { x[0] = d[1]; break; }
+    if (t >= d[2 * (n - 1)]) { x[0] = d[2 * n - 1]; break; }
+    int lo = 0, hi = n - 1; /* bisection: d[2 lo] <= t < d[2 hi] */
+    while (hi - lo > 1) {
+      int mid = (lo + hi) / 2;
+      if (d[2 * mid] <= t) lo = mid; else hi = mid;
+    }
+    mb_real h = d[2 * hi] - d[2 * lo], a = (d[2 * hi] - t) / h, b = 1 - a;
+    mb_real y0 = d[2 * lo + 1], y1 = d[2 * hi + 1], m0 = m[lo], m1 = m[hi];
+    x[0] = a * y0 + b * y1 + ((a * a * a - a) * m0 + (b * b * b - b) * m1) * h * h / 6;
+    x[1] = (y1 - y0) / h + (-(3 * a * a - 1) * m0 + (3 * b * b - 1) * m1) * h / 6;
+    x[2] = a * m0 + b * m1;
+    break;
+  }
+  default:
+    break;
+  }
+}
+
+/* --- constraint primitives --------------------------------------------------------- */
+typedef struct {
+  mb_real phi;         /* position constraint value */
+  mb_real dV[2][3];    /* d(phidot)/dV of marker 0 and 1 */
+  mb_real dW[2][3];    /* d(phidot)/dW of marker 0 and 1 */
+  mb_real quad;        /* part of phi'' quadratic in marker velocities (and time terms) */
+  mb_real nu;          /* phidot = D v - nu: nu = -d(phi)/dt (drivers) */
+} mb_row;
+
+static inline void mb_row_zero(mb_row *r) {
+  r->phi = r->quad = r->nu = 0;
+  for (int s = 0; s < 2; s++)
+    for (int k = 0; k < 3; k++) r->dV[s][k] = r->dW[s][k] = 0;
+}
+
+/* gamma = -(dV . aP + dW . aW + quad): the right side of D vdot = gamma */
+static inline mb_real mb_row_gamma(const mb_row *r, const mb_marker *m0, const mb_marker *m1) {
+  return -(mb_dot3(r->dV[0], m0->aP) + mb_dot3(r->dW[0], m0->aW) +
+           mb_dot3(r->dV[1], m1->aP) + mb_dot3(r->dW[1], m1->aW) + r->quad);
+}
+
+/* spherical, component k: phi = (P1 - P0)_k */
+static inline void mb_prim_sph(const mb_marker *m0, const mb_marker *m1, int k, mb_row *r) {
+  mb_row_zero(r);
+  r->phi = m1->P[k] - m0->P[k];
+  r->dV[0][k] = -1;
+  r->dV[1][k] = 1;
+}
+
+/* w x (w x a) */
+static inline void mb_wwa(const mb_real w[3], const mb_real a[3], mb_real out[3]) {
+  mb_real wa[3];
+  mb_cross3(w, a, wa);
+  mb_cross3(w, wa, out);
+}
+
+/* dot-1: axis a of marker 0 perpendicular to axis b of marker 1: phi = a0 . b1 */
+static inline void mb_prim_dot1(const mb_marker *m0, const mb_marker *m1, int a, int b, mb_row *r) {
+  mb_real ai[3], aj[3], c[3], wa_i[3], wa_j[3], q_i[3], q_j[3];
+  mb_row_zero(r);
+  mb_col3(m0->R, a, ai);
+  mb_col3(m1->R, b, aj);
+  r->phi = mb_dot3(ai, aj);
+  mb_cross3(ai, aj, c);
+  for (int k = 0; k < 3; k++) { r->dW[0][k] = c[k]; r->dW[1][k] = -c[k]; }
+  mb_cross3(m0->W, ai, wa_i);
+  mb_cross3(m1->W, aj, wa_j);
+  mb_wwa(m0->W, ai, q_i);
+  mb_wwa(m1->W, aj, q_j);
+  r->quad = mb_dot3(q_i, aj) + 2 * mb_dot3(wa_i, wa_j) + mb_dot3(ai, q_j);
+}
+
+/* dot-2: axis a of marker 0 perpendicular to d = P1 - P0: phi = a0 . d - x(t)
+ * (x = 0 for a plain constraint; a translation driver passes its profile) */
+static inline void mb_prim_dot2(const mb_marker *m0, const mb_marker *m1, int a, const mb_real x[3],
+                                mb_row *r) {
+  mb_real ai[3], d[3], dd[3], wa[3], q[3];
+  mb_row_zero(r);
+  mb_col3(m0->R, a, ai);
+  for (int k = 0; k < 3; k++) { d[k] = m1->P[k] - m0->P[k]; dd[k] = m1->V[k] - m0->V[k]; }
+  r->phi = mb_dot3(ai, d) - x[0];
+  mb_cross3(ai, d, r->dW[0]);
+  for (int k = 0; k < 3; k++) { r->dV[0][k] = -ai[k]; r->dV[1][k] = ai[k]; }
+  mb_cross3(m0->W, ai, wa);
+  mb_wwa(m0->W, ai, q);
+  r->quad = mb_dot3(q, d) + 2 * mb_dot3(wa, dd) - x[2];
+  r->nu = x[1];
+}
+
+/* distance: phi = (d . d - L^2) / (2 L), d = P1 - P0 */
+static inline void mb_prim_dist(const mb_marker *m0, const mb_marker *m1, mb_real L, mb_row *r) {
+  mb_real d[3], dd[3];
+  mb_row_zero(r);
+  for (int k = 0; k < 3; k++) { d[k] = m1->P[k] - m0->P[k]; dd[k] = m1->V[k] - m0->V[k]; }
+  r->phi = (mb_dot3(d, d) - L * L) / (2 * L);
+  for (int k = 0; k < 3; k++) { r->dV[0][k] = -d[k] / L; r->dV[1][k] = d[k] / L; }
+  r->quad = mb_dot3(dd, dd) / L;
+}
+
+/* rotation driver: the angle from x0 to x1 about z0 follows th(t):
+ * phi = x1 . e,  e = -sin(th) x0 + cos(th) y0  (phi = sin(angle - th)) */
+static inline void mb_prim_rot(const mb_marker *m0, const mb_marker *m1, const mb_real th[3],
+                               mb_row *r) {
+  mb_real f[3], g[3], a[3], e[3], c[3], ed[3], wa[3], q[3], t1[3], t2[3];
+  mb_row_zero(r);
+  mb_col3(m0->R, 0, f);
+  mb_col3(m0->R, 1, g);
+  mb_col3(m1->R, 0, a);
+  mb_real s = sin(th[0]), co = cos(th[0]);
+  for (int k = 0; k < 3; k++) { e[k] = -s * f[k] + co * g[k]; c[k] = co * f[k] + s * g[k]; }
+  r->phi = mb_dot3(a, e);
+  mb_cross3(e, a, r->dW[0]);
+  mb_cross3(a, e, r->dW[1]);
+  r->nu = th[1] * mb_dot3(a, c);
+  /* ed = W0 x e - th' c; phi'' = a'' . e + 2 a' . ed + a . e'' */
+  mb_cross3(m0->W, e, ed);
+  for (int k = 0; k < 3; k++) ed[k] -= th[1] * c[k];
+  mb_cross3(m1->W, a, wa);
+  mb_wwa(m1->W, a, q);
+  mb_cross3(m0->W, ed, t1);
+  mb_cross3(m0->W, c, t2);
+  mb_real edd_q[3];
+  for (int k = 0; k < 3; k++) edd_q[k] = t1[k] - th[2] * c[k] - th[1] * (t2[k] + th[1] * e[k]);
+  r->quad = mb_dot3(q, e) + 2 * mb_dot3(wa, ed) + mb_dot3(a, edd_q);
+}
+
+/* Which primitive a row is: the generic path dispatches on this. */
+enum { MB_PRIM_SPH = 1, MB_PRIM_DOT1, MB_PRIM_DOT2, MB_PRIM_DIST, MB_PRIM_ROT, MB_PRIM_TRANS };
+
+/* --- force elements ---------------------------------------------------------------------- */
+enum { MB_LAW_NONE = 0, MB_LAW_LINEAR, MB_LAW_POWER, MB_LAW_TABLE };
+
+typedef struct {
+  int kind;
+  mb_real coef, exponent;
+  int ntable;
+  const mb_real *table; /* ntable pairs (x, F) */
+} mb_law;
+
+/* F(x) of a force law, and its integral from 0 to x (for potential energy) */
+static inline mb_real mb_law_eval(const mb_law *l, mb_real x, mb_real *energy) {
+  mb_real F = 0, E = 0;
+  switch (l->kind) {
+  case MB_LAW_LINEAR:
+    F = l->coef * x;
+    E = 0.5 * l->coef * x * x;
+    break;
+  case MB_LAW_POWER: {
+    mb_real ax = fabs(x), pw = pow(ax, l->exponent);
+    F = (x < 0 ? -1 : 1) * l->coef * pw;
+    E = l->coef * pw * ax / (l->exponent + 1);
+    break;
+  }
+  case MB_LAW_TABLE: { /* piecewise linear, extrapolated linearly */
+    const mb_real *d = l->table;
+    int n = l->ntable, k = 0;
+    while (k < n - 2 && x > d[2 * (k + 1)]) k++;
+    mb_real s = (d[2 * k + 3] - d[2 * k + 1]) / (d[2 * k + 2] - d[2 * k]);
+    F = d[2 * k + 1] + s * (x - d[2 * k]);
+    /* energy: integrate the same piecewise-linear curve from 0 to x by segments */
+    mb_real a = 0, b = x, sign = 1;
+    if (b < a) { a = x; b = 0; sign = -1; }
+    for (int j = 0; j <= n - 2; j++) {
+      mb_real lo = (j == 0) ? -INFINITY : d[2 * j], hi = (j == n - 2) ? INFINITY : d[2 * j + 2];
+      mb_real u0 = a > lo ? a : lo, u1 = b < hi ? b : hi;
+      if (u1 <= u0) continue;
+      mb_real sj = (d[2 * j + 3] - d[2 * j + 1]) / (d[2 * j + 2] - d[2 * j]);
+      mb_real f0 = d[2 * j + 1] + sj * (u0 - d[2 * j]), f1 = d[2 * j + 1] + sj * (u1 - d[2 * j]);
+      E += sign * 0.5 * (f0 + f1) * (u1 - u0);
+    }
+    break;
+  }
+  default:
+    break;
+  }
+  if (energy) *energy = E;
+  return F;
+}
+
+/* spring-damper between marker points: tension T = k(L - L0) + c(Ldot) + preload.
+ * Writes the forces on marker 0 and marker 1 (global) and returns the potential energy. */
+static inline mb_real mb_force_spring(const mb_marker *m0, const mb_marker *m1, const mb_law *k,
+                                      const mb_law *c, mb_real L0, mb_real preload,
+                                      mb_real F0[3], mb_real F1[3]) {
+  mb_real d[3], dd[3], E = 0;
+  for (int j = 0; j < 3; j++) { d[j] = m1->P[j] - m0->P[j]; dd[j] = m1->V[j] - m0->V[j]; }
+  mb_real L = sqrt(mb_dot3(d, d));
+  mb_real n[3] = {d[0] / L, d[1] / L, d[2] / L};
+  mb_real x = L - L0, Ld = mb_dot3(n, dd);
+  mb_real T = mb_law_eval(k, x, &E) + mb_law_eval(c, Ld, 0) + preload;
+  for (int j = 0; j < 3; j++) { F0[j] = T * n[j]; F1[j] = -T * n[j]; }
+  return E + preload * x;
+}
+
+/* bushing: in the axes R0 of marker 0, force -K x - C xdot + preload and torque
+ * -K th - C wrel + preload on marker 1 (th: rotation vector of R0^T R1);
+ * the reaction acts on body 0 at the same point P1.  Returns the potential energy. */
+static inline mb_real mb_force_bushing(const mb_marker *m0, const mb_marker *m1, const mb_real k[6],
+                                       const mb_real c[6], const mb_real pre[6], mb_real F[3],
+                                       mb_real T[3]) {
+  mb_real d[3], dd[3], wd[3], x[3], xd[3], Rr[9], th[3], wr[3], wrel[3], fl[3], tl[3];
+  for (int j = 0; j < 3; j++) {
+    d[j] = m1->P[j] - m0->P[j];
+    wd[j] = m1->W[j] - m0->W[j];
+  }
+  mb_real wxd[3];
+  mb_cross3(m0->W, d, wxd);
+  for (int j = 0; j < 3; j++) dd[j] = m1->V[j] - m0->V[j] - wxd[j];
+  mb_mul3t(m0->R, d, x);
+  mb_mul3t(m0->R, dd, xd);
+  /* relative rotation R0^T R1 and its rotation vector */
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      Rr[3 * i + j] = m0->R[i] * m1->R[j] + m0->R[3 + i] * m1->R[3 + j] + m0->R[6 + i] * m1->R[6 + j];
+  mb_real v[3] = {0.5 * (Rr[7] - Rr[5]), 0.5 * (Rr[2] - Rr[6]), 0.5 * (Rr[3] - Rr[1])};
+  mb_real sn = sqrt(mb_dot3(v, v)), cs = 0.5 * (Rr[0] + Rr[4] + Rr[8] - 1);
+  mb_real ang = atan2(sn, cs), fac = (sn > 1e-12) ? ang / sn : 1;
+  for (int j = 0; j < 3; j++) th[j] = fac * v[j];
+  mb_mul3t(m0->R, wd, wr);
+  (void)wrel;
+  mb_real E = 0;
+  for (int j = 0; j < 3; j++) {
+    fl[j] = -k[j] * x[j] - c[j] * xd[j] + pre[j];
+    tl[j] = -k[3 + j] * th[j] - c[3 + j] * wr[j] + pre[3 + j];
+    E += 0.5 * k[j] * x[j] * x[j] - pre[j] * x[j] + 0.5 * k[3 + j] * th[j] * th[j] - pre[3 + j] * th[j];
+  }
+  mb_mul3(m0->R, fl, F);
+  mb_mul3(m0->R, tl, T);
+  return E;
+}
+
+#endif

@@ -1,0 +1,131 @@
+/* mb_model.h: a compiled model: its element tables (what the compiler fixed:
+ * sizes, the CSC pattern of K = [M D^T; D 0], markers, constraint rows, forces,
+ * outputs) and the functions that evaluate it.  The generated code provides a
+ * const mb_model whose eval is specialized straight-line code; the generic
+ * path provides the same tables with eval = mb_generic_eval, which walks them.
+ * Both call the kernels of mb_kernels.h, so they give the same numbers. */
+#ifndef MB_MODEL_H
+#define MB_MODEL_H
+
+#include <stddef.h>
+#include "mb_kernels.h"
+
+enum { MB_BODY_RIGID = 1, MB_BODY_VIRTUAL = 2 };
+
+typedef struct {
+  const char *name;
+  int kind;
+  mb_real mass;
+  mb_real J[9];      /* inertia about the centre of mass, body axes */
+  int qadr, vadr;    /* first position / velocity coordinate */
+  int mslot[12];     /* Kx slots of m (3 diagonal) and J (9, row-major); -1: none */
+} mb_body;
+
+typedef struct {
+  int body;          /* index into body[], or -1 for the ground */
+  mb_real s[3];      /* point in body axes (ground: global) */
+  mb_real C[9];      /* axes in body axes (ground: global), row-major, columns x y z */
+} mb_markerdef;
+
+typedef struct {
+  int kind;          /* MB_PRIM_* */
+  int m0, m1;        /* markers */
+  int a, b;          /* SPH: component in a; DOT1: axes a of m0, b of m1; DOT2/TRANS: axis a of m0 */
+  mb_real L;         /* DIST: length */
+  int profile;       /* ROT, TRANS: index into profile[]; else -1 */
+  int slot[2][6];    /* Kx slot of D(row, body column) for marker 0/1's body; -1: none */
+  int slotT[2][6];   /* Kx slot of the transposed entry D^T */
+  unsigned char constant[2][6]; /* 1: the entry never changes (written by init only) */
+  int joint;         /* the source joint (reactions); -1 for a driver row */
+  int driver;        /* the source driver (effort), or -1 */
+} mb_rowdef;
+
+enum { MB_FORCE_POINT = 1, MB_FORCE_TORQUE, MB_FORCE_SPRING, MB_FORCE_BUSHING };
+
+typedef struct {
+  int kind;
+  int m0, m1;        /* POINT/TORQUE: m0 only; SPRING/BUSHING: both */
+  mb_real vec[3];    /* POINT/TORQUE: value */
+  int body_frame;    /* POINT/TORQUE: 1 when vec is in body axes */
+  int profile;       /* POINT/TORQUE: scale profile, or -1 */
+  mb_law stiffness, damping; /* SPRING */
+  mb_real L0, preload;       /* SPRING */
+  mb_real k6[6], c6[6], pre6[6]; /* BUSHING */
+} mb_forcedef;
+
+enum {
+  MB_OUT_POSITION = 1, MB_OUT_ORIENTATION, MB_OUT_ANGLE, MB_OUT_VELOCITY, MB_OUT_ANGULAR_VELOCITY,
+  MB_OUT_ACCELERATION, MB_OUT_ANGULAR_ACCELERATION, MB_OUT_REACTION, MB_OUT_EFFORT,
+  MB_OUT_KINETIC_ENERGY, MB_OUT_POTENTIAL_ENERGY, MB_OUT_TOTAL_ENERGY
+};
+
+typedef struct {
+  int kind;
+  int body;          /* or -1 */
+  mb_real s[3];      /* point in body axes (position/velocity/acceleration) */
+  mb_real axis[3];   /* ANGLE: axis in body axes; the angle is of u about it */
+  mb_real u[3];      /* ANGLE: reference direction perpendicular to axis, body axes */
+  mb_real axis_g[3]; /* ANGLE: the axis, global */
+  mb_real u_g[3];    /* ANGLE: the reference direction, global */
+  int component;     /* -1: all; else 0..2 */
+  int joint;         /* REACTION: joint index; its marker 1 is reaction_marker */
+  int reaction_marker;
+  int driver_row;    /* EFFORT: the driver's row, or -1 when redundant */
+  int driver_marker; /* EFFORT: marker 0 of the driven joint (its z axis) */
+  int driver_rotation; /* EFFORT: 1 rotation, 0 translation */
+  mb_real scale;
+  int ncols, col;    /* columns in the output vector and the first of them */
+} mb_outputdef;
+
+struct mb_model;
+
+/* Fill the varying entries of Kx, rhs = [f; gamma] (length n), phi and nu
+ * (length nc) at time t, positions q and velocities v.  'work' has
+ * mb_model_worksize bytes (the generated eval needs none). */
+typedef void (*mb_eval_fn)(const struct mb_model *m, mb_real t, const mb_real *q,
+                           const mb_real *v, mb_real *Kx, mb_real *rhs, mb_real *phi,
+                           mb_real *nu, void *work);
+
+typedef struct mb_model {
+  const char *name;
+  int nbody, nmarker, nrow, nforce, nprofile, noutput, njoint;
+  int nq, nv, nc, n, nnz;
+  const mb_body *body;
+  const mb_markerdef *marker;
+  const mb_rowdef *row;
+  const mb_forcedef *force;
+  const mb_profile *profile;
+  const mb_outputdef *output;
+  const char *const *joint_name;
+  mb_real gravity[3];
+  const int *Kp, *Ki;          /* CSC pattern of K (both triangles), n+1 and nnz */
+  const mb_real *q0, *v0;      /* assembled, consistent initial state */
+  int ncols;                   /* output columns */
+  const char *const *col_name; /* their names */
+  mb_eval_fn eval;
+  void (*init)(const struct mb_model *m, mb_real *Kx); /* the constant entries of K */
+} mb_model;
+
+/* generic (table-walking) implementations; freestanding: no allocation, no I/O */
+size_t mb_model_worksize(const mb_model *m);
+void mb_generic_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
+                     mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *nu, void *work);
+void mb_generic_init(const mb_model *m, mb_real *Kx);
+
+/* qd = G(q) v: position-coordinate rates */
+void mb_model_qdot(const mb_model *m, const mb_real *q, const mb_real *v, mb_real *qd);
+/* q <- q (+) dv: move positions by a velocity-space increment (exact rotations) */
+void mb_model_qincrement(const mb_model *m, mb_real *q, const mb_real *dv);
+/* normalize Euler parameters */
+void mb_model_normalize(const mb_model *m, mb_real *q);
+/* Outputs at one instant: vd and lambda are the accelerations and multipliers
+ * (from the same solve).  'prev' holds the previous outputs (for unwrapping
+ * angles) or NULL.  Writes m->ncols values. */
+void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
+                      const mb_real *vd, const mb_real *lambda, const mb_real *prev,
+                      mb_real *out, void *work);
+/* kinetic and potential energy (gravity and force elements) */
+void mb_model_energy(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
+                     mb_real *kinetic, mb_real *potential, void *work);
+
+#endif

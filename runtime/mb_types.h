@@ -1,0 +1,27 @@
+/* mb_types.h: the scalar type and status codes shared by the runtime and
+ * the generated code.  Build with -DMB_REAL_FLOAT for single precision. */
+#ifndef MB_TYPES_H
+#define MB_TYPES_H
+
+#ifdef MB_REAL_FLOAT
+typedef float mb_real;
+#else
+typedef double mb_real;
+#endif
+
+/* Status codes: 0 is success; the runtime never prints or exits. */
+typedef enum {
+  MB_OK = 0,
+  MB_ERR_SINGULAR = 1,        /* the system matrix K could not be factorized */
+  MB_ERR_NONFINITE = 2,       /* NaN or Inf in the state or the accelerations */
+  MB_ERR_STEP_TOO_SMALL = 3,  /* the adaptive step fell below min_step */
+  MB_ERR_PROJECTION = 4,      /* coordinate projection did not converge */
+  MB_ERR_NOMEM = 5,           /* allocation failed (hosted runtime only) */
+  MB_ERR_INVALID = 6          /* invalid settings */
+} mb_status;
+
+#define MB_PI 3.14159265358979323846
+
+const char *mb_status_text(int status);
+
+#endif

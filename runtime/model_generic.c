@@ -1,0 +1,333 @@
+/* model_generic.c: evaluates a model by walking its element tables: the
+ * generic path, and the shared code for outputs, energy and coordinate
+ * updates that the generated code also uses.  No allocation, no I/O. */
+#include "mb_model.h"
+
+const char *mb_status_text(int status) {
+  switch (status) {
+  case MB_OK: return "ok";
+  case MB_ERR_SINGULAR: return "singular system matrix";
+  case MB_ERR_NONFINITE: return "non-finite value (NaN or Inf) in the solution";
+  case MB_ERR_STEP_TOO_SMALL: return "step size fell below the minimum";
+  case MB_ERR_PROJECTION: return "coordinate projection did not converge";
+  case MB_ERR_NOMEM: return "out of memory";
+  case MB_ERR_INVALID: return "invalid settings";
+  default: return "unknown error";
+  }
+}
+
+size_t mb_model_worksize(const mb_model *m) {
+  return (size_t)m->nbody * sizeof(mb_frame) + (size_t)m->nmarker * sizeof(mb_marker);
+}
+
+/* body frames and markers at (q, v) */
+static void frames_and_markers(const mb_model *m, const mb_real *q, const mb_real *v,
+                               mb_frame *F, mb_marker *MK) {
+  for (int b = 0; b < m->nbody; b++)
+    mb_frame_rigid(q + m->body[b].qadr, v + m->body[b].vadr, &F[b]);
+  for (int k = 0; k < m->nmarker; k++) {
+    const mb_markerdef *d = &m->marker[k];
+    if (d->body < 0)
+      mb_marker_ground(d->s, d->C, &MK[k]);
+    else
+      mb_marker_rigid(&F[d->body], d->s, d->C, &MK[k]);
+  }
+}
+
+/* one constraint row, dispatched on its primitive */
+static void row_eval(const mb_model *m, const mb_rowdef *rd, const mb_marker *MK, mb_real t,
+                     mb_row *r) {
+  static const mb_real none[3] = {0, 0, 0};
+  mb_real x[3];
+  const mb_marker *m0 = &MK[rd->m0], *m1 = &MK[rd->m1];
+  switch (rd->kind) {
+  case MB_PRIM_SPH: mb_prim_sph(m0, m1, rd->a, r); break;
+  case MB_PRIM_DOT1: mb_prim_dot1(m0, m1, rd->a, rd->b, r); break;
+  case MB_PRIM_DOT2: mb_prim_dot2(m0, m1, rd->a, none, r); break;
+  case MB_PRIM_DIST: mb_prim_dist(m0, m1, rd->L, r); break;
+  case MB_PRIM_ROT:
+    mb_profile_eval(&m->profile[rd->profile], t, x);
+    mb_prim_rot(m0, m1, x, r);
+    break;
+  case MB_PRIM_TRANS:
+    mb_profile_eval(&m->profile[rd->profile], t, x);
+    mb_prim_dot2(m0, m1, 2, x, r);
+    break;
+  default: mb_row_zero(r); break;
+  }
+}
+
+/* add a force F and torque T (global) acting at point P of body b into f */
+static void add_wrench(const mb_model *m, const mb_frame *F, int b, const mb_real P[3],
+                       const mb_real Fv[3], const mb_real T[3], mb_real *f) {
+  if (b < 0) return;
+  mb_real c[6];
+  mb_rigid_cols(&F[b], P, Fv, T, c);
+  for (int j = 0; j < 6; j++) f[m->body[b].vadr + j] += c[j];
+}
+
+/* applied forces of the force elements, added into f; returns their potential energy */
+static mb_real forces_eval(const mb_model *m, mb_real t, const mb_frame *F, const mb_marker *MK,
+                           mb_real *f) {
+  static const mb_real zero[3] = {0, 0, 0};
+  mb_real E = 0;
+  for (int e = 0; e < m->nforce; e++) {
+    const mb_forcedef *d = &m->force[e];
+    const mb_marker *m0 = &MK[d->m0];
+    int b0 = m->marker[d->m0].body;
+    switch (d->kind) {
+    case MB_FORCE_POINT:
+    case MB_FORCE_TORQUE: {
+      mb_real s = 1, x[3], val[3];
+      if (d->profile >= 0) { mb_profile_eval(&m->profile[d->profile], t, x); s = x[0]; }
+      for (int j = 0; j < 3; j++) val[j] = s * d->vec[j];
+      if (d->body_frame && b0 >= 0) mb_mul3(F[b0].A, val, val);
+      if (d->kind == MB_FORCE_POINT)
+        add_wrench(m, F, b0, m0->P, val, zero, f);
+      else
+        add_wrench(m, F, b0, m0->P, zero, val, f);
+      break;
+    }
+    case MB_FORCE_SPRING: {
+      mb_real F0[3], F1[3];
+      const mb_marker *m1 = &MK[d->m1];
+      E += mb_force_spring(m0, m1, &d->stiffness, &d->damping, d->L0, d->preload, F0, F1);
+      add_wrench(m, F, b0, m0->P, F0, zero, f);
+      add_wrench(m, F, m->marker[d->m1].body, m1->P, F1, zero, f);
+      break;
+    }
+    case MB_FORCE_BUSHING: {
+      mb_real Fv[3], T[3], mF[3], mT[3];
+      const mb_marker *m1 = &MK[d->m1];
+      E += mb_force_bushing(m0, m1, d->k6, d->c6, d->pre6, Fv, T);
+      for (int j = 0; j < 3; j++) { mF[j] = -Fv[j]; mT[j] = -T[j]; }
+      add_wrench(m, F, m->marker[d->m1].body, m1->P, Fv, T, f);
+      add_wrench(m, F, b0, m1->P, mF, mT, f); /* reaction at the same point */
+      break;
+    }
+    default:
+      break;
+    }
+  }
+  return E;
+}
+
+void mb_generic_init(const mb_model *m, mb_real *Kx) {
+  for (int k = 0; k < m->nnz; k++) Kx[k] = 0;
+  for (int b = 0; b < m->nbody; b++) {
+    const mb_body *B = &m->body[b];
+    for (int j = 0; j < 3; j++)
+      if (B->mslot[j] >= 0) Kx[B->mslot[j]] = B->mass;
+    for (int j = 0; j < 9; j++)
+      if (B->mslot[3 + j] >= 0) Kx[B->mslot[3 + j]] = B->J[j];
+  }
+  /* the only constant constraint entries: a spherical row's translational
+     columns, -1 on marker 0's body and +1 on marker 1's */
+  for (int r = 0; r < m->nrow; r++) {
+    const mb_rowdef *rd = &m->row[r];
+    for (int s = 0; s < 2; s++)
+      for (int j = 0; j < 6; j++)
+        if (rd->constant[s][j] && rd->slot[s][j] >= 0) {
+          Kx[rd->slot[s][j]] = s ? 1 : -1;
+          Kx[rd->slotT[s][j]] = s ? 1 : -1;
+        }
+  }
+}
+
+void mb_generic_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
+                     mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *nu, void *work) {
+  mb_frame *F = (mb_frame *)work;
+  mb_marker *MK = (mb_marker *)(F + m->nbody);
+  frames_and_markers(m, q, v, F, MK);
+
+  /* body forces: gravity and the quadratic-velocity (gyroscopic) terms */
+  for (int b = 0; b < m->nbody; b++) {
+    const mb_body *B = &m->body[b];
+    mb_real *f = rhs + B->vadr, s[3];
+    for (int j = 0; j < 3; j++) f[j] = B->mass * m->gravity[j];
+    mb_rigid_gyro(B->J, F[b].wl, s);
+    for (int j = 0; j < 3; j++) f[3 + j] = s[j];
+  }
+  forces_eval(m, t, F, MK, rhs);
+
+  /* constraint rows: D (both triangles of K), gamma, phi, nu */
+  for (int r = 0; r < m->nrow; r++) {
+    const mb_rowdef *rd = &m->row[r];
+    mb_row row;
+    row_eval(m, rd, MK, t, &row);
+    phi[r] = row.phi;
+    nu[r] = row.nu;
+    rhs[m->nv + r] = mb_row_gamma(&row, &MK[rd->m0], &MK[rd->m1]);
+    for (int s = 0; s < 2; s++) {
+      const mb_markerdef *md = &m->marker[s ? rd->m1 : rd->m0];
+      if (md->body < 0) continue;
+      mb_real c[6];
+      mb_rigid_cols(&F[md->body], MK[s ? rd->m1 : rd->m0].P, row.dV[s], row.dW[s], c);
+      for (int j = 0; j < 6; j++)
+        if (rd->slot[s][j] >= 0 && !rd->constant[s][j]) {
+          Kx[rd->slot[s][j]] = c[j];
+          Kx[rd->slotT[s][j]] = c[j];
+        }
+    }
+  }
+}
+
+void mb_model_qdot(const mb_model *m, const mb_real *q, const mb_real *v, mb_real *qd) {
+  for (int b = 0; b < m->nbody; b++) {
+    const mb_body *B = &m->body[b];
+    for (int j = 0; j < 3; j++) qd[B->qadr + j] = v[B->vadr + j];
+    mb_euler_rates(q + B->qadr + 3, v + B->vadr + 3, qd + B->qadr + 3);
+  }
+}
+
+void mb_model_qincrement(const mb_model *m, mb_real *q, const mb_real *dv) {
+  for (int b = 0; b < m->nbody; b++) {
+    const mb_body *B = &m->body[b];
+    for (int j = 0; j < 3; j++) q[B->qadr + j] += dv[B->vadr + j];
+    mb_euler_rotate(q + B->qadr + 3, dv + B->vadr + 3);
+  }
+}
+
+void mb_model_normalize(const mb_model *m, mb_real *q) {
+  for (int b = 0; b < m->nbody; b++) {
+    mb_real *p = q + m->body[b].qadr + 3;
+    mb_real n = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3]);
+    for (int j = 0; j < 4; j++) p[j] /= n;
+  }
+}
+
+void mb_model_energy(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
+                     mb_real *kinetic, mb_real *potential, void *work) {
+  mb_frame *F = (mb_frame *)work;
+  mb_marker *MK = (mb_marker *)(F + m->nbody);
+  frames_and_markers(m, q, v, F, MK);
+  mb_real T = 0, U = 0;
+  for (int b = 0; b < m->nbody; b++) {
+    const mb_body *B = &m->body[b];
+    T += mb_rigid_kinetic(B->mass, B->J, &F[b]);
+    U -= B->mass * mb_dot3(m->gravity, F[b].r);
+  }
+  /* force elements: their potential (the forces themselves are not needed) */
+  for (int e = 0; e < m->nforce; e++) {
+    const mb_forcedef *d = &m->force[e];
+    if (d->kind == MB_FORCE_SPRING) {
+      mb_real F0[3], F1[3];
+      U += mb_force_spring(&MK[d->m0], &MK[d->m1], &d->stiffness, &d->damping, d->L0, d->preload,
+                           F0, F1);
+    } else if (d->kind == MB_FORCE_BUSHING) {
+      mb_real Fv[3], Tq[3];
+      U += mb_force_bushing(&MK[d->m0], &MK[d->m1], d->k6, d->c6, d->pre6, Fv, Tq);
+    }
+  }
+  (void)t;
+  *kinetic = T;
+  *potential = U;
+}
+
+/* the angle of a body-fixed direction about a global axis, measured from its
+ * initial direction, unwrapped against the previous value */
+static mb_real body_angle(const mb_outputdef *o, const mb_frame *f, const mb_real *prev) {
+  mb_real u[3], c[3];
+  mb_mul3(f->A, o->u, u);
+  mb_cross3(o->u_g, u, c);
+  mb_real a = atan2(mb_dot3(o->axis_g, c), mb_dot3(o->u_g, u));
+  if (prev) {
+    while (a - *prev > MB_PI) a -= 2 * MB_PI;
+    while (a - *prev < -MB_PI) a += 2 * MB_PI;
+  }
+  return a;
+}
+
+void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
+                      const mb_real *vd, const mb_real *lambda, const mb_real *prev,
+                      mb_real *out, void *work) {
+  mb_frame *F = (mb_frame *)work;
+  mb_marker *MK = (mb_marker *)(F + m->nbody);
+  mb_real kin = 0, pot = 0;
+  int need_energy = 0;
+  for (int k = 0; k < m->noutput; k++) {
+    int kind = m->output[k].kind;
+    if (kind == MB_OUT_KINETIC_ENERGY || kind == MB_OUT_POTENTIAL_ENERGY ||
+        kind == MB_OUT_TOTAL_ENERGY)
+      need_energy = 1;
+  }
+  if (need_energy) mb_model_energy(m, t, q, v, &kin, &pot, work);
+  frames_and_markers(m, q, v, F, MK);
+
+  for (int k = 0; k < m->noutput; k++) {
+    const mb_outputdef *o = &m->output[k];
+    const mb_frame *f = o->body >= 0 ? &F[o->body] : 0;
+    mb_real val[6] = {0, 0, 0, 0, 0, 0}, u[3], tmp[3], tmp2[3];
+    int nval = 3;
+    switch (o->kind) {
+    case MB_OUT_POSITION:
+      mb_mul3(f->A, o->s, u);
+      for (int j = 0; j < 3; j++) val[j] = f->r[j] + u[j];
+      break;
+    case MB_OUT_ORIENTATION: {
+      const mb_real *p = q + m->body[o->body].qadr + 3;
+      mb_real n = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3]);
+      for (int j = 0; j < 4; j++) val[j] = p[j] / n;
+      nval = 4;
+      break;
+    }
+    case MB_OUT_ANGLE:
+      val[0] = body_angle(o, f, prev ? prev + o->col : 0);
+      nval = 1;
+      break;
+    case MB_OUT_VELOCITY:
+      mb_mul3(f->A, o->s, u);
+      mb_cross3(f->w, u, tmp);
+      for (int j = 0; j < 3; j++) val[j] = f->rd[j] + tmp[j];
+      break;
+    case MB_OUT_ANGULAR_VELOCITY:
+      for (int j = 0; j < 3; j++) val[j] = f->w[j];
+      break;
+    case MB_OUT_ACCELERATION: {
+      const mb_real *a = vd + m->body[o->body].vadr;
+      mb_real wd[3];
+      mb_mul3(f->A, a + 3, wd);
+      mb_mul3(f->A, o->s, u);
+      mb_cross3(wd, u, tmp);
+      mb_wwa(f->w, u, tmp2);
+      for (int j = 0; j < 3; j++) val[j] = a[j] + tmp[j] + tmp2[j];
+      break;
+    }
+    case MB_OUT_ANGULAR_ACCELERATION:
+      mb_mul3(f->A, vd + m->body[o->body].vadr + 3, val);
+      break;
+    case MB_OUT_REACTION:
+      /* constraint force on body 1 at its joint point: -sum lambda (dV1, dW1) */
+      for (int r = 0; r < m->nrow; r++) {
+        if (m->row[r].joint != o->joint) continue;
+        mb_row row;
+        row_eval(m, &m->row[r], MK, t, &row);
+        for (int j = 0; j < 3; j++) {
+          val[j] -= lambda[r] * row.dV[1][j];
+          val[3 + j] -= lambda[r] * row.dW[1][j];
+        }
+      }
+      nval = 6;
+      break;
+    case MB_OUT_EFFORT:
+      nval = 1;
+      if (o->driver_row >= 0) {
+        mb_row row;
+        mb_real z[3];
+        row_eval(m, &m->row[o->driver_row], MK, t, &row);
+        mb_col3(MK[o->driver_marker].R, 2, z);
+        val[0] = -lambda[o->driver_row] * mb_dot3(o->driver_rotation ? row.dW[1] : row.dV[1], z);
+      }
+      break;
+    case MB_OUT_KINETIC_ENERGY: val[0] = kin; nval = 1; break;
+    case MB_OUT_POTENTIAL_ENERGY: val[0] = pot; nval = 1; break;
+    case MB_OUT_TOTAL_ENERGY: val[0] = kin + pot; nval = 1; break;
+    default: nval = 0; break;
+    }
+    if (o->component >= 0 && nval == 3) {
+      out[o->col] = o->scale * val[o->component];
+    } else {
+      for (int j = 0; j < o->ncols; j++) out[o->col + j] = o->scale * val[j];
+    }
+  }
+}
