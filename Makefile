@@ -12,7 +12,7 @@ RT_HDR  := $(wildcard runtime/*.h)
 CC_SRC  := compiler/main.c compiler/reader.c compiler/diag.c compiler/lower.c \
            compiler/assemble.c compiler/emit.c
 CC_HDR  := $(wildcard compiler/*.h)
-B       := build
+B       ?= build
 
 .PHONY: all test demo clean sanitize docs
 all: $(B)/mbcc $(B)/libmbrt.a
@@ -26,6 +26,7 @@ $(B)/libmbrt.a: $(patsubst runtime/%.c,$(B)/rt/%.o,$(RT_SRC))
 
 $(B)/mbcc: $(CC_SRC) $(CC_HDR) $(B)/libmbrt.a
 	$(CC) $(STD) $(WARN) $(CFLAGS) -Icompiler -Iruntime -DMBCC_ROOT='"$(ROOT)"' \
+	  -DMBCC_RTLIB='"$(ROOT)/$(B)/libmbrt.a"' -DMBCC_GEN_CFLAGS='"$(CFLAGS)"' \
 	  $(CC_SRC) $(B)/libmbrt.a $(LIBS) -o $@
 
 demo: all

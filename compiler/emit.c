@@ -220,7 +220,8 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
           "    mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *nu, void *work) {\n"
           "  static const mb_real zero3[3] = {0, 0, 0};\n"
           "  mb_frame f[%d];\n  mb_marker k[%d];\n  mb_row r;\n  mb_real c[6], x[3];\n"
-          "  (void)m; (void)work; (void)t; (void)x; (void)c; (void)r; (void)zero3;\n",
+          "  (void)m; (void)work; (void)t; (void)x; (void)c; (void)r; (void)zero3;\n"
+          "  (void)Kx; (void)phi; (void)nu; (void)f; (void)k;\n",
           nm, m->nbody ? m->nbody : 1, m->nmarker ? m->nmarker : 1);
   fprintf(f, "\n  /* body frames */\n");
   for (int b = 0; b < m->nbody; b++)
@@ -302,11 +303,11 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
       }
       break;
     case MB_FORCE_BUSHING:
-      fprintf(f, "    mb_real F[3], T[3], mF[3], mT[3];\n"
-                 "    mb_force_bushing(&k[%d], &k[%d], forces[%d].k6, forces[%d].c6, forces[%d].pre6, F, T);\n"
-                 "    mF[0] = -F[0]; mF[1] = -F[1]; mF[2] = -F[2];\n"
-                 "    mT[0] = -T[0]; mT[1] = -T[1]; mT[2] = -T[2];\n",
+      fprintf(f, "    mb_real F[3], T[3];\n"
+                 "    mb_force_bushing(&k[%d], &k[%d], forces[%d].k6, forces[%d].c6, forces[%d].pre6, F, T);\n",
               d->m0, d->m1, k, k, k);
+      if (b0 >= 0)
+        fputs("    mb_real mF[3] = {-F[0], -F[1], -F[2]}, mT[3] = {-T[0], -T[1], -T[2]};\n", f);
       if (b1 >= 0) {
         fprintf(f, "    mb_rigid_cols(&f[%d], k[%d].P, F, T, c);\n", b1, d->m1);
         add_cols(f, L->body[b1].vadr);

@@ -15,6 +15,12 @@
 #ifndef MBCC_ROOT
 #define MBCC_ROOT "."
 #endif
+#ifndef MBCC_RTLIB
+#define MBCC_RTLIB MBCC_ROOT "/build/libmbrt.a"
+#endif
+#ifndef MBCC_GEN_CFLAGS
+#define MBCC_GEN_CFLAGS "-O2"
+#endif
 
 static const char *root_dir(void) {
   const char *r = getenv("MBCC_ROOT");
@@ -252,11 +258,21 @@ static int cmd_run(const options *o) {
     snprintf(src_c, sizeof src_c, "%s/%s.c", dir, L->m.name);
     snprintf(src_main, sizeof src_main, "%s/main.c", dir);
     snprintf(inc, sizeof inc, "-I%s/runtime", root_dir());
-    snprintf(lib, sizeof lib, "%s/build/libmbrt.a", root_dir());
+    const char *rtlib = getenv("MBCC_RTLIB");
+    snprintf(lib, sizeof lib, "%s", rtlib && *rtlib ? rtlib : MBCC_RTLIB);
     const char *cc = getenv("CC");
-    char *ccargs[] = {(char *)(cc && *cc ? cc : "cc"), "-std=c99", "-O2", inc, "-o", exe, src_c, src_main, lib,
-                      "-lklu", "-lamd", "-lcolamd", "-lbtf", "-lsuitesparseconfig", "-llapack",
-                      "-lblas", "-lm", NULL};
+    /* the C flags mbcc itself was built with (e.g. sanitizers), split on spaces */
+    static char flags[1024];
+    snprintf(flags, sizeof flags, "%s", MBCC_GEN_CFLAGS);
+    char *ccargs[64];
+    int nc = 0;
+    ccargs[nc++] = (char *)(cc && *cc ? cc : "cc");
+    ccargs[nc++] = "-std=c99";
+    for (char *tok = strtok(flags, " "); tok && nc < 40; tok = strtok(NULL, " ")) ccargs[nc++] = tok;
+    char *rest[] = {inc, "-o", exe, src_c, src_main, lib, "-lklu", "-lamd", "-lcolamd", "-lbtf",
+                    "-lsuitesparseconfig", "-llapack", "-lblas", "-lm", NULL};
+    for (int i = 0; rest[i]; i++) ccargs[nc++] = rest[i];
+    ccargs[nc] = NULL;
     if (!o->quiet) fprintf(stderr, "mbcc: compiling %s\n", src_c);
     if (run_command(ccargs)) {
       fprintf(stderr, "mbcc: error: the C compiler failed on %s\n", src_c);

@@ -1,0 +1,269 @@
+/* test_fd.c: the generated constraint Jacobian D, gamma and nu against
+ * finite differences of phi and of D v at random configurations, for every
+ * joint type and driver profile; generalized spring forces against finite
+ * differences of the potential energy; M and the gyroscopic forces against
+ * hand-derived values; the generated evaluation against the generic one. */
+// models: fd_all fd_springs spatial_joints slider_crank
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "support.h"
+#include "fd_all.h"
+#include "fd_springs.h"
+#include "spatial_joints.h"
+#include "slider_crank.h"
+
+typedef struct {
+  const mb_model *m;
+  double *Kx, *rhs, *phi, *nu;
+  void *work;
+} evaluator;
+
+static void ev_init(evaluator *e, const mb_model *m) {
+  e->m = m;
+  e->Kx = calloc((size_t)m->nnz + 1, sizeof(double));
+  e->rhs = calloc((size_t)m->n + 1, sizeof(double));
+  e->phi = calloc((size_t)m->nc + 1, sizeof(double));
+  e->nu = calloc((size_t)m->nc + 1, sizeof(double));
+  e->work = malloc(mb_model_worksize(m) + 16);
+  assert_non_null(e->Kx);
+  assert_non_null(e->work);
+}
+
+static void ev_free(evaluator *e) {
+  free(e->Kx); free(e->rhs); free(e->phi); free(e->nu); free(e->work);
+}
+
+static void ev(evaluator *e, double t, const double *q, const double *v) {
+  e->m->init(e->m, e->Kx);
+  e->m->eval(e->m, t, q, v, e->Kx, e->rhs, e->phi, e->nu, e->work);
+}
+
+/* D (nc x nv, row-major) from the constraint rows of K */
+static void dense_D(const mb_model *m, const double *Kx, double *D) {
+  memset(D, 0, sizeof(double) * (size_t)m->nc * (size_t)m->nv);
+  for (int c = 0; c < m->nv; c++)
+    for (int p = m->Kp[c]; p < m->Kp[c + 1]; p++)
+      if (m->Ki[p] >= m->nv) D[(size_t)(m->Ki[p] - m->nv) * (size_t)m->nv + (size_t)c] = Kx[p];
+}
+
+/* a random state: positions in [-1, 1], unit Euler parameters, velocities in [-2, 2] */
+static void random_state(const mb_model *m, double *q, double *v) {
+  for (int b = 0; b < m->nbody; b++) {
+    double *qb = q + m->body[b].qadr, n = 0;
+    for (int j = 0; j < 3; j++) qb[j] = urand(-1, 1);
+    for (int j = 0; j < 4; j++) { qb[3 + j] = urand(-1, 1); n += qb[3 + j] * qb[3 + j]; }
+    for (int j = 0; j < 4; j++) qb[3 + j] /= sqrt(n);
+  }
+  for (int j = 0; j < m->nv; j++) v[j] = urand(-2, 2);
+}
+
+/* q (+) s dv */
+static void moved(const mb_model *m, const double *q, const double *dv, double s, double *out) {
+  double *d = malloc(sizeof(double) * (size_t)m->nv);
+  memcpy(out, q, sizeof(double) * (size_t)m->nq);
+  for (int j = 0; j < m->nv; j++) d[j] = s * dv[j];
+  mb_model_qincrement(m, out, d);
+  free(d);
+}
+
+static void check_constraints(const mb_model *m, int trials) {
+  evaluator e;
+  ev_init(&e, m);
+  int nq = m->nq, nv = m->nv, nc = m->nc;
+  double *q = malloc(sizeof(double) * (size_t)nq), *v = malloc(sizeof(double) * (size_t)nv);
+  double *qp = malloc(sizeof(double) * (size_t)nq), *qm = malloc(sizeof(double) * (size_t)nq);
+  double *D = malloc(sizeof(double) * (size_t)(nc * nv + 1));
+  double *phip = malloc(sizeof(double) * (size_t)(nc + 1)), *phim = malloc(sizeof(double) * (size_t)(nc + 1));
+  double *cp = malloc(sizeof(double) * (size_t)(nc + 1)), *cm = malloc(sizeof(double) * (size_t)(nc + 1));
+  double *ej = calloc((size_t)nv, sizeof(double));
+  double *gamma = malloc(sizeof(double) * (size_t)(nc + 1)), *nu = malloc(sizeof(double) * (size_t)(nc + 1));
+  double *Dv = malloc(sizeof(double) * (size_t)(nc + 1));
+  const double h = 1e-6;
+  double worst_D = 0, worst_g = 0, worst_nu = 0;
+  for (int trial = 0; trial < trials; trial++) {
+    random_state(m, q, v);
+    double t = urand(0, 1.5);
+    ev(&e, t, q, v);
+    dense_D(m, e.Kx, D);
+    memcpy(gamma, e.rhs + nv, sizeof(double) * (size_t)nc);
+    memcpy(nu, e.nu, sizeof(double) * (size_t)nc);
+    for (int r = 0; r < nc; r++) {
+      Dv[r] = 0;
+      for (int j = 0; j < nv; j++) Dv[r] += D[(size_t)r * (size_t)nv + (size_t)j] * v[j];
+    }
+    /* D: central differences of phi along each velocity coordinate */
+    for (int j = 0; j < nv; j++) {
+      memset(ej, 0, sizeof(double) * (size_t)nv);
+      ej[j] = 1;
+      moved(m, q, ej, h, qp);
+      moved(m, q, ej, -h, qm);
+      ev(&e, t, qp, v);
+      memcpy(phip, e.phi, sizeof(double) * (size_t)nc);
+      ev(&e, t, qm, v);
+      memcpy(phim, e.phi, sizeof(double) * (size_t)nc);
+      for (int r = 0; r < nc; r++) {
+        double fd = (phip[r] - phim[r]) / (2 * h), an = D[(size_t)r * (size_t)nv + (size_t)j];
+        double err = fabs(fd - an) / (1 + fabs(an));
+        if (err > worst_D) worst_D = err;
+        if (err > 1e-7) print_error("%s: D[%d][%d] = %.12g, finite difference %.12g\n", m->name, r, j, an, fd);
+      }
+    }
+    /* phidot = D v - nu: central difference of phi along (q (+) tau v, t + tau) */
+    moved(m, q, v, h, qp);
+    moved(m, q, v, -h, qm);
+    ev(&e, t + h, qp, v);
+    memcpy(phip, e.phi, sizeof(double) * (size_t)nc);
+    ev(&e, t - h, qm, v);
+    memcpy(phim, e.phi, sizeof(double) * (size_t)nc);
+    for (int r = 0; r < nc; r++) {
+      double fd = (phip[r] - phim[r]) / (2 * h), an = Dv[r] - nu[r];
+      double err = fabs(fd - an) / (1 + fabs(an));
+      if (err > worst_nu) worst_nu = err;
+      if (err > 1e-7) print_error("%s: phidot[%d] = %.12g, finite difference %.12g\n", m->name, r, an, fd);
+    }
+    /* gamma = -d/dt (D v - nu) at constant v */
+    ev(&e, t + h, qp, v);
+    dense_D(m, e.Kx, D);
+    for (int r = 0; r < nc; r++) {
+      cp[r] = -e.nu[r];
+      for (int j = 0; j < nv; j++) cp[r] += D[(size_t)r * (size_t)nv + (size_t)j] * v[j];
+    }
+    ev(&e, t - h, qm, v);
+    dense_D(m, e.Kx, D);
+    for (int r = 0; r < nc; r++) {
+      cm[r] = -e.nu[r];
+      for (int j = 0; j < nv; j++) cm[r] += D[(size_t)r * (size_t)nv + (size_t)j] * v[j];
+    }
+    for (int r = 0; r < nc; r++) {
+      double fd = -(cp[r] - cm[r]) / (2 * h);
+      double err = fabs(fd - gamma[r]) / (1 + fabs(gamma[r]));
+      if (err > worst_g) worst_g = err;
+      if (err > 1e-6) print_error("%s: gamma[%d] = %.12g, finite difference %.12g\n", m->name, r, gamma[r], fd);
+    }
+  }
+  print_message("%s: %d rows, worst relative error: D %.2e, nu %.2e, gamma %.2e\n", m->name, nc,
+                worst_D, worst_nu, worst_g);
+  /* central differences with h = 1e-6: truncation ~1e-12 x third derivative,
+     round-off ~1e-16 / 1e-6 = 1e-10 per difference */
+  assert_true(worst_D < 1e-7);
+  assert_true(worst_nu < 1e-7);
+  assert_true(worst_g < 1e-6);
+  free(q); free(v); free(qp); free(qm); free(D); free(phip); free(phim); free(cp); free(cm);
+  free(ej); free(gamma); free(nu); free(Dv);
+  ev_free(&e);
+}
+
+static void test_constraints_all_joints(void **state) {
+  (void)state;
+  check_constraints(&fd_all_model, 5);
+}
+
+static void test_constraints_shipped(void **state) {
+  (void)state;
+  check_constraints(&spatial_joints_model, 3);
+  check_constraints(&slider_crank_model, 3);
+}
+
+/* generalized forces of conservative elements = -dU/dq (v = 0: no damping, no gyroscopic terms) */
+static void test_spring_forces(void **state) {
+  (void)state;
+  const mb_model *m = &fd_springs_model;
+  evaluator e;
+  ev_init(&e, m);
+  double q[64], v[64] = {0}, qp[64], qm[64], ej[64], worst = 0;
+  assert_true(m->nq <= 64);
+  for (int trial = 0; trial < 5; trial++) {
+    random_state(m, q, v);
+    memset(v, 0, sizeof v);
+    ev(&e, 0, q, v);
+    for (int j = 0; j < m->nv; j++) {
+      memset(ej, 0, sizeof ej);
+      ej[j] = 1;
+      const double h = 1e-6;
+      double Tp, Up, Tm, Um;
+      moved(m, q, ej, h, qp);
+      moved(m, q, ej, -h, qm);
+      mb_model_energy(m, 0, qp, v, &Tp, &Up, e.work);
+      mb_model_energy(m, 0, qm, v, &Tm, &Um, e.work);
+      double fd = -(Up - Um) / (2 * h);
+      double err = fabs(fd - e.rhs[j]) / (1 + fabs(e.rhs[j]));
+      if (err > worst) worst = err;
+      if (err > 1e-6) print_error("generalized force %d = %.12g, -dU/dq = %.12g\n", j, e.rhs[j], fd);
+    }
+  }
+  print_message("fd_springs: worst relative error of forces against -dU/dq: %.2e\n", worst);
+  assert_true(worst < 1e-6);
+  ev_free(&e);
+}
+
+/* M entries and the gyroscopic force -w' x (J w') of fd_all's body b5 (full inertia tensor) */
+static void test_mass_and_gyroscopic(void **state) {
+  (void)state;
+  const mb_model *m = &fd_all_model;
+  evaluator e;
+  ev_init(&e, m);
+  double q[64], v[64];
+  random_state(m, q, v);
+  ev(&e, 0, q, v);
+  const mb_body *B = &m->body[4]; /* b5: m 0.7, J = [0.01 0.001 0.0005; 0.001 0.012 -0.002; 0.0005 -0.002 0.015] */
+  const double J[9] = {0.01, 0.001, 0.0005, 0.001, 0.012, -0.002, 0.0005, -0.002, 0.015};
+  assert_string_equal(B->name, "b5");
+  for (int j = 0; j < 3; j++) assert_close(e.Kx[B->mslot[j]], 0.7, 0);
+  for (int j = 0; j < 9; j++) assert_close(e.Kx[B->mslot[3 + j]], J[j], 0);
+  const double *w = v + B->vadr + 3;
+  double Jw[3] = {J[0] * w[0] + J[1] * w[1] + J[2] * w[2], J[3] * w[0] + J[4] * w[1] + J[5] * w[2],
+                  J[6] * w[0] + J[7] * w[1] + J[8] * w[2]};
+  double s[3] = {-(w[1] * Jw[2] - w[2] * Jw[1]), -(w[2] * Jw[0] - w[0] * Jw[2]), -(w[0] * Jw[1] - w[1] * Jw[0])};
+  /* b5 carries no force element: its rhs is m g and the gyroscopic term */
+  const double g[3] = {0.3, -9.81, 0.2};
+  for (int j = 0; j < 3; j++) {
+    assert_close(e.rhs[B->vadr + j], 0.7 * g[j], 1e-14);
+    assert_close(e.rhs[B->vadr + 3 + j], s[j], 1e-13);
+  }
+  ev_free(&e);
+}
+
+/* the generated code and the generic table walk give the same numbers */
+static void test_generated_equals_generic(void **state) {
+  (void)state;
+  const mb_model *models[] = {&fd_all_model, &fd_springs_model, &spatial_joints_model, &slider_crank_model};
+  for (int k = 0; k < 4; k++) {
+    const mb_model *m = models[k];
+    mb_model g = generic_twin(m);
+    evaluator a, b;
+    ev_init(&a, m);
+    ev_init(&b, &g);
+    double *q = malloc(sizeof(double) * (size_t)m->nq), *v = malloc(sizeof(double) * (size_t)m->nv);
+    double worst = 0;
+    for (int trial = 0; trial < 5; trial++) {
+      random_state(m, q, v);
+      double t = urand(0, 1.5);
+      ev(&a, t, q, v);
+      ev(&b, t, q, v);
+      for (int i = 0; i < m->nnz; i++) worst = fmax(worst, fabs(a.Kx[i] - b.Kx[i]) / (1 + fabs(b.Kx[i])));
+      for (int i = 0; i < m->n; i++) worst = fmax(worst, fabs(a.rhs[i] - b.rhs[i]) / (1 + fabs(b.rhs[i])));
+      for (int i = 0; i < m->nc; i++) {
+        worst = fmax(worst, fabs(a.phi[i] - b.phi[i]));
+        worst = fmax(worst, fabs(a.nu[i] - b.nu[i]));
+      }
+    }
+    print_message("%s: generated vs generic, worst relative difference %.2e\n", m->name, worst);
+    assert_true(worst < 1e-13);
+    free(q); free(v);
+    ev_free(&a);
+    ev_free(&b);
+  }
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_constraints_all_joints),
+      cmocka_unit_test(test_constraints_shipped),
+      cmocka_unit_test(test_spring_forces),
+      cmocka_unit_test(test_mass_and_gyroscopic),
+      cmocka_unit_test(test_generated_equals_generic),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
