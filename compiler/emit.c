@@ -102,7 +102,10 @@ static void emit_tables(FILE *f, const lmodel *L) {
       vec(f, B->J, 9);
       fprintf(f, ", %d, %d, ", B->qadr, B->vadr);
       ivec(f, B->mslot, 12);
-      fputs("},\n", f);
+      if (B->kind == MB_BODY_FLEXIBLE)
+        fprintf(f, ", %d, &flex%d, flex%d_mslot},\n", B->nm, b, b);
+      else
+        fputs(", 0, 0, 0},\n", f);
     }
     fputs("};\n", f);
   }
@@ -110,7 +113,7 @@ static void emit_tables(FILE *f, const lmodel *L) {
     fprintf(f, "static const mb_markerdef markers[%d] = {\n", m->nmarker);
     for (int k = 0; k < m->nmarker; k++) {
       const mb_markerdef *d = &L->marker[k];
-      fprintf(f, "  /* %d: %s */\n  {%d, ", k, L->marker_desc[k], d->body);
+      fprintf(f, "  /* %d: %s */\n  {%d, %d, ", k, L->marker_desc[k], d->body, d->node);
       vec(f, d->s, 3);
       fputs(", ", f);
       vec(f, d->C, 9);
@@ -135,7 +138,7 @@ static void emit_tables(FILE *f, const lmodel *L) {
         if (s) fputs(", ", f);
         ivec(f, c, 6);
       }
-      fprintf(f, "}, %d, %d},\n", R->joint, R->driver);
+      fprintf(f, "}, {%d, %d}, %d, %d},\n", R->mslot[0], R->mslot[1], R->joint, R->driver);
     }
     fputs("};\n", f);
   }
@@ -188,8 +191,8 @@ static void emit_tables(FILE *f, const lmodel *L) {
       fprintf(f, ") */\n  {%d, %d, ", o->kind, o->body);
       vec(f, o->s, 3); fputs(", ", f); vec(f, o->axis, 3); fputs(", ", f); vec(f, o->u, 3);
       fputs(", ", f); vec(f, o->axis_g, 3); fputs(", ", f); vec(f, o->u_g, 3);
-      fprintf(f, ", %d, %d, %d, %d, %d, %d, ", o->component, o->joint, o->reaction_marker,
-              o->driver_row, o->driver_marker, o->driver_rotation);
+      fprintf(f, ", %d, %d, %d, %d, %d, %d, %d, {%d, %d}, ", o->component, o->joint, o->reaction_marker,
+              o->driver_row, o->driver_marker, o->driver_rotation, o->node, o->chord[0], o->chord[1]);
       num(f, o->scale);
       fprintf(f, ", %d, %d},\n", o->ncols, o->col);
     }

@@ -40,7 +40,60 @@ typedef struct {
 /* --- bodies ----------------------------------------------------------------- */
 typedef enum { BODY_GROUND, BODY_RIGID, BODY_VIRTUAL, BODY_FLEXIBLE } ir_body_kind;
 
-struct ir_flex; /* the FE / modal description of a flexible body (flexible-bodies issue) */
+/* --- flexible bodies: an FE beam model or a modal data file ------------------ */
+typedef enum { BEAM_EULER_BERNOULLI, BEAM_TIMOSHENKO } ir_beam_theory;
+typedef enum { MASS_LUMPED, MASS_CONSISTENT } ir_mass_kind;
+typedef enum { COUPLING_FULL, COUPLING_PARTIAL, COUPLING_CONSTANT, COUPLING_RIGID } ir_coupling;
+typedef enum { MODES_COUNT, MODES_MAX_FREQUENCY, MODES_LIST, MODES_ALL } ir_mode_select;
+typedef enum { DAMPING_NONE, DAMPING_RATIO, DAMPING_BANDS, DAMPING_LIST } ir_damping_kind;
+
+typedef struct {
+  int node[2];             /* node indices */
+  ir_beam_theory theory;
+  double E, G, rho;        /* material */
+  double A, Iy, Iz, J;     /* section: area, second moments about local y and z, torsion constant */
+  double shear_y, shear_z; /* Timoshenko shear area ratios (A_s = ratio * A); 0 for Euler-Bernoulli */
+  double yaxis[3];         /* unit local y of the section (perpendicular to the element), body axes */
+  ir_loc loc;
+} ir_beam;
+
+typedef struct {
+  int node;
+  double mass;
+  double inertia[9];       /* body axes, about the node */
+  ir_loc loc;
+} ir_point_mass;
+
+typedef struct ir_flex {
+  /* FE description (nmodal_file == NULL) */
+  int nnodes;
+  double *nodes;           /* 3 * nnodes: positions in body axes relative to the body frame origin */
+  ir_loc *node_loc;        /* where each node (or the generator) was given */
+  ir_beam *beams;
+  int nbeams;
+  ir_point_mass *point_masses;
+  int npoint_masses;
+  ir_mass_kind mass;       /* FE mass matrix: lumped (HRZ) or consistent */
+  int *reference;          /* nodes fixed to the body frame (reference conditions) */
+  int nreference;
+  int *interface;          /* Craig-Bampton interface nodes (none: constrained normal modes) */
+  int ninterface;
+  /* modal data file instead of FE (documented neutral format) */
+  char *modal_file;
+  /* mode selection */
+  ir_mode_select select;
+  int count;               /* MODES_COUNT */
+  double max_frequency;    /* MODES_MAX_FREQUENCY, Hz */
+  int *list;               /* MODES_LIST: 1-based mode numbers */
+  int nlist;
+  /* modal damping */
+  ir_damping_kind damping;
+  double ratio;            /* DAMPING_RATIO */
+  double *ratios;          /* DAMPING_LIST, one per selected mode */
+  int nratios;
+  ir_coupling coupling;
+  ir_loc loc;
+} ir_flex;
 
 typedef struct {
   char *name;
@@ -153,7 +206,8 @@ typedef enum {
   OUT_KINETIC_ENERGY,       /* system: 1 */
   OUT_POTENTIAL_ENERGY,     /* system, gravity and springs: 1 */
   OUT_TOTAL_ENERGY,         /* system: 1 */
-  OUT_DEFLECTION            /* flexible body node deflection (flexible-bodies issue) */
+  OUT_DEFLECTION,           /* flexible body: node deflection X_k w, body axes: 3 or 1 */
+  OUT_MODAL                 /* flexible body: modal coordinate 'mode' (1-based in the model) */
 } ir_output_kind;
 
 typedef struct {
@@ -164,6 +218,8 @@ typedef struct {
   int joint;         /* or -1 */
   int driver;        /* or -1 */
   int node;          /* or -1 */
+  int chord[2];      /* DEFLECTION: measured from the chord between these nodes, or -1 */
+  int mode;          /* MODAL: 0-based mode index */
   bool has_point;
   double point[3];   /* global point on the body at t = 0 */
   double axis[3];    /* OUT_ANGLE: unit axis */

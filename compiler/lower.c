@@ -90,6 +90,7 @@ static int add_marker(lmodel *L, int ib, const double P[3], const double Cg[9], 
   mb_markerdef *d = &L->marker[k];
   L->marker_desc[k] = desc;
   d->body = ib - 1;
+  d->node = -1;
   if (ib == 0) {
     memcpy(d->s, P, sizeof(double) * 3);
     memcpy(d->C, Cg, sizeof(double) * 9);
@@ -124,6 +125,7 @@ static void add_row(lmodel *L, int kind, int m0, int m1, int a, int b, const cha
   R->a = a;
   R->b = b;
   R->profile = -1;
+  R->mslot[0] = R->mslot[1] = -1;
   R->joint = joint;
   R->driver = driver;
   L->row_desc[r] = xstrdup_printf("%s '%s': %s", ekind, elem, what);
@@ -362,6 +364,8 @@ lmodel *lower_model(const ir_model *ir) {
     d->driver_row = -1;
     d->reaction_marker = -1;
     d->driver_marker = -1;
+    d->node = -1;
+    d->chord[0] = d->chord[1] = -1;
     d->ncols = output_columns(o);
     d->col = col;
     if (d->body >= 0) {

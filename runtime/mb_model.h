@@ -8,9 +8,9 @@
 #define MB_MODEL_H
 
 #include <stddef.h>
-#include "mb_kernels.h"
+#include "mb_flex.h"
 
-enum { MB_BODY_RIGID = 1, MB_BODY_VIRTUAL = 2 };
+enum { MB_BODY_RIGID = 1, MB_BODY_VIRTUAL = 2, MB_BODY_FLEXIBLE = 3 };
 
 typedef struct {
   const char *name;
@@ -19,10 +19,14 @@ typedef struct {
   mb_real J[9];      /* inertia about the centre of mass, body axes */
   int qadr, vadr;    /* first position / velocity coordinate */
   int mslot[12];     /* Kx slots of m (3 diagonal) and J (9, row-major); -1: none */
+  int nm;            /* flexible: modes (coordinates qadr+7.., vadr+6..) */
+  const mb_flex *flex;   /* flexible: invariants and node shapes; else NULL */
+  const int *mslotf;     /* flexible: Kx slots of the (6+nm)^2 mass block, row-major; -1: none */
 } mb_body;
 
 typedef struct {
   int body;          /* index into body[], or -1 for the ground */
+  int node;          /* flexible body: FE node the marker sits on, or -1 (body frame) */
   mb_real s[3];      /* point in body axes (ground: global) */
   mb_real C[9];      /* axes in body axes (ground: global), row-major, columns x y z */
 } mb_markerdef;
@@ -36,6 +40,8 @@ typedef struct {
   int slot[2][6];    /* Kx slot of D(row, body column) for marker 0/1's body; -1: none */
   int slotT[2][6];   /* Kx slot of the transposed entry D^T */
   unsigned char constant[2][6]; /* 1: the entry never changes (written by init only) */
+  int mslot[2];      /* flexible node markers: index into modal_slot of this row's modal
+                        columns (nm slots, then nm transposed slots); -1: none */
   int joint;         /* the source joint (reactions); -1 for a driver row */
   int driver;        /* the source driver (effort), or -1 */
 } mb_rowdef;
@@ -56,7 +62,8 @@ typedef struct {
 enum {
   MB_OUT_POSITION = 1, MB_OUT_ORIENTATION, MB_OUT_ANGLE, MB_OUT_VELOCITY, MB_OUT_ANGULAR_VELOCITY,
   MB_OUT_ACCELERATION, MB_OUT_ANGULAR_ACCELERATION, MB_OUT_REACTION, MB_OUT_EFFORT,
-  MB_OUT_KINETIC_ENERGY, MB_OUT_POTENTIAL_ENERGY, MB_OUT_TOTAL_ENERGY
+  MB_OUT_KINETIC_ENERGY, MB_OUT_POTENTIAL_ENERGY, MB_OUT_TOTAL_ENERGY, MB_OUT_DEFLECTION,
+  MB_OUT_MODAL
 };
 
 typedef struct {
@@ -73,6 +80,8 @@ typedef struct {
   int driver_row;    /* EFFORT: the driver's row, or -1 when redundant */
   int driver_marker; /* EFFORT: marker 0 of the driven joint (its z axis) */
   int driver_rotation; /* EFFORT: 1 rotation, 0 translation */
+  int node;          /* DEFLECTION: the node; deflection X_k w in body axes */
+  int chord[2];      /* DEFLECTION: minus the chord between these nodes' deflections, or -1 */
   mb_real scale;
   int ncols, col;    /* columns in the output vector and the first of them */
 } mb_outputdef;
@@ -99,6 +108,7 @@ typedef struct mb_model {
   const char *const *joint_name;
   mb_real gravity[3];
   const int *Kp, *Ki;          /* CSC pattern of K (both triangles), n+1 and nnz */
+  const int *modal_slot;       /* Kx slots of constraint rows' modal columns (see mb_rowdef) */
   const mb_real *q0, *v0;      /* assembled, consistent initial state */
   int ncols;                   /* output columns */
   const char *const *col_name; /* their names */

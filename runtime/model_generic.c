@@ -27,11 +27,28 @@ static void frames_and_markers(const mb_model *m, const mb_real *q, const mb_rea
     mb_frame_rigid(q + m->body[b].qadr, v + m->body[b].vadr, &F[b]);
   for (int k = 0; k < m->nmarker; k++) {
     const mb_markerdef *d = &m->marker[k];
-    if (d->body < 0)
+    if (d->body < 0) {
       mb_marker_ground(d->s, d->C, &MK[k]);
-    else
+    } else if (d->node >= 0) {
+      const mb_body *B = &m->body[d->body];
+      mb_marker_node(&F[d->body], B->flex, d->node, q + B->qadr + 7, v + B->vadr + 6, d->C, &MK[k]);
+    } else {
       mb_marker_rigid(&F[d->body], d->s, d->C, &MK[k]);
+    }
   }
+}
+
+/* the body columns of a force-like pair (dV, dW) at marker k: 6 or 6 + nm values */
+static int marker_cols(const mb_model *m, const mb_frame *F, const mb_marker *MK, int k,
+                       const mb_real *q, const mb_real dV[3], const mb_real dW[3], mb_real *c) {
+  const mb_markerdef *d = &m->marker[k];
+  const mb_body *B = &m->body[d->body];
+  if (d->node >= 0) {
+    mb_node_cols(&F[d->body], B->flex, d->node, q + B->qadr + 7, MK[k].P, dV, dW, c);
+    return 6 + B->nm;
+  }
+  mb_rigid_cols(&F[d->body], MK[k].P, dV, dW, c);
+  return 6;
 }
 
 /* one constraint row, dispatched on its primitive */
@@ -57,9 +74,20 @@ static void row_eval(const mb_model *m, const mb_rowdef *rd, const mb_marker *MK
   }
 }
 
-/* add a force F and torque T (global) acting at point P of body b into f */
-static void add_wrench(const mb_model *m, const mb_frame *F, int b, const mb_real P[3],
-                       const mb_real Fv[3], const mb_real T[3], mb_real *f) {
+/* add a force Fv at marker k's point and a torque T (global) into f */
+static void add_wrench(const mb_model *m, const mb_frame *F, const mb_marker *MK, int k,
+                       const mb_real *q, const mb_real Fv[3], const mb_real T[3], mb_real *f) {
+  int b = m->marker[k].body;
+  if (b < 0) return;
+  mb_real c[6 + MB_MAX_MODES];
+  int nc = marker_cols(m, F, MK, k, q, Fv, T, c);
+  for (int j = 0; j < nc; j++) f[m->body[b].vadr + j] += c[j];
+}
+
+/* the bushing's reaction on body 0 acts at marker 1's point: the same
+   pair of forces at one point (angular momentum is conserved) */
+static void add_wrench_at(const mb_model *m, const mb_frame *F, int b, const mb_real P[3],
+                          const mb_real Fv[3], const mb_real T[3], mb_real *f) {
   if (b < 0) return;
   mb_real c[6];
   mb_rigid_cols(&F[b], P, Fv, T, c);
@@ -67,8 +95,8 @@ static void add_wrench(const mb_model *m, const mb_frame *F, int b, const mb_rea
 }
 
 /* applied forces of the force elements, added into f; returns their potential energy */
-static mb_real forces_eval(const mb_model *m, mb_real t, const mb_frame *F, const mb_marker *MK,
-                           mb_real *f) {
+static mb_real forces_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_frame *F,
+                           const mb_marker *MK, mb_real *f) {
   static const mb_real zero[3] = {0, 0, 0};
   mb_real E = 0;
   for (int e = 0; e < m->nforce; e++) {
@@ -83,17 +111,17 @@ static mb_real forces_eval(const mb_model *m, mb_real t, const mb_frame *F, cons
       for (int j = 0; j < 3; j++) val[j] = s * d->vec[j];
       if (d->body_frame && b0 >= 0) mb_mul3(F[b0].A, val, val);
       if (d->kind == MB_FORCE_POINT)
-        add_wrench(m, F, b0, m0->P, val, zero, f);
+        add_wrench(m, F, MK, d->m0, q, val, zero, f);
       else
-        add_wrench(m, F, b0, m0->P, zero, val, f);
+        add_wrench(m, F, MK, d->m0, q, zero, val, f);
       break;
     }
     case MB_FORCE_SPRING: {
       mb_real F0[3], F1[3];
       const mb_marker *m1 = &MK[d->m1];
       E += mb_force_spring(m0, m1, &d->stiffness, &d->damping, d->L0, d->preload, F0, F1);
-      add_wrench(m, F, b0, m0->P, F0, zero, f);
-      add_wrench(m, F, m->marker[d->m1].body, m1->P, F1, zero, f);
+      add_wrench(m, F, MK, d->m0, q, F0, zero, f);
+      add_wrench(m, F, MK, d->m1, q, F1, zero, f);
       break;
     }
     case MB_FORCE_BUSHING: {
@@ -101,8 +129,8 @@ static mb_real forces_eval(const mb_model *m, mb_real t, const mb_frame *F, cons
       const mb_marker *m1 = &MK[d->m1];
       E += mb_force_bushing(m0, m1, d->k6, d->c6, d->pre6, Fv, T);
       for (int j = 0; j < 3; j++) { mF[j] = -Fv[j]; mT[j] = -T[j]; }
-      add_wrench(m, F, m->marker[d->m1].body, m1->P, Fv, T, f);
-      add_wrench(m, F, b0, m1->P, mF, mT, f); /* reaction at the same point */
+      add_wrench(m, F, MK, d->m1, q, Fv, T, f);
+      add_wrench_at(m, F, b0, m1->P, mF, mT, f); /* reaction at the same point */
       break;
     }
     default:
@@ -116,6 +144,7 @@ void mb_generic_init(const mb_model *m, mb_real *Kx) {
   for (int k = 0; k < m->nnz; k++) Kx[k] = 0;
   for (int b = 0; b < m->nbody; b++) {
     const mb_body *B = &m->body[b];
+    if (B->kind == MB_BODY_FLEXIBLE) continue; /* written by every evaluation */
     for (int j = 0; j < 3; j++)
       if (B->mslot[j] >= 0) Kx[B->mslot[j]] = B->mass;
     for (int j = 0; j < 9; j++)
@@ -144,11 +173,19 @@ void mb_generic_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_re
   for (int b = 0; b < m->nbody; b++) {
     const mb_body *B = &m->body[b];
     mb_real *f = rhs + B->vadr, s[3];
+    if (B->kind == MB_BODY_FLEXIBLE) {
+      mb_real Mb[(6 + MB_MAX_MODES) * (6 + MB_MAX_MODES)];
+      int nb = 6 + B->nm;
+      mb_flex_body(B->flex, &F[b], q + B->qadr + 7, v + B->vadr + 6, m->gravity, Mb, f);
+      for (int i = 0; i < nb * nb; i++)
+        if (B->mslotf[i] >= 0) Kx[B->mslotf[i]] = Mb[i];
+      continue;
+    }
     for (int j = 0; j < 3; j++) f[j] = B->mass * m->gravity[j];
     mb_rigid_gyro(B->J, F[b].wl, s);
     for (int j = 0; j < 3; j++) f[3 + j] = s[j];
   }
-  forces_eval(m, t, F, MK, rhs);
+  forces_eval(m, t, q, F, MK, rhs);
 
   /* constraint rows: D (both triangles of K), gamma, phi, nu */
   for (int r = 0; r < m->nrow; r++) {
@@ -159,15 +196,21 @@ void mb_generic_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_re
     nu[r] = row.nu;
     rhs[m->nv + r] = mb_row_gamma(&row, &MK[rd->m0], &MK[rd->m1]);
     for (int s = 0; s < 2; s++) {
-      const mb_markerdef *md = &m->marker[s ? rd->m1 : rd->m0];
-      if (md->body < 0) continue;
-      mb_real c[6];
-      mb_rigid_cols(&F[md->body], MK[s ? rd->m1 : rd->m0].P, row.dV[s], row.dW[s], c);
+      int k = s ? rd->m1 : rd->m0;
+      if (m->marker[k].body < 0) continue;
+      mb_real c[6 + MB_MAX_MODES];
+      int nc = marker_cols(m, F, MK, k, q, row.dV[s], row.dW[s], c);
       for (int j = 0; j < 6; j++)
         if (rd->slot[s][j] >= 0 && !rd->constant[s][j]) {
           Kx[rd->slot[s][j]] = c[j];
           Kx[rd->slotT[s][j]] = c[j];
         }
+      if (rd->mslot[s] >= 0) {
+        const int *ms = m->modal_slot + rd->mslot[s];
+        int nm = nc - 6;
+        for (int j = 0; j < nm; j++)
+          if (ms[j] >= 0) Kx[ms[j]] = Kx[ms[nm + j]] = c[6 + j];
+      }
     }
   }
 }
@@ -177,6 +220,7 @@ void mb_model_qdot(const mb_model *m, const mb_real *q, const mb_real *v, mb_rea
     const mb_body *B = &m->body[b];
     for (int j = 0; j < 3; j++) qd[B->qadr + j] = v[B->vadr + j];
     mb_euler_rates(q + B->qadr + 3, v + B->vadr + 3, qd + B->qadr + 3);
+    for (int j = 0; j < B->nm; j++) qd[B->qadr + 7 + j] = v[B->vadr + 6 + j];
   }
 }
 
@@ -185,6 +229,7 @@ void mb_model_qincrement(const mb_model *m, mb_real *q, const mb_real *dv) {
     const mb_body *B = &m->body[b];
     for (int j = 0; j < 3; j++) q[B->qadr + j] += dv[B->vadr + j];
     mb_euler_rotate(q + B->qadr + 3, dv + B->vadr + 3);
+    for (int j = 0; j < B->nm; j++) q[B->qadr + 7 + j] += dv[B->vadr + 6 + j];
   }
 }
 
@@ -204,6 +249,19 @@ void mb_model_energy(const mb_model *m, mb_real t, const mb_real *q, const mb_re
   mb_real T = 0, U = 0;
   for (int b = 0; b < m->nbody; b++) {
     const mb_body *B = &m->body[b];
+    if (B->kind == MB_BODY_FLEXIBLE) {
+      const mb_flex *fx = B->flex;
+      const mb_real *w = q + B->qadr + 7;
+      mb_real Mb[(6 + MB_MAX_MODES) * (6 + MB_MAX_MODES)], fb[6 + MB_MAX_MODES], S[3], AS[3];
+      T += mb_flex_kinetic(fx, &F[b], w, v + B->vadr + 6, Mb, fb);
+      /* gravity: -g . (m r + A S(w));  elastic: 1/2 sum k_j w_j^2 */
+      mb_modal3(fx->S1, fx->nm, w, S);
+      for (int i = 0; i < 3; i++) S[i] += fx->S0[i];
+      mb_mul3(F[b].A, S, AS);
+      U -= mb_dot3(m->gravity, AS) + fx->mass * mb_dot3(m->gravity, F[b].r);
+      for (int j = 0; j < fx->nm; j++) U += 0.5 * fx->stiffness[j] * w[j] * w[j];
+      continue;
+    }
     T += mb_rigid_kinetic(B->mass, B->J, &F[b]);
     U -= B->mass * mb_dot3(m->gravity, F[b].r);
   }
@@ -319,6 +377,35 @@ void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_r
         val[0] = -lambda[o->driver_row] * mb_dot3(o->driver_rotation ? row.dW[1] : row.dV[1], z);
       }
       break;
+    case MB_OUT_DEFLECTION: {
+      /* node deflection X_k w in body axes, less the chord between two nodes */
+      const mb_body *B = &m->body[o->body];
+      const mb_flex *fx = B->flex;
+      const mb_real *w = q + B->qadr + 7;
+      mb_modal3(fx->node_X + 3 * o->node * fx->nm, fx->nm, w, val);
+      if (o->chord[0] >= 0) {
+        mb_real d0[3], d1[3], x0[3], x1[3], xk[3];
+        mb_modal3(fx->node_X + 3 * o->chord[0] * fx->nm, fx->nm, w, d0);
+        mb_modal3(fx->node_X + 3 * o->chord[1] * fx->nm, fx->nm, w, d1);
+        for (int j = 0; j < 3; j++) {
+          x0[j] = fx->node_x[3 * o->chord[0] + j];
+          x1[j] = fx->node_x[3 * o->chord[1] + j];
+          xk[j] = fx->node_x[3 * o->node + j];
+        }
+        /* the chord point at the node's position along the undeformed chord */
+        mb_real e[3] = {x1[0] - x0[0], x1[1] - x0[1], x1[2] - x0[2]}, r[3];
+        for (int j = 0; j < 3; j++) r[j] = xk[j] - x0[j];
+        mb_real s = mb_dot3(r, e) / mb_dot3(e, e);
+        for (int j = 0; j < 3; j++) val[j] -= (1 - s) * d0[j] + s * d1[j];
+      }
+      break;
+    }
+    case MB_OUT_MODAL: {
+      const mb_body *B = &m->body[o->body];
+      nval = 1;
+      val[0] = q[B->qadr + 7 + o->node];
+      break;
+    }
     case MB_OUT_KINETIC_ENERGY: val[0] = kin; nval = 1; break;
     case MB_OUT_POTENTIAL_ENERGY: val[0] = pot; nval = 1; break;
     case MB_OUT_TOTAL_ENERGY: val[0] = kin + pot; nval = 1; break;

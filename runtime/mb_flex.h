@@ -1,0 +1,262 @@
+/* mb_flex.h: kernels of a flexible (modal) body, shared by the generated code
+ * and the generic path.  A flexible body has the rigid body's coordinates
+ * (r, p; rd, w') plus nm modal coordinates w (velocities wd).  Node k sits at
+ * b_k = x_k + X_k w in body axes and rotates by theta_k = Psi_k w (exact
+ * rotation exp(theta~)).  The mass matrix and the quadratic-velocity forces
+ * come from inertia invariants computed at compile time (docs/formulation.md):
+ *   S(w) = S0 + S1 w,  J(w) = J0 + sum_j w_j J1_j + sum_ij w_i w_j J2_ij,
+ *   J1_j = 2 tr(E_j) I - E_j - E_j^T,  J2_ij = tr(F_ij) I - (F_ij + F_ij^T)/2,
+ *   M_thf = C0 + sum_i w_i G_i.,  with E_j = sum_k m_k X_kj x_k^T,
+ *   F_ij = sum_k m_k X_ki X_kj^T, G_ij = sum_k m_k X_ki x X_kj,
+ *   C0 = sum_k (m_k x_k~ X_k + J_k Psi_k), CPsi = sum_k J_k Psi_k. */
+#ifndef MB_FLEX_H
+#define MB_FLEX_H
+
+#include "mb_kernels.h"
+
+#define MB_MAX_MODES 64
+
+enum { MB_COUPLING_FULL = 0, MB_COUPLING_PARTIAL = 1, MB_COUPLING_CONSTANT = 2 };
+
+typedef struct {
+  int nm;              /* modes */
+  int coupling;        /* MB_COUPLING_* */
+  mb_real mass;
+  mb_real S0[3];
+  const mb_real *S1;   /* 3 x nm, column j at S1 + 3 j */
+  mb_real J0[9];
+  const mb_real *E;    /* nm matrices 3x3 (row-major), E_j at E + 9 j */
+  const mb_real *F;    /* nm x nm matrices 3x3, F_ij at F + 9 (i nm + j) */
+  const mb_real *G;    /* nm x nm vectors, G_ij at G + 3 (i nm + j) */
+  const mb_real *C0;   /* 3 x nm, column j at C0 + 3 j */
+  const mb_real *CPsi; /* 3 x nm */
+  const mb_real *Mff;  /* nm x nm, row-major */
+  const mb_real *stiffness; /* nm: omega_j^2 */
+  const mb_real *damping;   /* nm: 2 zeta_j omega_j */
+  int nnode;
+  const mb_real *node_x;    /* 3 per node */
+  const mb_real *node_X;    /* per node 3 x nm (column j at node_X + 3 (k nm + j)) */
+  const mb_real *node_Psi;  /* per node 3 x nm, likewise */
+} mb_flex;
+
+/* left Jacobian of SO(3) at theta and its time derivative along thetad:
+ * d/dt exp(theta~) = (Jl thetad)~ exp(theta~) */
+static inline void mb_so3_jl(const mb_real th[3], const mb_real thd[3], mb_real Jl[9],
+                             mb_real Jld[9]) {
+  mb_real p2 = mb_dot3(th, th), p = sqrt(p2), a, b, a1, b1;
+  if (p < 1e-2) { /* series: no cancellation near zero */
+    a = 0.5 - p2 / 24 + p2 * p2 / 720;
+    b = 1.0 / 6 - p2 / 120 + p2 * p2 / 5040;
+    a1 = -1.0 / 12 + p2 / 180;
+    b1 = -1.0 / 60 + p2 / 1260;
+  } else {
+    mb_real s = sin(p), c = cos(p);
+    a = (1 - c) / p2;
+    b = (p - s) / (p2 * p);
+    a1 = (p * s - 2 + 2 * c) / (p2 * p2);
+    b1 = ((1 - c) * p - 3 * (p - s)) / (p2 * p2 * p);
+  }
+  mb_real T[9] = {0, -th[2], th[1], th[2], 0, -th[0], -th[1], th[0], 0};
+  mb_real Td[9] = {0, -thd[2], thd[1], thd[2], 0, -thd[0], -thd[1], thd[0], 0};
+  mb_real T2[9], TdT[9], TTd[9];
+  mb_matmul3(T, T, T2);
+  mb_matmul3(Td, T, TdT);
+  mb_matmul3(T, Td, TTd);
+  mb_real tt = mb_dot3(th, thd); /* phi phid */
+  for (int i = 0; i < 9; i++) {
+    Jl[i] = (i % 4 == 0) + a * T[i] + b * T2[i];
+    Jld[i] = a1 * tt * T[i] + a * Td[i] + b1 * tt * T2[i] + b * (TdT[i] + TTd[i]);
+  }
+}
+
+/* exp(theta~) by Rodrigues' formula */
+static inline void mb_so3_exp(const mb_real th[3], mb_real E[9]) {
+  mb_real p2 = mb_dot3(th, th), p = sqrt(p2), s1, c1;
+  if (p < 1e-4) { s1 = 1 - p2 / 6; c1 = 0.5 - p2 / 24; }
+  else { s1 = sin(p) / p; c1 = (1 - cos(p)) / p2; }
+  mb_real T[9] = {0, -th[2], th[1], th[2], 0, -th[0], -th[1], th[0], 0}, T2[9];
+  mb_matmul3(T, T, T2);
+  for (int i = 0; i < 9; i++) E[i] = (i % 4 == 0) + s1 * T[i] + c1 * T2[i];
+}
+
+/* y = X w for a 3 x nm block stored by columns */
+static inline void mb_modal3(const mb_real *X, int nm, const mb_real *w, mb_real y[3]) {
+  y[0] = y[1] = y[2] = 0;
+  for (int j = 0; j < nm; j++)
+    for (int i = 0; i < 3; i++) y[i] += X[3 * j + i] * w[j];
+}
+
+/* marker on node k of a flexible body (frame f, modal w, wd), axes C in body axes */
+static inline void mb_marker_node(const mb_frame *f, const mb_flex *fx, int k, const mb_real *w,
+                                  const mb_real *wd, const mb_real C[9], mb_marker *m) {
+  int nm = fx->nm;
+  const mb_real *X = fx->node_X + 3 * k * nm, *Psi = fx->node_Psi + 3 * k * nm;
+  mb_real b[3], th[3], thd[3], Xwd[3], Jl[9], Jld[9], Ex[9], AE[9], u[3], t1[3], t2[3], g[3];
+  mb_modal3(X, nm, w, b);
+  for (int i = 0; i < 3; i++) b[i] += fx->node_x[3 * k + i];
+  mb_modal3(Psi, nm, w, th);
+  mb_modal3(Psi, nm, wd, thd);
+  mb_modal3(X, nm, wd, Xwd);
+  mb_so3_jl(th, thd, Jl, Jld);
+  mb_so3_exp(th, Ex);
+  mb_matmul3(f->A, Ex, AE);
+  mb_matmul3(AE, C, m->R);
+  mb_mul3(f->A, b, u);
+  /* V = rd + A (w' x b + X wd) */
+  mb_cross3(f->wl, b, t1);
+  for (int i = 0; i < 3; i++) t1[i] += Xwd[i];
+  mb_mul3(f->A, t1, t2);
+  for (int i = 0; i < 3; i++) { m->P[i] = f->r[i] + u[i]; m->V[i] = f->rd[i] + t2[i]; }
+  /* aP = A (w' x (w' x b) + 2 w' x X wd) */
+  mb_wwa(f->wl, b, t1);
+  mb_cross3(f->wl, Xwd, t2);
+  for (int i = 0; i < 3; i++) t1[i] += 2 * t2[i];
+  mb_mul3(f->A, t1, m->aP);
+  /* W = A (w' + Jl thd),  aW = A (w' x Jl thd + Jld thd) */
+  mb_mul3(Jl, thd, g);
+  for (int i = 0; i < 3; i++) t1[i] = f->wl[i] + g[i];
+  mb_mul3(f->A, t1, m->W);
+  mb_cross3(f->wl, g, t1);
+  mb_mul3(Jld, thd, t2);
+  for (int i = 0; i < 3; i++) t1[i] += t2[i];
+  mb_mul3(f->A, t1, m->aW);
+}
+
+/* Map (dV, dW) at a node marker to the body's 6 + nm velocity coordinates:
+ * [dV; A^T(u x dV + dW); X^T A^T dV + (Jl Psi)^T A^T dW], u = P - r. */
+static inline void mb_node_cols(const mb_frame *f, const mb_flex *fx, int k, const mb_real *w,
+                                const mb_real P[3], const mb_real dV[3], const mb_real dW[3],
+                                mb_real *c) {
+  int nm = fx->nm;
+  const mb_real *X = fx->node_X + 3 * k * nm, *Psi = fx->node_Psi + 3 * k * nm;
+  mb_real th[3], zero[3] = {0, 0, 0}, Jl[9], Jld[9], lV[3], lW[3], JtW[3];
+  mb_rigid_cols(f, P, dV, dW, c);
+  mb_modal3(Psi, nm, w, th);
+  mb_so3_jl(th, zero, Jl, Jld);
+  mb_mul3t(f->A, dV, lV);
+  mb_mul3t(f->A, dW, lW);
+  mb_mul3t(Jl, lW, JtW);
+  for (int j = 0; j < nm; j++) c[6 + j] = mb_dot3(X + 3 * j, lV) + mb_dot3(Psi + 3 * j, JtW);
+}
+
+/* The flexible body's mass matrix Mb ((6+nm)^2, row-major, coordinates
+ * [rd; w'; wd]) and its forces fb (6+nm): gravity g (global), quadratic-velocity
+ * terms, modal stiffness and damping.  Returns nothing; see the header comment. */
+static inline void mb_flex_body(const mb_flex *fx, const mb_frame *f, const mb_real *w,
+                                const mb_real *wd, const mb_real g[3], mb_real *Mb,
+                                mb_real *fb) {
+  int nm = fx->nm, n = 6 + nm;
+  int lin = fx->coupling != MB_COUPLING_CONSTANT, quad = fx->coupling == MB_COUPLING_FULL;
+  const mb_real *wl = f->wl;
+  mb_real S[3], J[9], B[9], h = 0, H[9] = {0}, t[3], t2[3], Ag[3];
+  /* S(w), J(w) */
+  for (int i = 0; i < 3; i++) S[i] = fx->S0[i];
+  for (int i = 0; i < 9; i++) J[i] = fx->J0[i];
+  if (lin) {
+    for (int j = 0; j < nm; j++) {
+      const mb_real *E = fx->E + 9 * j;
+      mb_real tr = E[0] + E[4] + E[8];
+      for (int i = 0; i < 3; i++) S[i] += fx->S1[3 * j + i] * w[j];
+      for (int i = 0; i < 3; i++)
+        for (int l = 0; l < 3; l++)
+          J[3 * i + l] += w[j] * (2 * tr * (i == l) - E[3 * i + l] - E[3 * l + i]);
+    }
+  }
+  if (quad) {
+    for (int a = 0; a < nm; a++)
+      for (int b = 0; b < nm; b++) {
+        const mb_real *F = fx->F + 9 * (a * nm + b);
+        mb_real ww = w[a] * w[b], tr = F[0] + F[4] + F[8];
+        for (int i = 0; i < 3; i++)
+          for (int l = 0; l < 3; l++)
+            J[3 * i + l] += ww * (tr * (i == l) - 0.5 * (F[3 * i + l] + F[3 * l + i]));
+      }
+  }
+  for (int i = 0; i < n * n; i++) Mb[i] = 0;
+  /* M_rr = m I, M_rth = -A S~, M_rf = A S1 */
+  mb_real AS[9], Sx[9] = {0, -S[2], S[1], S[2], 0, -S[0], -S[1], S[0], 0};
+  mb_matmul3(f->A, Sx, AS);
+  for (int i = 0; i < 3; i++) {
+    Mb[n * i + i] = fx->mass;
+    for (int l = 0; l < 3; l++) {
+      Mb[n * i + 3 + l] = -AS[3 * i + l];
+      Mb[n * (3 + l) + i] = -AS[3 * i + l];
+      Mb[n * (3 + i) + 3 + l] = J[3 * i + l];
+    }
+  }
+  for (int j = 0; j < nm; j++) {
+    mb_real col[3], thf[3];
+    mb_mul3(f->A, fx->S1 + 3 * j, col);
+    for (int i = 0; i < 3; i++) thf[i] = fx->C0[3 * j + i];
+    if (lin)
+      for (int a = 0; a < nm; a++)
+        for (int i = 0; i < 3; i++) thf[i] += w[a] * fx->G[3 * (a * nm + j) + i];
+    for (int i = 0; i < 3; i++) {
+      Mb[n * i + 6 + j] = Mb[n * (6 + j) + i] = col[i];
+      Mb[n * (3 + i) + 6 + j] = Mb[n * (6 + j) + 3 + i] = thf[i];
+    }
+    for (int l = 0; l < nm; l++) Mb[n * (6 + j) + 6 + l] = fx->Mff[nm * j + l];
+  }
+
+  /* forces: rigid-frame part */
+  mb_real S1wd[3], wS[3];
+  mb_modal3(fx->S1, nm, wd, S1wd);
+  mb_wwa(wl, S, t);
+  mb_cross3(wl, S1wd, t2);
+  for (int i = 0; i < 3; i++) t[i] += 2 * t2[i];
+  mb_mul3(f->A, t, t2);
+  mb_mul3t(f->A, g, Ag);
+  for (int i = 0; i < 3; i++) fb[i] = fx->mass * g[i] - t2[i];
+  /* h = sum_k m_k (X_k^T b_k) . wd and H = sum_k m_k (X_k wd) b_k^T */
+  for (int j = 0; j < nm; j++) {
+    const mb_real *E = fx->E + 9 * j;
+    mb_real hj = E[0] + E[4] + E[8];
+    for (int i = 0; i < 9; i++) H[i] += wd[j] * E[i];
+    if (lin)
+      for (int a = 0; a < nm; a++) {
+        const mb_real *F = fx->F + 9 * (j * nm + a);
+        hj += w[a] * (F[0] + F[4] + F[8]);
+        for (int i = 0; i < 9; i++) H[i] += wd[j] * w[a] * F[i];
+      }
+    h += hj * wd[j];
+  }
+  /* s_th = -w' x (J w') - 2 (w' h - H w') - w' x (CPsi wd) + S x (A^T g) */
+  mb_real Jw[3], Hw[3], Cw[3];
+  mb_mul3(J, wl, Jw);
+  mb_mul3(H, wl, Hw);
+  mb_modal3(fx->CPsi, nm, wd, Cw);
+  for (int i = 0; i < 3; i++) Jw[i] += Cw[i];
+  mb_cross3(wl, Jw, t);
+  mb_cross3(S, Ag, wS);
+  for (int i = 0; i < 3; i++) fb[3 + i] = -t[i] - 2 * (wl[i] * h - Hw[i]) + wS[i];
+  /* s_f(j) = -(w'^T B_j w' - |w'|^2 tr B_j) - 2 sum_i wd_i w'.G_ij + S1_j . A^T g - k w - c wd,
+     B_j = E_j + sum_a w_a F_ja */
+  mb_real ww = mb_dot3(wl, wl);
+  for (int j = 0; j < nm; j++) {
+    for (int i = 0; i < 9; i++) B[i] = fx->E[9 * j + i];
+    if (lin)
+      for (int a = 0; a < nm; a++)
+        for (int i = 0; i < 9; i++) B[i] += w[a] * fx->F[9 * (j * nm + a) + i];
+    mb_real Bw[3], gsum = 0;
+    mb_mul3(B, wl, Bw);
+    for (int a = 0; a < nm; a++) gsum += wd[a] * mb_dot3(wl, fx->G + 3 * (a * nm + j));
+    fb[6 + j] = -(mb_dot3(wl, Bw) - ww * (B[0] + B[4] + B[8])) - 2 * gsum +
+                mb_dot3(fx->S1 + 3 * j, Ag) - fx->stiffness[j] * w[j] - fx->damping[j] * wd[j];
+  }
+}
+
+/* kinetic energy 1/2 v^T M v of a flexible body, elastic energy 1/2 w^T K w */
+static inline mb_real mb_flex_kinetic(const mb_flex *fx, const mb_frame *f, const mb_real *w,
+                                      const mb_real *wd, mb_real *Mb, mb_real *fb) {
+  static const mb_real zero[3] = {0, 0, 0};
+  int n = 6 + fx->nm;
+  mb_real T = 0, v[6 + MB_MAX_MODES];
+  mb_flex_body(fx, f, w, wd, zero, Mb, fb);
+  for (int i = 0; i < 3; i++) { v[i] = f->rd[i]; v[3 + i] = f->wl[i]; }
+  for (int j = 0; j < fx->nm; j++) v[6 + j] = wd[j];
+  for (int i = 0; i < n; i++)
+    for (int l = 0; l < n; l++) T += 0.5 * v[i] * Mb[n * i + l] * v[l];
+  return T;
+}
+
+#endif

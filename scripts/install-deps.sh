@@ -1,0 +1,84 @@
+#!/usr/bin/env bash
+# install-deps.sh: installs the Debian 12 packages that building, testing and
+# plotting need; idempotent.  Every requirement is probed first (dpkg -s, or
+# the header, library or program itself); when all are present, apt is not
+# touched, so this works offline on a prepared machine.  Otherwise it runs
+# apt-get update and apt-get install -y --no-install-recommends on the missing
+# packages, through sudo when not root.
+#   MBCC_DEPS_FORCE=1  run apt even when everything is present
+set -euo pipefail
+
+# can the C compiler link against library $1?
+links() {
+  command -v cc >/dev/null 2>&1 || return 1
+  local out
+  out=$(mktemp)
+  if echo 'int main(void) { return 0; }' | cc -x c - "-l$1" -o "$out" >/dev/null 2>&1; then
+    rm -f "$out"; return 0
+  fi
+  rm -f "$out"; return 1
+}
+
+# the requirement that package $1 provides is met
+present() {
+  if dpkg -s "$1" >/dev/null 2>&1; then
+    # installed; for gnuplot, also the PNG terminal the plots use
+    [ "$1" != gnuplot-nox ] || gnuplot -e 'set terminal pngcairo' >/dev/null 2>&1
+    return
+  fi
+  case $1 in
+    build-essential)    command -v cc && command -v make && [ -e /usr/include/stdio.h ] ;;
+    libyaml-dev)        [ -e /usr/include/yaml.h ] && links yaml ;;
+    libsuitesparse-dev) [ -e /usr/include/suitesparse/klu.h ] && links klu ;;
+    liblapack-dev)      links lapack ;;
+    libblas-dev)        links blas ;;
+    libcmocka-dev)      [ -e /usr/include/cmocka.h ] && links cmocka ;;
+    gnuplot-nox)        gnuplot -e 'set terminal pngcairo' ;;
+    clang)              command -v clang ;;
+    *)                  false ;;
+  esac >/dev/null 2>&1
+}
+
+# gnuplot-nox has the pngcairo terminal on Debian 12 (checked: 5.4.4)
+packages=(build-essential libyaml-dev libsuitesparse-dev liblapack-dev libblas-dev
+          libcmocka-dev gnuplot-nox clang)
+missing=()
+for p in "${packages[@]}"; do
+  present "$p" || missing+=("$p")
+done
+
+if [ ${#missing[@]} -eq 0 ] && [ "${MBCC_DEPS_FORCE:-0}" != 1 ]; then
+  echo "install-deps: all dependencies present"
+  exit 0
+fi
+[ ${#missing[@]} -eq 0 ] && missing=("${packages[@]}")
+
+if ! command -v apt-get >/dev/null 2>&1; then
+  echo "install-deps: error: missing ${missing[*]}, and apt-get is not available" \
+       "(this script is for Debian 12; install the equivalents by hand)" >&2
+  exit 1
+fi
+sudo=()
+if [ "$(id -u)" != 0 ]; then
+  if ! command -v sudo >/dev/null 2>&1; then
+    echo "install-deps: error: missing ${missing[*]}; run this script as root or install sudo" >&2
+    exit 1
+  fi
+  sudo=(sudo)
+fi
+
+echo "install-deps: installing ${missing[*]}"
+"${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update
+"${sudo[@]}" env DEBIAN_FRONTEND=noninteractive \
+  apt-get install -y --no-install-recommends "${missing[@]}"
+
+# check that what was installed does what we need
+failed=()
+for p in "${packages[@]}"; do
+  present "$p" || failed+=("$p")
+done
+if [ ${#failed[@]} -ne 0 ]; then
+  echo "install-deps: error: still missing after apt-get: ${failed[*]}" >&2
+  exit 1
+fi
+echo "install-deps: all dependencies present"
