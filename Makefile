@@ -9,7 +9,7 @@ LIBS    := -lyaml -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig -llapack -lblas
 RT_SRC  := runtime/model_generic.c runtime/solver_klu.c runtime/solver_dense.c \
            runtime/integrate.c runtime/driver.c
 RT_HDR  := $(wildcard runtime/*.h)
-CC_SRC  := compiler/main.c compiler/reader.c compiler/diag.c compiler/lower.c \
+CC_SRC  := compiler/main.c compiler/reader.c compiler/diag.c compiler/lower.c compiler/fe.c compiler/flex.c \
            compiler/assemble.c compiler/emit.c
 CC_HDR  := $(wildcard compiler/*.h)
 B       ?= build

@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "diag.h"
+#include "flex.h"
 #include "lower.h"
 
 /* out = a/b; nonzero if it does not fit */
@@ -67,10 +68,15 @@ static void loc_comment(FILE *f, const lmodel *L, ir_loc loc) {
   fprintf(f, "%s:%d:%d", L->ir->path, loc.line, loc.col);
 }
 
+static void emit_flex_tables(FILE *f, const lmodel *L, int b);
+
 /* the tables: bodies, markers, rows, forces, profiles, outputs */
 static void emit_tables(FILE *f, const lmodel *L) {
   const mb_model *m = &L->m;
   fprintf(f, "/* --- element tables (also used for outputs and energy) --- */\n");
+  for (int b = 0; b < m->nbody; b++)
+    if (L->body[b].kind == MB_BODY_FLEXIBLE) emit_flex_tables(f, L, b);
+  if (L->nmodal_slot) int_array(f, "modal_slot", L->modal_slot, L->nmodal_slot);
   for (int k = 0; k < m->nprofile; k++) {
     const mb_profile *p = &L->profile[k];
     if (p->kind != MB_PROFILE_TABLE) continue;
@@ -96,7 +102,9 @@ static void emit_tables(FILE *f, const lmodel *L) {
       const mb_body *B = &L->body[b];
       fprintf(f, "  /* body '%s' (", B->name);
       loc_comment(f, L, L->ir->bodies[b + 1].loc);
-      fprintf(f, ") */\n  {\"%s\", %s, ", B->name, B->kind == MB_BODY_VIRTUAL ? "MB_BODY_VIRTUAL" : "MB_BODY_RIGID");
+      fprintf(f, ") */\n  {\"%s\", %s, ", B->name, B->kind == MB_BODY_VIRTUAL    ? "MB_BODY_VIRTUAL"
+                                          : B->kind == MB_BODY_FLEXIBLE ? "MB_BODY_FLEXIBLE"
+                                                                        : "MB_BODY_RIGID");
       num(f, B->mass);
       fputs(", ", f);
       vec(f, B->J, 9);
@@ -210,9 +218,63 @@ static void emit_tables(FILE *f, const lmodel *L) {
   }
 }
 
-/* rhs[va..va+5] += c */
-static void add_cols(FILE *f, int vadr) {
-  for (int j = 0; j < 6; j++) fprintf(f, "    rhs[%d] += c[%d];\n", vadr + j, j);
+/* c = the body columns of (dV, dW) at marker k; returns how many (6 or 6 + nm) */
+static int emit_cols(FILE *f, const lmodel *L, int k, const char *P, const char *dV, const char *dW,
+                     const char *indent) {
+  const mb_markerdef *d = &L->marker[k];
+  const mb_body *B = &L->body[d->body];
+  if (d->node >= 0) {
+    fprintf(f, "%smb_node_cols(&f[%d], &flex%d, %d, q + %d, %s, %s, %s, c);\n", indent, d->body,
+            d->body, d->node, B->qadr + 7, P, dV, dW);
+    return 6 + B->nm;
+  }
+  fprintf(f, "%smb_rigid_cols(&f[%d], %s, %s, %s, c);\n", indent, d->body, P, dV, dW);
+  return 6;
+}
+
+/* rhs[va..va+n-1] += c */
+static void add_cols(FILE *f, int vadr, int n) {
+  for (int j = 0; j < n; j++) fprintf(f, "    rhs[%d] += c[%d];\n", vadr + j, j);
+}
+
+/* a flexible body's constant data: invariants, node shapes, mass-block slots */
+static void emit_flex_tables(FILE *f, const lmodel *L, int b) {
+  const mb_body *B = &L->body[b];
+  const mb_flex *x = B->flex;
+  int nm = x->nm, nn = x->nnode;
+  char nm_[64];
+  fprintf(f, "/* flexible body '%s': %d modes, %d nodes; frequencies (Hz):", B->name, nm, nn);
+  for (int j = 0; j < nm; j++) fprintf(f, " %.6g", L->modes[b].freq_hz[j]);
+  fputs(" */\n", f);
+#define ARR(field, n)                                   \
+  snprintf(nm_, sizeof nm_, "flex%d_" #field, b);       \
+  real_array(f, nm_, (n) > 0 ? x->field : zero1, (n) > 0 ? (n) : 1);
+  static const double zero1[1] = {0};
+  ARR(S1, 3 * nm)
+  ARR(E, 9 * nm)
+  ARR(F, 9 * nm * nm)
+  ARR(G, 3 * nm * nm)
+  ARR(C0, 3 * nm)
+  ARR(CPsi, 3 * nm)
+  ARR(Mff, nm * nm)
+  ARR(stiffness, nm)
+  ARR(damping, nm)
+  ARR(node_x, 3 * nn)
+  ARR(node_X, 3 * nm * nn)
+  ARR(node_Psi, 3 * nm * nn)
+#undef ARR
+  int nbk = 6 + nm;
+  snprintf(nm_, sizeof nm_, "flex%d_mslot", b);
+  int_array(f, nm_, B->mslotf, nbk * nbk);
+  fprintf(f, "static const mb_flex flex%d = {%d, %d, ", b, nm, x->coupling);
+  num(f, x->mass);
+  fputs(", ", f);
+  vec(f, x->S0, 3);
+  fprintf(f, ", flex%d_S1, ", b);
+  vec(f, x->J0, 9);
+  fprintf(f, ",\n  flex%d_E, flex%d_F, flex%d_G, flex%d_C0, flex%d_CPsi, flex%d_Mff, flex%d_stiffness,\n"
+             "  flex%d_damping, %d, flex%d_node_x, flex%d_node_X, flex%d_node_Psi};\n",
+          b, b, b, b, b, b, b, b, nn, b, b, b);
 }
 
 static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
@@ -222,7 +284,7 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
           "void %s_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,\n"
           "    mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *nu, void *work) {\n"
           "  static const mb_real zero3[3] = {0, 0, 0};\n"
-          "  mb_frame f[%d];\n  mb_marker k[%d];\n  mb_row r;\n  mb_real c[6], x[3];\n"
+          "  mb_frame f[%d];\n  mb_marker k[%d];\n  mb_row r;\n  mb_real c[6 + MB_MAX_MODES], x[3];\n"
           "  (void)m; (void)work; (void)t; (void)x; (void)c; (void)r; (void)zero3;\n"
           "  (void)Kx; (void)phi; (void)nu; (void)f; (void)k;\n",
           nm, m->nbody ? m->nbody : 1, m->nmarker ? m->nmarker : 1);
@@ -236,6 +298,12 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
     fprintf(f, "  /* %s */\n", L->marker_desc[k]);
     if (d->body < 0) {
       fprintf(f, "  mb_marker_ground(markers[%d].s, markers[%d].C, &k[%d]);\n", k, k, k);
+    } else if (d->node >= 0) {
+      const mb_body *B = &L->body[d->body];
+      fprintf(f, "  mb_marker_node(&f[%d], &flex%d, %d, q + %d, v + %d, (const mb_real[9])", d->body,
+              d->body, d->node, B->qadr + 7, B->vadr + 6);
+      vec(f, d->C, 9);
+      fprintf(f, ", &k[%d]);\n", k);
     } else {
       fprintf(f, "  mb_marker_rigid(&f[%d], (const mb_real[3])", d->body);
       vec(f, d->s, 3);
@@ -248,6 +316,17 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
   for (int b = 0; b < m->nbody; b++) {
     const mb_body *B = &L->body[b];
     fprintf(f, "  /* body '%s' */\n", B->name);
+    if (B->kind == MB_BODY_FLEXIBLE) {
+      int nbk = 6 + B->nm;
+      fprintf(f, "  {\n    mb_real Mb[%d];\n    mb_flex_body(&flex%d, &f[%d], q + %d, v + %d, (const mb_real[3])", nbk * nbk, b, b, B->qadr + 7, B->vadr + 6);
+      vec(f, m->gravity, 3);
+      fprintf(f, ", Mb, rhs + %d);\n", B->vadr);
+      for (int i = 0; i < nbk * nbk; i++)
+        if (B->mslotf[i] >= 0 && flex_mass_entry(B->flex, i / nbk, i % nbk) == 2)
+          fprintf(f, "    Kx[%d] = Mb[%d];\n", B->mslotf[i], i);
+      fputs("  }\n", f);
+      continue;
+    }
     for (int j = 0; j < 3; j++) {
       fprintf(f, "  rhs[%d] = ", B->vadr + j);
       num(f, B->mass * m->gravity[j]);
@@ -283,9 +362,13 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
         fputs(";\n", f);
       }
       if (d->body_frame) fprintf(f, "    mb_mul3(f[%d].A, val, val);\n", b0);
-      fprintf(f, "    mb_rigid_cols(&f[%d], k[%d].P, %s, %s, c);\n", b0, d->m0,
-              d->kind == MB_FORCE_POINT ? "val" : "zero3", d->kind == MB_FORCE_POINT ? "zero3" : "val");
-      add_cols(f, L->body[b0].vadr);
+      {
+        char P[32];
+        snprintf(P, sizeof P, "k[%d].P", d->m0);
+        int n = emit_cols(f, L, d->m0, P, d->kind == MB_FORCE_POINT ? "val" : "zero3",
+                          d->kind == MB_FORCE_POINT ? "zero3" : "val", "    ");
+        add_cols(f, L->body[b0].vadr, n);
+      }
       break;
     }
     case MB_FORCE_SPRING:
@@ -297,12 +380,14 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
       num(f, d->preload);
       fputs(", F0, F1);\n", f);
       if (b0 >= 0) {
-        fprintf(f, "    mb_rigid_cols(&f[%d], k[%d].P, F0, zero3, c);\n", b0, d->m0);
-        add_cols(f, L->body[b0].vadr);
+        char P[32];
+        snprintf(P, sizeof P, "k[%d].P", d->m0);
+        add_cols(f, L->body[b0].vadr, emit_cols(f, L, d->m0, P, "F0", "zero3", "    "));
       }
       if (b1 >= 0) {
-        fprintf(f, "    mb_rigid_cols(&f[%d], k[%d].P, F1, zero3, c);\n", b1, d->m1);
-        add_cols(f, L->body[b1].vadr);
+        char P[32];
+        snprintf(P, sizeof P, "k[%d].P", d->m1);
+        add_cols(f, L->body[b1].vadr, emit_cols(f, L, d->m1, P, "F1", "zero3", "    "));
       }
       break;
     case MB_FORCE_BUSHING:
@@ -312,12 +397,13 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
       if (b0 >= 0)
         fputs("    mb_real mF[3] = {-F[0], -F[1], -F[2]}, mT[3] = {-T[0], -T[1], -T[2]};\n", f);
       if (b1 >= 0) {
-        fprintf(f, "    mb_rigid_cols(&f[%d], k[%d].P, F, T, c);\n", b1, d->m1);
-        add_cols(f, L->body[b1].vadr);
+        char P[32];
+        snprintf(P, sizeof P, "k[%d].P", d->m1);
+        add_cols(f, L->body[b1].vadr, emit_cols(f, L, d->m1, P, "F", "T", "    "));
       }
       if (b0 >= 0) {
         fprintf(f, "    mb_rigid_cols(&f[%d], k[%d].P, mF, mT, c); /* reaction at the same point */\n", b0, d->m1);
-        add_cols(f, L->body[b0].vadr);
+        add_cols(f, L->body[b0].vadr, 6);
       }
       break;
     }
@@ -353,11 +439,22 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
       int mk = s ? R->m1 : R->m0, b = L->marker[mk].body, any = 0;
       if (b < 0) continue;
       for (int j = 0; j < 6; j++) any |= R->slot[s][j] >= 0 && !R->constant[s][j];
+      if (R->mslot[s] >= 0) any = 1;
       if (!any) continue;
-      fprintf(f, "  mb_rigid_cols(&f[%d], k[%d].P, r.dV[%d], r.dW[%d], c);\n", b, mk, s, s);
+      char P[32], dV[32], dW[32];
+      snprintf(P, sizeof P, "k[%d].P", mk);
+      snprintf(dV, sizeof dV, "r.dV[%d]", s);
+      snprintf(dW, sizeof dW, "r.dW[%d]", s);
+      emit_cols(f, L, mk, P, dV, dW, "  ");
       for (int j = 0; j < 6; j++)
         if (R->slot[s][j] >= 0 && !R->constant[s][j])
           fprintf(f, "  Kx[%d] = Kx[%d] = c[%d];\n", R->slot[s][j], R->slotT[s][j], j);
+      if (R->mslot[s] >= 0) {
+        int nmb = L->body[b].nm;
+        const int *ms = L->modal_slot + R->mslot[s];
+        for (int j = 0; j < nmb; j++)
+          if (ms[j] >= 0) fprintf(f, "  Kx[%d] = Kx[%d] = c[%d];\n", ms[j], ms[nmb + j], 6 + j);
+      }
     }
   }
   fputs("}\n", f);
@@ -370,6 +467,21 @@ static void emit_init(FILE *f, const lmodel *L, const char *nm) {
              "  for (int i = 0; i < %d; i++) Kx[i] = 0;\n", nm, m->nnz);
   for (int b = 0; b < m->nbody; b++) {
     const mb_body *B = &L->body[b];
+    if (B->kind == MB_BODY_FLEXIBLE) {
+      /* the constant entries of the mass block: computed by the kernel at rest */
+      int nbk = 6 + B->nm, any = 0;
+      for (int i = 0; i < nbk * nbk; i++) any |= B->mslotf[i] >= 0 && flex_mass_entry(B->flex, i / nbk, i % nbk) == 1;
+      if (!any) continue;
+      fprintf(f, "  { /* body '%s': constant mass entries */\n    mb_real Mb[%d], fb[%d], w[%d] = {0};\n"
+                 "    mb_frame f0 = {{0, 0, 0}, {1, 0, 0, 0, 1, 0, 0, 0, 1}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};\n"
+                 "    mb_flex_body(&flex%d, &f0, w, w, w, Mb, fb);\n",
+              B->name, nbk * nbk, nbk, nbk, b);
+      for (int i = 0; i < nbk * nbk; i++)
+        if (B->mslotf[i] >= 0 && flex_mass_entry(B->flex, i / nbk, i % nbk) == 1)
+          fprintf(f, "    Kx[%d] = Mb[%d];\n", B->mslotf[i], i);
+      fputs("  }\n", f);
+      continue;
+    }
     if (B->kind != MB_BODY_RIGID) continue;
     fprintf(f, "  /* body '%s': mass and inertia */\n", B->name);
     for (int j = 0; j < 12; j++)
@@ -455,8 +567,8 @@ static void emit_source(FILE *f, const lmodel *L, const char *nm) {
           m->noutput ? "outputs" : "0", m->njoint ? "joint_names" : "0");
   fputs("  .gravity = ", f);
   vec(f, m->gravity, 3);
-  fprintf(f, ",\n  .Kp = Kp, .Ki = %s, .q0 = %s, .v0 = %s,\n", m->nnz ? "Ki" : "0",
-          m->nq ? "q0" : "0", m->nv ? "v0" : "0");
+  fprintf(f, ",\n  .Kp = Kp, .Ki = %s, .q0 = %s, .v0 = %s, .modal_slot = %s,\n", m->nnz ? "Ki" : "0",
+          m->nq ? "q0" : "0", m->nv ? "v0" : "0", L->nmodal_slot ? "modal_slot" : "0");
   fprintf(f, "  .ncols = %s_NCOLS, .col_name = %s,\n  .eval = %s_eval, .init = %s_init,\n};\n", U,
           m->ncols ? "col_names" : "0", nm, nm);
 }

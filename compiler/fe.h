@@ -40,4 +40,28 @@ typedef struct {
 int fe_compute_modes(const ir_flex *fx, fe_modes *out, char *err, size_t nerr);
 void fe_modes_free(fe_modes *m);
 
+/* As fe_assemble and fe_compute_modes, and also report in *where the source
+ * location of the item at fault (a beam, a point mass, a node, or the body);
+ * line 0 when there is none.  Errors in a modal data file already carry
+ * their place: err then reads "file:line:col: error: ..." and where->line is 0.
+ * Node numbers in messages are the IR's (0-based) indices.
+ * Craig-Bampton: the selection applies to the fixed-interface normal modes,
+ * and all_freq_hz lists those; the result is the 6 x (interface nodes) +
+ * selected modes of the reduced eigenproblem, each with its frequency.
+ * Constrained normal modes: all_freq_hz lists every mode, and the selected
+ * ones hold exactly the values in freq_hz. */
+int fe_assemble_at(const ir_flex *fx, fe_system *out, char *err, size_t nerr, ir_loc *where);
+int fe_compute_modes_at(const ir_flex *fx, fe_modes *out, char *err, size_t nerr, ir_loc *where);
+
+/* Lumped (HRZ) nodal masses and rotary inertias of the FE model, point masses
+ * included: node_mass[nnodes], node_inertia[9 nnodes] (body axes, row-major).
+ * Returns 0, or nonzero with err. */
+int fe_lumped_nodes(const ir_flex *fx, double *node_mass, double *node_inertia, char *err,
+                    size_t nerr, ir_loc *where);
+
+/* Write m (its selected modes) as a modal data file (docs/modal-file.md);
+ * 'description' may be NULL.  Returns 0, or nonzero with err. */
+int fe_modes_write(const fe_modes *m, const char *path, const char *description, char *err,
+                   size_t nerr);
+
 #endif

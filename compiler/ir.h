@@ -132,6 +132,8 @@ typedef struct {
                          marker x axis; angles of a driver are measured about
                          axis[0] from it); chosen by the reader if not given */
   bool active;        /* false when a scene deactivates it */
+  bool via_virtual;   /* on a flexible node: lower through a massless virtual body
+                         (simulation.joints_on_flexible: virtual, or this joint listed) */
 } ir_joint;
 
 /* --- drivers ------------------------------------------------------------------- */
@@ -207,7 +209,8 @@ typedef enum {
   OUT_POTENTIAL_ENERGY,     /* system, gravity and springs: 1 */
   OUT_TOTAL_ENERGY,         /* system: 1 */
   OUT_DEFLECTION,           /* flexible body: node deflection X_k w, body axes: 3 or 1 */
-  OUT_MODAL                 /* flexible body: modal coordinate 'mode' (1-based in the model) */
+  OUT_MODAL,                /* flexible body: modal coordinate 'mode' (1-based in the model) */
+  OUT_MOMENTUM              /* system: linear and angular momentum (about the origin): 6 */
 } ir_output_kind;
 
 typedef struct {
@@ -231,7 +234,7 @@ typedef struct {
 typedef enum { INTEGRATOR_RK4, INTEGRATOR_DOPRI5 } ir_integrator;
 typedef enum { SOLVER_KLU, SOLVER_DENSE } ir_solver;
 typedef enum { STAB_PROJECTION, STAB_BAUMGARTE, STAB_NONE } ir_stab;
-typedef enum { JOF_DIRECT, JOF_VIRTUAL } ir_jof;
+typedef enum { JOF_DIRECT, JOF_VIRTUAL, JOF_LIST } ir_jof;
 
 typedef struct {
   double end_time;      /* default 1 */

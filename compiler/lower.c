@@ -1,6 +1,7 @@
 /* lower.c: lowers the IR to coordinates, markers, constraint rows, force and
  * output tables, and works out the fixed CSC pattern of K = [M D^T; D 0]. */
 #define _POSIX_C_SOURCE 200809L
+#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -84,23 +85,28 @@ static int add_profile(lmodel *L, const ir_profile *p, int driver, int force) {
   return k;
 }
 
-/* a marker on IR body ib at global point P with global axes Cg */
-static int add_marker(lmodel *L, int ib, const double P[3], const double Cg[9], char *desc) {
+/* a marker on mb body b (-1: ground) at global point P with global axes Cg;
+ * on FE node 'node' of a flexible body when node >= 0 */
+static int add_marker(lmodel *L, int b, int node, const double P[3], const double Cg[9], char *desc) {
   int k = L->m.nmarker++;
   mb_markerdef *d = &L->marker[k];
   L->marker_desc[k] = desc;
-  d->body = ib - 1;
+  d->body = b;
   d->node = -1;
-  if (ib == 0) {
+  if (b < 0) {
     memcpy(d->s, P, sizeof(double) * 3);
     memcpy(d->C, Cg, sizeof(double) * 9);
     return k;
   }
-  const ir_body *B = &L->ir->bodies[ib];
+  const double *q = L->q0 + L->body[b].qadr;
   double A[9], rel[3];
-  mb_euler_to_A(B->orientation, A);
-  for (int j = 0; j < 3; j++) rel[j] = P[j] - B->position[j];
+  mb_euler_to_A(q + 3, A);
+  for (int j = 0; j < 3; j++) rel[j] = P[j] - q[j];
   mb_mul3t(A, rel, d->s);
+  if (node >= 0 && L->body[b].kind == MB_BODY_FLEXIBLE) {
+    d->node = node;
+    memcpy(d->s, L->modes[b].x + 3 * node, sizeof(double) * 3);
+  }
   /* C = A^T Cg */
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++)
@@ -184,10 +190,10 @@ static void joint_rows(lmodel *L, int j, int m0, int m1) {
 static int output_columns(const ir_output *o) {
   switch (o->kind) {
   case OUT_POSITION: case OUT_VELOCITY: case OUT_ANGULAR_VELOCITY: case OUT_ACCELERATION:
-  case OUT_ANGULAR_ACCELERATION:
+  case OUT_ANGULAR_ACCELERATION: case OUT_DEFLECTION:
     return o->component >= 0 ? 1 : 3;
   case OUT_ORIENTATION: return 4;
-  case OUT_REACTION: return 6;
+  case OUT_REACTION: case OUT_MOMENTUM: return 6;
   default: return 1;
   }
 }
@@ -198,17 +204,29 @@ static const int out_kind_map[] = {
     [OUT_ANGULAR_VELOCITY] = MB_OUT_ANGULAR_VELOCITY, [OUT_ACCELERATION] = MB_OUT_ACCELERATION,
     [OUT_ANGULAR_ACCELERATION] = MB_OUT_ANGULAR_ACCELERATION, [OUT_REACTION] = MB_OUT_REACTION,
     [OUT_EFFORT] = MB_OUT_EFFORT, [OUT_KINETIC_ENERGY] = MB_OUT_KINETIC_ENERGY,
-    [OUT_POTENTIAL_ENERGY] = MB_OUT_POTENTIAL_ENERGY, [OUT_TOTAL_ENERGY] = MB_OUT_TOTAL_ENERGY};
+    [OUT_POTENTIAL_ENERGY] = MB_OUT_POTENTIAL_ENERGY, [OUT_TOTAL_ENERGY] = MB_OUT_TOTAL_ENERGY,
+    [OUT_DEFLECTION] = MB_OUT_DEFLECTION, [OUT_MODAL] = MB_OUT_MODAL,
+    [OUT_MOMENTUM] = MB_OUT_MOMENTUM};
 
 lmodel *lower_model(const ir_model *ir) {
   lmodel *L = calloc(1, sizeof *L);
   if (!L) return NULL;
   L->ir = ir;
   int nb = ir->nbodies - 1;
-  int maxmk = 2 * ir->njoints + 2 * ir->nforces + 1;
-  int maxrow = 6 * ir->njoints + ir->ndrivers + 1;
+  /* joints on flexible nodes lowered through virtual bodies: one body each */
+  int nvirt_max = 0;
+  for (int j = 0; j < ir->njoints; j++)
+    for (int s = 0; s < 2; s++)
+      if (ir->joints[j].active && ir->joints[j].via_virtual && ir->joints[j].node[s] >= 0) nvirt_max++;
+  int nbmax = nb + nvirt_max;
+  int maxmk = 2 * ir->njoints + 2 * ir->nforces + 2 * nvirt_max + 1;
+  int maxrow = 6 * ir->njoints + ir->ndrivers + 6 * nvirt_max + 1;
   int maxprof = ir->ndrivers + ir->nforces + 1;
-  L->body = calloc((size_t)nb + 1, sizeof *L->body);
+  L->body = calloc((size_t)nbmax + 1, sizeof *L->body);
+  L->modes = calloc((size_t)nbmax + 1, sizeof *L->modes);
+  L->flexd = calloc((size_t)nbmax + 1, sizeof *L->flexd);
+  L->mslotf = calloc((size_t)nbmax + 1, sizeof *L->mslotf);
+  L->body_name = calloc((size_t)nbmax + 1, sizeof *L->body_name);
   L->marker = calloc((size_t)maxmk, sizeof *L->marker);
   L->marker_desc = calloc((size_t)maxmk, sizeof(char *));
   L->row = calloc((size_t)maxrow, sizeof *L->row);
@@ -222,24 +240,34 @@ lmodel *lower_model(const ir_model *ir) {
   L->spline = calloc((size_t)maxprof, sizeof(double *));
   L->table = calloc((size_t)maxprof, sizeof(double *));
   L->output = calloc((size_t)ir->noutputs + 1, sizeof *L->output);
-  L->q0 = calloc(7 * (size_t)nb + 1, sizeof(double));
-  L->v0 = calloc(6 * (size_t)nb + 1, sizeof(double));
   L->joint_name = calloc((size_t)ir->njoints + 1, sizeof(char *));
   int ncols = 0;
   for (int k = 0; k < ir->noutputs; k++) ncols += output_columns(&ir->outputs[k]);
   L->col_name = calloc((size_t)ncols + 1, sizeof(char *));
   if (!L->body || !L->marker || !L->marker_desc || !L->row || !L->row_desc || !L->row_loc ||
       !L->force || !L->force_ir || !L->profile || !L->profile_driver || !L->profile_force ||
-      !L->spline || !L->table || !L->output || !L->q0 || !L->v0 || !L->joint_name ||
-      !L->col_name) {
+      !L->spline || !L->table || !L->output || !L->joint_name || !L->col_name || !L->modes ||
+      !L->flexd || !L->mslotf || !L->body_name) {
     lower_free(L);
     return NULL;
   }
   mb_model *m = &L->m;
-  m->name = ir->name;
+  /* a scene's code gets its own symbols: <model>_<scene>, made an identifier */
+  L->name = malloc(strlen(ir->name) + (ir->scene ? strlen(ir->scene) + 2 : 1));
+  if (!L->name) { lower_free(L); return NULL; }
+  strcpy(L->name, ir->name);
+  if (ir->scene) {
+    char *e = L->name + strlen(L->name);
+    *e++ = '_';
+    for (const char *c = ir->scene; *c; c++) *e++ = (isalnum((unsigned char)*c) || *c == '_') ? *c : '_';
+    *e = 0;
+  }
+  m->name = L->name;
   memcpy(m->gravity, ir->gravity, sizeof m->gravity);
 
-  /* bodies: 7 position and 6 velocity coordinates each */
+  /* bodies: 7 position and 6 velocity coordinates each, plus the modes of a
+     flexible body (computed here: they size the coordinates) */
+  int nq = 0, nv = 0;
   for (int b = 0; b < nb; b++) {
     const ir_body *B = &ir->bodies[b + 1];
     mb_body *d = &L->body[b];
@@ -247,20 +275,43 @@ lmodel *lower_model(const ir_model *ir) {
     d->kind = B->kind == BODY_VIRTUAL ? MB_BODY_VIRTUAL : MB_BODY_RIGID;
     d->mass = B->mass;
     memcpy(d->J, B->inertia, sizeof d->J);
-    d->qadr = 7 * b;
-    d->vadr = 6 * b;
+    d->qadr = nq;
+    d->vadr = nv;
+    if (B->kind == BODY_FLEXIBLE) {
+      char err[512];
+      if (fe_compute_modes(B->flex, &L->modes[b], err, sizeof err) ||
+          flex_build(B->flex, &L->modes[b], &L->flexd[b], err, sizeof err)) {
+        diag_error(ir->path, B->loc, "flexible body '%s': %s", B->name, err);
+        lower_free(L);
+        return NULL;
+      }
+      d->kind = MB_BODY_FLEXIBLE;
+      d->flex = &L->flexd[b].flex;
+      d->nm = d->flex->nm;
+      d->mass = d->flex->mass;
+      memcpy(d->J, d->flex->J0, sizeof d->J);
+    }
+    nq += 7 + d->nm;
+    nv += 6 + d->nm;
+  }
+  L->q0 = calloc((size_t)nq + 7 * (size_t)nvirt_max + 1, sizeof(double));
+  L->v0 = calloc((size_t)nv + 6 * (size_t)nvirt_max + 1, sizeof(double));
+  if (!L->q0 || !L->v0) { lower_free(L); return NULL; }
+  for (int b = 0; b < nb; b++) {
+    const ir_body *B = &ir->bodies[b + 1];
+    const mb_body *d = &L->body[b];
     double A[9];
     mb_euler_to_A(B->orientation, A);
-    memcpy(L->q0 + 7 * b, B->position, sizeof(double) * 3);
-    memcpy(L->q0 + 7 * b + 3, B->orientation, sizeof(double) * 4);
-    memcpy(L->v0 + 6 * b, B->velocity, sizeof(double) * 3);
-    mb_mul3t(A, B->angular_velocity, L->v0 + 6 * b + 3);
+    memcpy(L->q0 + d->qadr, B->position, sizeof(double) * 3);
+    memcpy(L->q0 + d->qadr + 3, B->orientation, sizeof(double) * 4);
+    memcpy(L->v0 + d->vadr, B->velocity, sizeof(double) * 3);
+    mb_mul3t(A, B->angular_velocity, L->v0 + d->vadr + 3);
   }
   m->nbody = nb;
-  m->nq = 7 * nb;
-  m->nv = 6 * nb;
 
-  /* joints: two markers each (frames z = axis), then their rows */
+  /* joints: two markers each (frames z = axis), then their rows; a side on a
+     flexible node lowered through a virtual body gets the body and the 6-row
+     rigid joint of seed 000 eqs. 33-42 between it and the node */
   int *jm0 = calloc((size_t)ir->njoints + 1, sizeof(int));
   int *jm1 = calloc((size_t)ir->njoints + 1, sizeof(int));
   if (!jm0 || !jm1) { free(jm0); free(jm1); lower_free(L); return NULL; }
@@ -268,20 +319,63 @@ lmodel *lower_model(const ir_model *ir) {
     const ir_joint *J = &ir->joints[j];
     L->joint_name[j] = J->name;
     if (!J->active) { jm0[j] = jm1[j] = -1; continue; }
-    double C0[9], C1[9];
-    frame_from_axes(J->axis[0], J->ref, C0);
+    double C[2][9];
+    frame_from_axes(J->axis[0], J->ref, C[0]);
     if (J->kind == JOINT_UNIVERSAL)
-      frame_from_axes(J->axis[1], J->axis[0], C1); /* x1 along the other cross axis */
+      frame_from_axes(J->axis[1], J->axis[0], C[1]); /* x1 along the other cross axis */
     else
-      memcpy(C1, C0, sizeof C1);
-    jm0[j] = add_marker(L, J->body[0], J->point[0], C0,
-                        xstrdup_printf("joint '%s', on body '%s'%s", J->name,
-                                       ir->bodies[J->body[0]].name, ""));
-    jm1[j] = add_marker(L, J->body[1], J->point[1], C1,
-                        xstrdup_printf("joint '%s', on body '%s'%s", J->name,
-                                       ir->bodies[J->body[1]].name, ""));
+      memcpy(C[1], C[0], sizeof C[1]);
+    int mk[2];
+    for (int s = 0; s < 2; s++) {
+      int b = J->body[s] - 1, node = J->node[s];
+      if (b >= 0 && node >= 0 && J->via_virtual && L->body[b].kind == MB_BODY_FLEXIBLE) {
+        /* a massless body at the node, in the flexible body's axes */
+        int v = m->nbody++;
+        char name[300];
+        snprintf(name, sizeof name, "%s_%s_virtual", J->name, L->body[b].name);
+        L->body_name[v] = strdup(name);
+        mb_body *d = &L->body[v];
+        d->name = L->body_name[v];
+        d->kind = MB_BODY_VIRTUAL;
+        d->qadr = nq;
+        d->vadr = nv;
+        nq += 7;
+        nv += 6;
+        const double *qb = L->q0 + L->body[b].qadr;
+        double A[9], P[3], Cg[9];
+        mb_euler_to_A(qb + 3, A);
+        mb_mul3(A, L->modes[b].x + 3 * node, P);
+        for (int i = 0; i < 3; i++) P[i] += qb[i];
+        for (int i = 0; i < 9; i++) Cg[i] = A[i];
+        memcpy(L->q0 + d->qadr, P, sizeof P);
+        memcpy(L->q0 + d->qadr + 3, qb + 3, sizeof(double) * 4);
+        int mn = add_marker(L, b, node, P, Cg,
+                            xstrdup_printf("node of body '%s' under virtual body '%s'%s",
+                                           L->body[b].name, name, ""));
+        int mv = add_marker(L, v, -1, P, Cg,
+                            xstrdup_printf("virtual body '%s' at its node%s%s", name, "", ""));
+        char what[64];
+        for (int k = 0; k < 3; k++) {
+          snprintf(what, sizeof what, "node and virtual body coincide, %s", axis_name[k]);
+          add_row(L, MB_PRIM_SPH, mn, mv, k, 0, what, -1, -1, J->loc, name, "rigid joint of virtual body");
+        }
+        add_row(L, MB_PRIM_DOT1, mn, mv, 0, 1, "no relative rotation about z", -1, -1, J->loc, name, "rigid joint of virtual body");
+        add_row(L, MB_PRIM_DOT1, mn, mv, 1, 2, "no relative rotation about x", -1, -1, J->loc, name, "rigid joint of virtual body");
+        add_row(L, MB_PRIM_DOT1, mn, mv, 2, 0, "no relative rotation about y", -1, -1, J->loc, name, "rigid joint of virtual body");
+        L->nvirtual++;
+        b = v;
+        node = -1;
+      }
+      mk[s] = add_marker(L, b, node, J->point[s], C[s],
+                         xstrdup_printf("joint '%s', on body '%s'%s", J->name,
+                                        b >= 0 ? L->body[b].name : "ground", ""));
+    }
+    jm0[j] = mk[0];
+    jm1[j] = mk[1];
     joint_rows(L, j, jm0[j], jm1[j]);
   }
+  m->nq = nq;
+  m->nv = nv;
   for (int d = 0; d < ir->ndrivers; d++) {
     const ir_driver *D = &ir->drivers[d];
     if (!D->active || !ir->joints[D->joint].active) continue;
@@ -309,7 +403,7 @@ lmodel *lower_model(const ir_model *ir) {
     case FORCE_POINT_FORCE:
     case FORCE_POINT_TORQUE:
       d->kind = F->kind == FORCE_POINT_FORCE ? MB_FORCE_POINT : MB_FORCE_TORQUE;
-      d->m0 = add_marker(L, F->body[0], F->point[0], I3,
+      d->m0 = add_marker(L, F->body[0] - 1, F->node[0], F->point[0], I3,
                          xstrdup_printf("force '%s', on body '%s'%s", F->name,
                                         ir->bodies[F->body[0]].name, ""));
       memcpy(d->vec, F->vector, sizeof d->vec);
@@ -324,7 +418,7 @@ lmodel *lower_model(const ir_model *ir) {
       int spring = F->kind == FORCE_SPRING_DAMPER;
       d->kind = spring ? MB_FORCE_SPRING : MB_FORCE_BUSHING;
       for (int s = 0; s < 2; s++) {
-        int mk = add_marker(L, F->body[s], F->point[s], spring ? I3 : Cg,
+        int mk = add_marker(L, F->body[s] - 1, F->node[s], F->point[s], spring ? I3 : Cg,
                             xstrdup_printf("force '%s', on body '%s'%s", F->name,
                                            ir->bodies[F->body[s]].name, ""));
         if (s) d->m1 = mk; else d->m0 = mk;
@@ -383,6 +477,22 @@ lmodel *lower_model(const ir_model *ir) {
         mb_mul3t(A, d->u_g, d->u);
       }
     }
+    if (o->kind == OUT_DEFLECTION) {
+      d->node = o->node;
+      d->chord[0] = o->chord[0];
+      d->chord[1] = o->chord[1];
+    }
+    if (o->kind == OUT_MODAL) d->node = o->mode;
+    if ((o->kind == OUT_DEFLECTION || o->kind == OUT_MODAL) &&
+        (d->body < 0 || L->body[d->body].kind != MB_BODY_FLEXIBLE ||
+         (o->kind == OUT_MODAL && o->mode >= L->body[d->body].nm))) {
+      diag_error(ir->path, o->loc, "output '%s' needs a flexible body%s", o->name,
+                 o->kind == OUT_MODAL ? " with that many modes" : "");
+      free(jm0);
+      free(jm1);
+      lower_free(L);
+      return NULL;
+    }
     if (o->kind == OUT_REACTION) d->reaction_marker = jm1[o->joint];
     if (o->kind == OUT_EFFORT) {
       const ir_driver *D = &ir->drivers[o->driver];
@@ -392,12 +502,13 @@ lmodel *lower_model(const ir_model *ir) {
         if (L->row[r].driver == o->driver) d->driver_row = r;
     }
     static const char *xyz[3] = {"x", "y", "z"}, *e4[4] = {"e0", "e1", "e2", "e3"},
-                      *rc[6] = {"fx", "fy", "fz", "tx", "ty", "tz"};
+                      *rc[6] = {"fx", "fy", "fz", "tx", "ty", "tz"},
+                      *pm[6] = {"px", "py", "pz", "hx", "hy", "hz"};
     for (int j = 0; j < d->ncols; j++) {
       const char *suffix = NULL;
       if (d->ncols == 3) suffix = xyz[j];
       else if (d->ncols == 4) suffix = e4[j];
-      else if (d->ncols == 6) suffix = rc[j];
+      else if (d->ncols == 6) suffix = o->kind == OUT_MOMENTUM ? pm[j] : rc[j];
       L->col_name[col + j] = suffix ? xstrdup_printf("%s.%s%s", o->name, suffix, "")
                                     : strdup(o->name);
     }
@@ -437,7 +548,7 @@ static int entry_cmp(const void *a, const void *b) {
 /* which of a row's 6 columns on side s are structurally nonzero, and which constant */
 static void row_structure(const lmodel *L, const mb_rowdef *R, int s, int nz[6], int cst[6]) {
   const mb_markerdef *md = &L->marker[s ? R->m1 : R->m0];
-  int offset = fabs(md->s[0]) + fabs(md->s[1]) + fabs(md->s[2]) > 0;
+  int offset = md->node >= 0 || fabs(md->s[0]) + fabs(md->s[1]) + fabs(md->s[2]) > 0;
   for (int j = 0; j < 6; j++) nz[j] = cst[j] = 0;
   switch (R->kind) {
   case MB_PRIM_SPH:
@@ -458,6 +569,20 @@ static void row_structure(const lmodel *L, const mb_rowdef *R, int s, int nz[6],
   }
 }
 
+/* can a row's column of mode j on side s be nonzero (a node marker whose
+ * shape rows for mode j are nonzero in the part the primitive uses)? */
+static int modal_nonzero(const lmodel *L, const mb_rowdef *R, int s, int j) {
+  const mb_markerdef *md = &L->marker[s ? R->m1 : R->m0];
+  if (md->body < 0 || md->node < 0) return 0;
+  const mb_flex *f = L->body[md->body].flex;
+  const double *X = f->node_X + 3 * ((size_t)md->node * f->nm + j);
+  const double *P = f->node_Psi + 3 * ((size_t)md->node * f->nm + j);
+  int uses_V = R->kind != MB_PRIM_DOT1 && R->kind != MB_PRIM_ROT;
+  int uses_W = R->kind != MB_PRIM_SPH && R->kind != MB_PRIM_DIST;
+  return (uses_V && (X[0] != 0 || X[1] != 0 || X[2] != 0)) ||
+         (uses_W && (P[0] != 0 || P[1] != 0 || P[2] != 0));
+}
+
 static int find_slot(const int *Kp, const int *Ki, int row, int col) {
   for (int p = Kp[col]; p < Kp[col + 1]; p++)
     if (Ki[p] == row) return p;
@@ -468,12 +593,25 @@ int lower_pattern(lmodel *L) {
   mb_model *m = &L->m;
   m->nc = m->nrow;
   m->n = m->nv + m->nc;
-  size_t cap = 12 * (size_t)m->nbody + 24 * (size_t)m->nrow + 1;
+  size_t cap = 24 * (size_t)m->nrow + 1;
+  for (int b = 0; b < m->nbody; b++) cap += (size_t)(6 + L->body[b].nm) * (size_t)(6 + L->body[b].nm) + 12;
+  for (int r = 0; r < m->nrow; r++)
+    for (int s = 0; s < 2; s++) {
+      int b = L->marker[s ? L->row[r].m1 : L->row[r].m0].body;
+      if (b >= 0) cap += 2 * (size_t)L->body[b].nm;
+    }
   entry *E = malloc(cap * sizeof *E);
   if (!E) return -1;
   size_t ne = 0;
   for (int b = 0; b < m->nbody; b++) {
     const mb_body *B = &L->body[b];
+    if (B->kind == MB_BODY_FLEXIBLE) {
+      int nbk = 6 + B->nm;
+      for (int i = 0; i < nbk; i++)
+        for (int l = 0; l < nbk; l++)
+          if (flex_mass_entry(B->flex, i, l)) E[ne++] = (entry){B->vadr + i, B->vadr + l};
+      continue;
+    }
     if (B->kind != MB_BODY_RIGID) continue;
     for (int j = 0; j < 3; j++) E[ne++] = (entry){B->vadr + j, B->vadr + j};
     for (int i = 0; i < 3; i++)
@@ -490,6 +628,11 @@ int lower_pattern(lmodel *L) {
         if (nz[j]) {
           E[ne++] = (entry){m->nv + r, L->body[b].vadr + j};
           E[ne++] = (entry){L->body[b].vadr + j, m->nv + r};
+        }
+      for (int j = 0; j < L->body[b].nm; j++)
+        if (modal_nonzero(L, R, s, j)) {
+          E[ne++] = (entry){m->nv + r, L->body[b].vadr + 6 + j};
+          E[ne++] = (entry){L->body[b].vadr + 6 + j, m->nv + r};
         }
     }
   }
@@ -515,11 +658,53 @@ int lower_pattern(lmodel *L) {
   for (int b = 0; b < m->nbody; b++) {
     mb_body *B = &L->body[b];
     for (int j = 0; j < 12; j++) B->mslot[j] = -1;
+    if (B->kind == MB_BODY_FLEXIBLE) {
+      int nbk = 6 + B->nm;
+      free(L->mslotf[b]);
+      L->mslotf[b] = malloc(sizeof(int) * (size_t)nbk * (size_t)nbk);
+      if (!L->mslotf[b]) return -1;
+      for (int i = 0; i < nbk; i++)
+        for (int l = 0; l < nbk; l++)
+          L->mslotf[b][nbk * i + l] = flex_mass_entry(B->flex, i, l)
+                                          ? find_slot(L->Kp, L->Ki, B->vadr + i, B->vadr + l)
+                                          : -1;
+      B->mslotf = L->mslotf[b];
+      continue;
+    }
     if (B->kind != MB_BODY_RIGID) continue;
     for (int j = 0; j < 3; j++) B->mslot[j] = find_slot(L->Kp, L->Ki, B->vadr + j, B->vadr + j);
     for (int i = 0; i < 3; i++)
       for (int j = 0; j < 3; j++)
         B->mslot[3 + 3 * i + j] = find_slot(L->Kp, L->Ki, B->vadr + 3 + i, B->vadr + 3 + j);
+  }
+  /* modal columns of rows on node markers: nm slots, then nm transposed slots */
+  size_t nms = 0;
+  for (int r = 0; r < m->nrow; r++)
+    for (int s = 0; s < 2; s++) {
+      const mb_markerdef *md = &L->marker[s ? L->row[r].m1 : L->row[r].m0];
+      if (md->body >= 0 && md->node >= 0) nms += 2 * (size_t)L->body[md->body].nm;
+    }
+  free(L->modal_slot);
+  L->modal_slot = malloc(sizeof(int) * (nms + 1));
+  if (!L->modal_slot) return -1;
+  L->nmodal_slot = (int)nms;
+  m->modal_slot = L->modal_slot;
+  nms = 0;
+  for (int r = 0; r < m->nrow; r++) {
+    mb_rowdef *R = &L->row[r];
+    for (int s = 0; s < 2; s++) {
+      const mb_markerdef *md = &L->marker[s ? R->m1 : R->m0];
+      R->mslot[s] = -1;
+      if (md->body < 0 || md->node < 0) continue;
+      const mb_body *B = &L->body[md->body];
+      R->mslot[s] = (int)nms;
+      for (int j = 0; j < B->nm; j++) {
+        int nz = modal_nonzero(L, R, s, j), c = B->vadr + 6 + j;
+        L->modal_slot[nms + (size_t)j] = nz ? find_slot(L->Kp, L->Ki, m->nv + r, c) : -1;
+        L->modal_slot[nms + (size_t)B->nm + (size_t)j] = nz ? find_slot(L->Kp, L->Ki, c, m->nv + r) : -1;
+      }
+      nms += 2 * (size_t)B->nm;
+    }
   }
   for (int r = 0; r < m->nrow; r++) {
     mb_rowdef *R = &L->row[r];
@@ -580,5 +765,13 @@ void lower_free(lmodel *L) {
   free(L->profile_driver); free(L->profile_force); free(L->spline); free(L->table);
   free(L->output); free(L->q0); free(L->v0); free(L->col_name); free(L->joint_name);
   free(L->Kp); free(L->Ki);
+  for (int b = 0; b < L->m.nbody; b++) {
+    if (L->modes) fe_modes_free(&L->modes[b]);
+    if (L->flexd) flex_data_free(&L->flexd[b]);
+    if (L->mslotf) free(L->mslotf[b]);
+    if (L->body_name) free(L->body_name[b]);
+  }
+  free(L->name);
+  free(L->modes); free(L->flexd); free(L->mslotf); free(L->body_name); free(L->modal_slot);
   free(L);
 }

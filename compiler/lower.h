@@ -5,6 +5,7 @@
 #ifndef MBCC_LOWER_H
 #define MBCC_LOWER_H
 
+#include "flex.h"
 #include "ir.h"
 #include "mb_model.h"
 
@@ -30,6 +31,15 @@ typedef struct {
   int *profile_force;
   double **spline;           /* owned spline and table arrays of table profiles */
   double **table;
+  /* flexible bodies: per mb body (NULL / unused for others) */
+  fe_modes *modes;           /* m.nbody entries */
+  flex_data *flexd;
+  int **mslotf;
+  int *modal_slot;           /* slots of constraint rows' modal columns */
+  int nmodal_slot;
+  int nvirtual;              /* virtual bodies inserted for joints on flexible nodes */
+  char **body_name;          /* owned names of inserted bodies */
+  char *name;                /* model name, with the scene's appended: <model>_<scene> */
   int nredundant;            /* rows removed at assembly */
   int dof;
 } lmodel;

@@ -1,6 +1,7 @@
 /* main.c: the mbcc command line: check, compile, run, plot. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -9,6 +10,7 @@
 #include <unistd.h>
 
 #include "diag.h"
+#include "fe.h"
 #include "lower.h"
 #include "mb_driver.h"
 
@@ -35,11 +37,12 @@ static void usage(void) {
           "                [--integrator rk4|dopri5] [-o results.csv] [--plot out.png|none]\n"
           "                [--end T] [--output-step H] [--step H] [--rtol R] [--atol A]\n"
           "                [--stabilization projection|baumgarte|none] [--quiet]\n"
+          "       mbcc modes M.yaml --body NAME [--scene S] [--shapes shapes.csv]\n"
           "       mbcc plot results.csv [-o out.png] [--columns a,b,...]\n");
 }
 
 typedef struct {
-  const char *model, *scene, *outdir, *csv, *plot, *path;
+  const char *model, *scene, *outdir, *csv, *plot, *path, *body, *shapes;
   const char *sim_args[32];
   int nsim;
   int quiet;
@@ -59,6 +62,8 @@ static int parse_options(int argc, char **argv, options *o) {
     if (!v) { fprintf(stderr, "mbcc: error: option '%s' needs a value\n", a); return 2; }
     i++;
     if (!strcmp(a, "--scene")) o->scene = v;
+    else if (!strcmp(a, "--body")) o->body = v;
+    else if (!strcmp(a, "--shapes")) o->shapes = v;
     else if (!strcmp(a, "-o")) { o->outdir = v; o->csv = v; }
     else if (!strcmp(a, "--plot")) o->plot = v;
     else if (!strcmp(a, "--path")) o->path = v;
@@ -120,16 +125,86 @@ static int cmd_check(const options *o) {
   printf("  degrees of freedom %d\n", L->dof);
   printf("  system dimension  %d (K = [M D^T; D 0])\n", m->n);
   printf("  nnz(K)            %d (%.2f%% dense)\n", m->nnz, m->n ? 100.0 * m->nnz / ((double)m->n * m->n) : 0.0);
+  if (L->nvirtual) printf("  virtual bodies    %d inserted for joints on flexible nodes\n", L->nvirtual);
+  for (int b = 0; b < m->nbody; b++) {
+    if (m->body[b].kind != MB_BODY_FLEXIBLE) continue;
+    const fe_modes *fm = &L->modes[b];
+    static const char *coupling[] = {"full", "partial", "constant"};
+    printf("  flexible body '%s': %d nodes, %d modes (coordinates q %d..%d, v %d..%d), coupling %s\n",
+           m->body[b].name, fm->nnodes, m->body[b].nm, m->body[b].qadr + 7,
+           m->body[b].qadr + 6 + m->body[b].nm, m->body[b].vadr + 6, m->body[b].vadr + 5 + m->body[b].nm,
+           coupling[m->body[b].flex->coupling]);
+    printf("    frequencies (Hz):");
+    for (int j = 0; j < m->body[b].nm; j++) printf(" %.6g", fm->freq_hz[j]);
+    printf("\n    mass %.6g kg, damping ratios:", m->body[b].flex->mass);
+    for (int j = 0; j < m->body[b].nm; j++)
+      printf(" %.3g", m->body[b].flex->damping[j] / (2 * 2 * MB_PI * fm->freq_hz[j] * sqrt(m->body[b].flex->Mff[j * m->body[b].nm + j])));
+    printf("\n");
+  }
   lower_free(L);
   ir_free(ir);
   return 0;
 }
 
+/* mbcc modes: frequencies and (optionally) mode shapes of one flexible body */
+static int cmd_modes(const options *o) {
+  if (!o->body) { fprintf(stderr, "mbcc: error: modes needs --body NAME\n"); return 2; }
+  ir_model *ir = ir_read(o->model, o->scene);
+  if (!ir) return 2;
+  int ib = ir_find_body(ir, o->body);
+  if (ib < 0 || ir->bodies[ib].kind != BODY_FLEXIBLE) {
+    fprintf(stderr, "%s: error: '%s' is not a flexible body of this model\n", o->model, o->body);
+    ir_free(ir);
+    return 2;
+  }
+  fe_modes fm;
+  char err[512];
+  if (fe_compute_modes(ir->bodies[ib].flex, &fm, err, sizeof err)) {
+    diag_error(o->model, ir->bodies[ib].loc, "flexible body '%s': %s", o->body, err);
+    ir_free(ir);
+    return 2;
+  }
+  printf("flexible body '%s': %d nodes, %d DOFs computed, %d modes selected\n", o->body, fm.nnodes,
+         fm.nall, fm.nmodes);
+  printf("mode  frequency_hz  selected\n");
+  for (int j = 0; j < fm.nall; j++) {
+    int sel = 0;
+    for (int k = 0; k < fm.nmodes; k++)
+      if (fabs(fm.freq_hz[k] - fm.all_freq_hz[j]) <= 1e-12 * fabs(fm.all_freq_hz[j])) sel = 1;
+    printf("%4d  %12.6g  %s\n", j + 1, fm.all_freq_hz[j], sel ? "yes" : "");
+  }
+  int st = 0;
+  if (o->shapes) {
+    char tmp[4200];
+    snprintf(tmp, sizeof tmp, "%s.part", o->shapes);
+    FILE *f = fopen(tmp, "w");
+    if (!f) {
+      fprintf(stderr, "mbcc: error: cannot write '%s'\n", tmp);
+      st = 2;
+    } else {
+      fprintf(f, "node,x,y,z");
+      for (int j = 0; j < fm.nmodes; j++)
+        fprintf(f, ",m%d_ux,m%d_uy,m%d_uz,m%d_rx,m%d_ry,m%d_rz", j + 1, j + 1, j + 1, j + 1, j + 1, j + 1);
+      fputc('\n', f);
+      for (int k = 0; k < fm.nnodes; k++) {
+        fprintf(f, "%d,%.17g,%.17g,%.17g", k, fm.x[3 * k], fm.x[3 * k + 1], fm.x[3 * k + 2]);
+        for (int j = 0; j < fm.nmodes; j++)
+          for (int i = 0; i < 6; i++)
+            fprintf(f, ",%.17g", fm.shapes[(size_t)j * 6 * (size_t)fm.nnodes + 6 * (size_t)k + (size_t)i]);
+        fputc('\n', f);
+      }
+      if (fclose(f) || rename(tmp, o->shapes)) { remove(tmp); st = 2; }
+      else printf("wrote %s\n", o->shapes);
+    }
+  }
+  fe_modes_free(&fm);
+  ir_free(ir);
+  return st;
+}
+
 static void default_dir(const lmodel *L, const ir_model *ir, char *dir, size_t n) {
-  if (ir->scene)
-    snprintf(dir, n, "generated/%s-%s", L->m.name, ir->scene);
-  else
-    snprintf(dir, n, "generated/%s", L->m.name);
+  (void)ir;
+  snprintf(dir, n, "generated/%s", L->m.name);
 }
 
 static int cmd_compile(const options *o, char *dir_out, size_t n, lmodel **Lp, ir_model **irp) {
@@ -222,7 +297,7 @@ static int cmd_run(const options *o) {
     if (!Lg) return 2;
     if (!o->csv) {
       mkdir("results", 0777);
-      snprintf(csv, sizeof csv, "results/%s%s%s.csv", Lg->m.name, ir->scene ? "-" : "", ir->scene ? ir->scene : "");
+      snprintf(csv, sizeof csv, "results/%s.csv", Lg->m.name);
     }
     const ir_sim *s = &ir->sim;
     mb_settings set;
@@ -250,7 +325,7 @@ static int cmd_run(const options *o) {
     if (rc) return rc;
     if (!o->csv) {
       mkdir("results", 0777);
-      snprintf(csv, sizeof csv, "results/%s%s%s.csv", L->m.name, ir->scene ? "-" : "", ir->scene ? ir->scene : "");
+      snprintf(csv, sizeof csv, "results/%s.csv", L->m.name);
     }
     /* compile the generated code against the runtime library */
     char exe[8400], src_c[8400], src_main[8400], inc[8400], lib[8400];
@@ -336,13 +411,14 @@ int main(int argc, char **argv) {
     if (!st) printf("wrote %s\n", png);
     return st;
   }
-  if (strcmp(cmd, "check") && strcmp(cmd, "compile") && strcmp(cmd, "run")) {
+  if (strcmp(cmd, "check") && strcmp(cmd, "compile") && strcmp(cmd, "run") && strcmp(cmd, "modes")) {
     fprintf(stderr, "mbcc: error: unknown command '%s'\n", cmd);
     usage();
     return 2;
   }
   if (parse_options(argc, argv, &o)) return 2;
   if (!strcmp(cmd, "check")) return cmd_check(&o);
+  if (!strcmp(cmd, "modes")) return cmd_modes(&o);
   if (!strcmp(cmd, "compile")) return cmd_compile(&o, NULL, 0, NULL, NULL);
   return cmd_run(&o);
 }

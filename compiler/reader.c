@@ -58,6 +58,14 @@ static double distance3(const double a[3], const double b[3]) {
   return norm3(d);
 }
 
+/* rotation matrix (row-major, body to global) of unit Euler parameters */
+static void quaternion_to_matrix(const double e[4], double A[9]) {
+  double e0 = e[0], e1 = e[1], e2 = e[2], e3 = e[3];
+  A[0] = 2 * (e0 * e0 + e1 * e1) - 1; A[1] = 2 * (e1 * e2 - e0 * e3); A[2] = 2 * (e1 * e3 + e0 * e2);
+  A[3] = 2 * (e1 * e2 + e0 * e3); A[4] = 2 * (e0 * e0 + e2 * e2) - 1; A[5] = 2 * (e2 * e3 - e0 * e1);
+  A[6] = 2 * (e1 * e3 - e0 * e2); A[7] = 2 * (e2 * e3 + e0 * e1); A[8] = 2 * (e0 * e0 + e3 * e3) - 1;
+}
+
 static void scale3(double a[3], double factor) {
   a[0] *= factor;
   a[1] *= factor;
@@ -164,6 +172,7 @@ typedef struct {
   int noutputs;
   bool *joint_off, *driver_off, *force_off;
   ir_sim sim;
+  yaml_node_t *jof_list;
 } chosen_scene;
 
 typedef struct {
@@ -854,12 +863,91 @@ static bool get_body_pair(mapping *m, int body[2], ir_loc body_loc[2]) {
   return true;
 }
 
-static const char *fe_node_message = "FE nodes need a flexible body (flexible bodies are "
-                                     "not supported yet)";
+static bool is_null_scalar(const yaml_node_t *n) {
+  return n->type == YAML_SCALAR_NODE &&
+         (scalar_length(n) == 0 || scalar_equals(n, "~") || scalar_equals(n, "null"));
+}
 
-static void reject_fe_nodes(mapping *m) {
-  map_reject(m, "node", "%s", fe_node_message);
-  map_reject(m, "nodes", "%s", fe_node_message);
+/* node index 'n' on flexible body b (checked against its node count when known) */
+static int to_fe_node(reader *r, yaml_node_t *n, const ir_body *b) {
+  double v;
+  char label[SHOWN_SIZE];
+  snprintf(label, sizeof label, "FE node of body '%s'", b->name);
+  if (!to_number(r, n, label, &v)) return -1;
+  int nn = b->flex && b->flex->nodes ? b->flex->nnodes : -1;
+  if (v != floor(v) || v < 0 || (nn >= 0 && v >= nn)) {
+    if (nn >= 0)
+      error_at(r, loc_of(n), "body '%s' has no node %g (its nodes are numbered 0 to %d)", b->name, v, nn - 1);
+    else
+      error_at(r, loc_of(n), "%s must be a node number (got %g)", label, v);
+    return -1;
+  }
+  return (int)v;
+}
+
+/* FE nodes of an element on one or two bodies: 'node: K' on its one flexible
+ * body, or 'nodes: [K0, K1]' with ~ on a side that is not flexible. */
+static bool get_fe_nodes(mapping *m, const int body[2], int node[2]) {
+  reader *r = m->r;
+  const ir_model *model = r->model;
+  yaml_node_t *one = map_get(m, "node"), *two = map_get(m, "nodes");
+  node[0] = node[1] = -1;
+  if (one != NULL && two != NULL) {
+    error_at(r, loc_of(two), "give either 'node' or 'nodes', not both");
+    return false;
+  }
+  bool flex[2];
+  for (int s = 0; s < 2; s++)
+    flex[s] = body[s] >= 0 && model->bodies[body[s]].kind == BODY_FLEXIBLE && model->bodies[body[s]].flex;
+  if (one != NULL) {
+    if (flex[0] && flex[1]) {
+      error_at(r, loc_of(one), "both bodies are flexible: say which node of each with 'nodes: [K0, K1]'");
+      return false;
+    }
+    if (!flex[0] && !flex[1]) {
+      error_at(r, loc_of(one), "FE nodes need a flexible body (no body of %s is flexible)", m->what);
+      return false;
+    }
+    int s = flex[0] ? 0 : 1;
+    node[s] = to_fe_node(r, one, &model->bodies[body[s]]);
+  }
+  if (two != NULL) {
+    if (two->type != YAML_SEQUENCE_NODE || seq_length(two) != 2) {
+      error_at(r, loc_of(two), "'nodes': expected [K0, K1] with ~ for a body that is not flexible");
+      return false;
+    }
+    for (int s = 0; s < 2; s++) {
+      yaml_node_t *item = seq_item(r, two, s);
+      if (is_null_scalar(item)) continue;
+      if (!flex[s]) {
+        error_at(r, loc_of(item), "FE nodes need a flexible body ('%s' is not flexible; use ~)",
+                 body[s] >= 0 ? model->bodies[body[s]].name : "?");
+        continue;
+      }
+      node[s] = to_fe_node(r, item, &model->bodies[body[s]]);
+    }
+  }
+  return node[0] >= 0 || node[1] >= 0;
+}
+
+static void node_global(const ir_body *b, int k, double out[3]);
+
+/* the point of side s: the node's position when a node is given (a point
+ * given as well must coincide with it) */
+static void check_node_point(reader *r, const ir_model *model, ir_loc loc, const int body[2],
+                             const int node[2], bool point_given, double *point) {
+  for (int s = 0; s < 2; s++) {
+    if (node[s] < 0 || !model->bodies[body[s]].flex || !model->bodies[body[s]].flex->nodes) continue;
+    double P[3];
+    node_global(&model->bodies[body[s]], node[s], P);
+    if (!point_given) {
+      memcpy(point + 3 * s, P, sizeof P);
+    } else if (distance3(P, point + 3 * s) > 1e-9 * (1 + norm3(P))) {
+      error_at(r, loc, "the point is %g away from node %d of body '%s' (expected the node's position "
+               "[%g, %g, %g], or leave the point out)", distance3(P, point + 3 * s), node[s],
+               model->bodies[body[s]].name, P[0], P[1], P[2]);
+    }
+  }
 }
 
 /* ---------------------------------------------------------------------------
@@ -1060,10 +1148,380 @@ static void parse_virtual_body(mapping *m, ir_body *b) {
   parse_body_state(m, b);
 }
 
-/* The flexible-bodies issue replaces this with the FE / modal reader. */
+/* A list of node indices, each < nnodes (nnodes < 0: not checked yet). */
+static int *to_node_list(reader *r, yaml_node_t *n, const char *label, int nnodes, int *count) {
+  *count = 0;
+  if (n->type != YAML_SEQUENCE_NODE) {
+    error_at(r, loc_of(n), "%s: expected a list of node numbers, got %s", label, show_node(r, n));
+    return NULL;
+  }
+  int k = seq_length(n);
+  int *out = xcalloc((size_t)k + 1, sizeof *out);
+  for (int i = 0; i < k; i++) {
+    double v;
+    yaml_node_t *item = seq_item(r, n, i);
+    char item_label[SHOWN_SIZE];
+    snprintf(item_label, sizeof item_label, "item %d of %s", i + 1, label);
+    if (!to_number(r, item, item_label, &v)) continue;
+    if (v != floor(v) || v < 0 || (nnodes >= 0 && v >= nnodes)) {
+      error_at(r, loc_of(item), "%s: node %g does not exist (nodes are numbered 0 to %d)", label, v,
+               nnodes - 1);
+      continue;
+    }
+    out[(*count)++] = (int)v;
+  }
+  return out;
+}
+
+static const char *const theory_names[] = {"euler_bernoulli", "timoshenko", NULL};
+static const char *const mass_kind_names[] = {"lumped", "consistent", NULL};
+static const char *const coupling_names[] = {"full", "partial", "constant", "rigid", NULL};
+
+/* section and material of a beam (fields of ir_beam other than the nodes) */
+static void parse_beam_properties(reader *r, mapping *body, ir_beam *proto) {
+  yaml_node_t *n = map_require(body, "section", true, "a mapping {area, Iy, Iz, J, ...}");
+  if (n != NULL) {
+    mapping m;
+    if (map_open(&m, r, n, loc_of(n), "'section' of %s", body->what)) {
+      static const char *const keys[] = {"area", "Iy", "Iz", "J", "shear_y", "shear_z", "yaxis", NULL};
+      map_check_keys(&m, keys);
+      get_positive(&m, "area", true, &proto->A);
+      /* defaults: a solid circular section of that area */
+      proto->Iy = proto->Iz = proto->A * proto->A / (4 * PI);
+      proto->J = 2 * proto->Iy;
+      get_positive(&m, "Iy", false, &proto->Iy);
+      get_positive(&m, "Iz", false, &proto->Iz);
+      get_positive(&m, "J", false, &proto->J);
+      if (proto->theory == BEAM_TIMOSHENKO) proto->shear_y = proto->shear_z = 5.0 / 6.0;
+      get_positive(&m, "shear_y", false, &proto->shear_y);
+      get_positive(&m, "shear_z", false, &proto->shear_z);
+      if (proto->theory == BEAM_EULER_BERNOULLI) proto->shear_y = proto->shear_z = 0;
+      get_axis(&m, "yaxis", false, proto->yaxis);
+    }
+    map_close(&m);
+  }
+  n = map_require(body, "material", true, "a mapping {E, nu or G, density}");
+  if (n != NULL) {
+    mapping m;
+    if (map_open(&m, r, n, loc_of(n), "'material' of %s", body->what)) {
+      static const char *const keys[] = {"E", "G", "nu", "density", NULL};
+      map_check_keys(&m, keys);
+      get_positive(&m, "E", true, &proto->E);
+      get_positive(&m, "density", true, &proto->rho);
+      double nu = 0.3;
+      bool has_nu = get_number(&m, "nu", false, &nu);
+      if (has_nu && !(nu > -1 && nu < 0.5))
+        error_at(r, m.last_loc, "'nu' must lie between -1 and 0.5 (got %g)", nu);
+      proto->G = proto->E / (2 * (1 + nu));
+      if (map_has(&m, "G")) {
+        if (has_nu) error_at(r, m.loc, "give either 'G' or 'nu', not both");
+        get_positive(&m, "G", false, &proto->G);
+      }
+    }
+    map_close(&m);
+  }
+}
+
+/* A flexible body: an FE beam model (line generator or nodes and beams) or a
+ * modal data file, with reference conditions, mode selection, damping and
+ * coupling.  Node positions are global at t = 0; they are stored in body axes
+ * relative to the body frame origin. */
 static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
-  (void)b;
-  error_at(m->r, type_loc, "flexible bodies are not supported yet");
+  reader *r = m->r;
+  (void)type_loc;
+  static const char *const keys[] = {
+      "type",    "position",  "orientation", "velocity", "angular_velocity", "line",
+      "nodes",   "beams",     "section",     "material", "theory",           "mass",
+      "point_masses", "reference", "interface", "modes", "damping", "coupling", "modal_file", NULL};
+  map_check_keys(m, keys);
+  map_reject(m, "inertia", "flexible body '%s': its inertia comes from its FE model", b->name);
+  ir_flex *fx = xcalloc(1, sizeof *fx);
+  b->flex = fx;
+  fx->loc = b->loc;
+  fx->select = MODES_ALL;
+  fx->coupling = COUPLING_FULL;
+  yaml_node_t *orientation = map_get(m, "orientation");
+  if (orientation != NULL) parse_orientation(r, orientation, m->what, b->orientation);
+  get_vector(m, "velocity", 3, false, b->velocity);
+  get_vector(m, "angular_velocity", 3, false, b->angular_velocity);
+  int c;
+  if (get_choice(m, "coupling", "coupling", coupling_names, false, &c)) fx->coupling = (ir_coupling)c;
+
+  yaml_node_t *modal_file = map_get(m, "modal_file");
+  yaml_node_t *line = map_get(m, "line"), *nodes = map_get(m, "nodes");
+  double *global = NULL; /* node positions, global */
+  if (modal_file != NULL) {
+    static const char *const fe_only[] = {"line", "nodes", "beams", "section", "material",
+                                          "theory", "mass", "point_masses", "interface", NULL};
+    for (int i = 0; fe_only[i]; i++)
+      map_reject(m, fe_only[i], "flexible body '%s': '%s' does not go with 'modal_file'", b->name, fe_only[i]);
+    if (modal_file->type != YAML_SCALAR_NODE) {
+      error_at(r, loc_of(modal_file), "'modal_file' must be a file name (got %s)", show_node(r, modal_file));
+    } else {
+      /* relative to the model file's directory */
+      const char *slash = strrchr(r->path, '/');
+      const char *fname = scalar_text(modal_file);
+      size_t dl = (slash && fname[0] != '/') ? (size_t)(slash - r->path + 1) : 0;
+      fx->modal_file = xcalloc(dl + scalar_length(modal_file) + 1, 1);
+      memcpy(fx->modal_file, r->path, dl);
+      memcpy(fx->modal_file + dl, fname, scalar_length(modal_file));
+    }
+  } else if (line != NULL && nodes != NULL) {
+    error_at(r, loc_of(nodes), "give either 'line' or 'nodes', not both");
+  } else if (line == NULL && nodes == NULL) {
+    error_at(r, m->loc, "flexible body '%s' needs an FE model ('line' or 'nodes' and 'beams') or a 'modal_file'", b->name);
+  } else {
+    ir_beam proto;
+    memset(&proto, 0, sizeof proto);
+    int th = 0;
+    if (get_choice(m, "theory", "beam theory", theory_names, false, &th)) proto.theory = (ir_beam_theory)th;
+    int mk = 0;
+    if (get_choice(m, "mass", "mass matrix", mass_kind_names, false, &mk)) fx->mass = (ir_mass_kind)mk;
+    if (line != NULL) {
+      mapping lm;
+      if (map_open(&lm, r, line, loc_of(line), "'line' of %s", m->what)) {
+        static const char *const lkeys[] = {"from", "to", "elements", NULL};
+        map_check_keys(&lm, lkeys);
+        double p0[3], p1[3], ne = 0;
+        bool ok = get_vector(&lm, "from", 3, true, p0);
+        ok = get_vector(&lm, "to", 3, true, p1) && ok;
+        ok = get_positive(&lm, "elements", true, &ne) && ok;
+        if (ok && (ne != floor(ne) || ne > 100000)) {
+          error_at(r, lm.last_loc, "'elements' must be a whole number (got %g)", ne);
+          ok = false;
+        }
+        if (ok && distance3(p0, p1) <= ZERO_LENGTH) {
+          error_at(r, loc_of(line), "'line' has zero length");
+          ok = false;
+        }
+        if (ok) {
+          int n = (int)ne;
+          fx->nnodes = n + 1;
+          global = xcalloc(3 * (size_t)(n + 1), sizeof *global);
+          fx->node_loc = xcalloc((size_t)n + 1, sizeof *fx->node_loc);
+          for (int k = 0; k <= n; k++) {
+            for (int i = 0; i < 3; i++) global[3 * k + i] = p0[i] + (p1[i] - p0[i]) * k / n;
+            fx->node_loc[k] = loc_of(line);
+          }
+          fx->nbeams = n;
+          fx->beams = xcalloc((size_t)n, sizeof *fx->beams);
+          for (int e = 0; e < n; e++) {
+            fx->beams[e].node[0] = e;
+            fx->beams[e].node[1] = e + 1;
+            fx->beams[e].loc = loc_of(line);
+          }
+        }
+      }
+      map_close(&lm);
+      map_reject(m, "beams", "'beams' does not go with 'line' (the line makes its own elements)");
+    } else {
+      int n = nodes->type == YAML_SEQUENCE_NODE ? seq_length(nodes) : 0;
+      if (n < 2) {
+        error_at(r, loc_of(nodes), "'nodes': expected a list of at least 2 points [x, y, z]");
+      } else {
+        fx->nnodes = n;
+        global = xcalloc(3 * (size_t)n, sizeof *global);
+        fx->node_loc = xcalloc((size_t)n, sizeof *fx->node_loc);
+        for (int k = 0; k < n; k++) {
+          char label[64];
+          snprintf(label, sizeof label, "node %d", k);
+          yaml_node_t *item = seq_item(r, nodes, k);
+          to_vector(r, item, label, 3, global + 3 * k);
+          fx->node_loc[k] = loc_of(item);
+        }
+        yaml_node_t *beams = map_get(m, "beams");
+        if (beams == NULL) { /* consecutive nodes */
+          fx->nbeams = n - 1;
+          fx->beams = xcalloc((size_t)n, sizeof *fx->beams);
+          for (int e = 0; e < n - 1; e++) {
+            fx->beams[e].node[0] = e;
+            fx->beams[e].node[1] = e + 1;
+            fx->beams[e].loc = loc_of(nodes);
+          }
+        } else if (beams->type != YAML_SEQUENCE_NODE || seq_length(beams) < 1) {
+          error_at(r, loc_of(beams), "'beams': expected a list of node pairs [i, j]");
+        } else {
+          int ne = seq_length(beams);
+          fx->beams = xcalloc((size_t)ne, sizeof *fx->beams);
+          for (int e = 0; e < ne; e++) {
+            yaml_node_t *item = seq_item(r, beams, e);
+            char label[64];
+            snprintf(label, sizeof label, "beam %d", e + 1);
+            int cnt = 0;
+            int *pair = to_node_list(r, item, label, n, &cnt);
+            if (cnt == 2 && pair[0] != pair[1] && seq_length(item) == 2) {
+              fx->beams[fx->nbeams].node[0] = pair[0];
+              fx->beams[fx->nbeams].node[1] = pair[1];
+              fx->beams[fx->nbeams].loc = loc_of(item);
+              fx->nbeams++;
+            } else if (cnt == seq_length(item)) {
+              error_at(r, loc_of(item), "%s: expected two different node numbers [i, j]", label);
+            }
+            free(pair);
+          }
+        }
+      }
+    }
+    /* section and material: common to all beams */
+    proto.yaxis[1] = 1; /* default: global y, unless along the element (fixed below) */
+    bool yaxis_given = false;
+    {
+      yaml_node_t *sec = map_get(m, "section");
+      if (sec != NULL && sec->type == YAML_MAPPING_NODE) {
+        mapping probe;
+        if (map_open(&probe, r, sec, loc_of(sec), "'section'")) yaxis_given = map_has(&probe, "yaxis");
+        /* map_close of a probe would report nothing: keys are checked below */
+        free(probe.handled);
+      }
+    }
+    parse_beam_properties(r, m, &proto);
+    for (int e = 0; e < fx->nbeams; e++) {
+      ir_beam *bm = &fx->beams[e];
+      int nd[2] = {bm->node[0], bm->node[1]};
+      ir_loc loc = bm->loc;
+      *bm = proto;
+      bm->node[0] = nd[0];
+      bm->node[1] = nd[1];
+      bm->loc = loc;
+      if (global && !yaxis_given) {
+        /* a y axis across the element: global y, or global z for elements along y */
+        double d[3];
+        for (int i = 0; i < 3; i++) d[i] = global[3 * nd[1] + i] - global[3 * nd[0] + i];
+        double len = norm3(d);
+        if (len > 0 && fabs(d[1]) > 0.9 * len) { bm->yaxis[0] = bm->yaxis[1] = 0; bm->yaxis[2] = 1; }
+      }
+    }
+    yaml_node_t *pm = map_get(m, "point_masses");
+    if (pm != NULL) {
+      if (pm->type != YAML_SEQUENCE_NODE) {
+        error_at(r, loc_of(pm), "'point_masses': expected a list of {node, mass, inertia}");
+      } else {
+        int np = seq_length(pm);
+        fx->point_masses = xcalloc((size_t)np + 1, sizeof *fx->point_masses);
+        for (int i = 0; i < np; i++) {
+          yaml_node_t *item = seq_item(r, pm, i);
+          mapping pmm;
+          if (map_open(&pmm, r, item, loc_of(item), "point mass %d of %s", i + 1, m->what)) {
+            static const char *const pkeys[] = {"node", "mass", "inertia", NULL};
+            map_check_keys(&pmm, pkeys);
+            ir_point_mass *p = &fx->point_masses[fx->npoint_masses];
+            double node = -1;
+            p->loc = loc_of(item);
+            if (get_number(&pmm, "node", true, &node) &&
+                (node != floor(node) || node < 0 || node >= fx->nnodes))
+              error_at(r, pmm.last_loc, "node %g does not exist (nodes are numbered 0 to %d)", node, fx->nnodes - 1);
+            else
+              p->node = (int)node;
+            get_nonnegative(&pmm, "mass", true, &p->mass);
+            yaml_node_t *in = map_get(&pmm, "inertia");
+            if (in != NULL) parse_inertia(r, in, p->inertia);
+            fx->npoint_masses++;
+          }
+          map_close(&pmm);
+        }
+      }
+    }
+  }
+
+  /* reference conditions and Craig-Bampton interface */
+  int nn = modal_file ? -1 : fx->nnodes;
+  yaml_node_t *ref = map_get(m, "reference");
+  if (ref != NULL) {
+    fx->reference = to_node_list(r, ref, "'reference'", nn, &fx->nreference);
+  } else if (!modal_file) {
+    fx->reference = xcalloc(1, sizeof *fx->reference);
+    fx->nreference = 1; /* node 0 */
+  }
+  yaml_node_t *itf = map_get(m, "interface");
+  if (itf != NULL) fx->interface = to_node_list(r, itf, "'interface'", nn, &fx->ninterface);
+
+  /* body frame: the given position, or the first reference node */
+  bool has_position = get_vector(m, "position", 3, false, b->position);
+  if (!has_position && global && fx->nreference > 0)
+    memcpy(b->position, global + 3 * fx->reference[0], sizeof b->position);
+  if (global) {
+    double A[9];
+    quaternion_to_matrix(b->orientation, A);
+    fx->nodes = xcalloc(3 * (size_t)fx->nnodes, sizeof *fx->nodes);
+    for (int k = 0; k < fx->nnodes; k++) {
+      double d[3];
+      for (int i = 0; i < 3; i++) d[i] = global[3 * k + i] - b->position[i];
+      for (int i = 0; i < 3; i++)
+        fx->nodes[3 * k + i] = A[i] * d[0] + A[3 + i] * d[1] + A[6 + i] * d[2];
+    }
+    /* beam y axes are given globally too */
+    for (int e = 0; e < fx->nbeams; e++) {
+      double y[3];
+      memcpy(y, fx->beams[e].yaxis, sizeof y);
+      for (int i = 0; i < 3; i++)
+        fx->beams[e].yaxis[i] = A[i] * y[0] + A[3 + i] * y[1] + A[6 + i] * y[2];
+    }
+    free(global);
+  }
+
+  /* mode selection */
+  yaml_node_t *modes = map_get(m, "modes");
+  if (modes != NULL) {
+    if (modes->type == YAML_SCALAR_NODE && scalar_equals(modes, "all")) {
+      fx->select = MODES_ALL;
+    } else if (modes->type == YAML_SCALAR_NODE) {
+      double k;
+      if (to_number(r, modes, "'modes'", &k)) {
+        if (k != floor(k) || k < 1) error_at(r, loc_of(modes), "'modes' must be a positive whole number, 'all' or a mapping (got %g)", k);
+        fx->select = MODES_COUNT;
+        fx->count = (int)k;
+      }
+    } else {
+      mapping mm;
+      if (map_open(&mm, r, modes, loc_of(modes), "'modes' of %s", m->what)) {
+        static const char *const mkeys[] = {"count", "max_frequency", "list", NULL};
+        map_check_keys(&mm, mkeys);
+        double v;
+        if (map_has(&mm, "count") + map_has(&mm, "max_frequency") + map_has(&mm, "list") != 1)
+          error_at(r, loc_of(modes), "'modes' takes exactly one of 'count', 'max_frequency', 'list'");
+        if (get_positive(&mm, "count", false, &v)) { fx->select = MODES_COUNT; fx->count = (int)v; }
+        if (get_positive(&mm, "max_frequency", false, &v)) { fx->select = MODES_MAX_FREQUENCY; fx->max_frequency = v; }
+        yaml_node_t *l = map_get(&mm, "list");
+        if (l != NULL) {
+          fx->select = MODES_LIST;
+          fx->list = to_node_list(r, l, "'list' of modes", -1, &fx->nlist);
+          for (int i = 0; i < fx->nlist; i++)
+            if (fx->list[i] < 1) error_at(r, loc_of(l), "mode numbers start at 1");
+        }
+      }
+      map_close(&mm);
+    }
+  }
+  /* modal damping */
+  yaml_node_t *damp = map_get(m, "damping");
+  if (damp != NULL) {
+    if (damp->type == YAML_SCALAR_NODE && scalar_equals(damp, "bands")) {
+      fx->damping = DAMPING_BANDS;
+    } else if (damp->type == YAML_SCALAR_NODE && scalar_equals(damp, "none")) {
+      fx->damping = DAMPING_NONE;
+    } else if (damp->type == YAML_SEQUENCE_NODE) {
+      fx->damping = DAMPING_LIST;
+      fx->nratios = seq_length(damp);
+      fx->ratios = xcalloc((size_t)fx->nratios + 1, sizeof *fx->ratios);
+      for (int i = 0; i < fx->nratios; i++) {
+        char label[64];
+        snprintf(label, sizeof label, "item %d of 'damping'", i + 1);
+        if (to_number(r, seq_item(r, damp, i), label, &fx->ratios[i]) && fx->ratios[i] < 0)
+          error_at(r, loc_of(seq_item(r, damp, i)), "%s must be >= 0", label);
+      }
+    } else if (to_number(r, damp, "'damping' (a ratio, 'bands', 'none' or a list)", &fx->ratio)) {
+      fx->damping = DAMPING_RATIO;
+      if (fx->ratio < 0) error_at(r, loc_of(damp), "'damping' must be >= 0 (got %g)", fx->ratio);
+    }
+  }
+}
+
+/* global position of node k of flexible body b */
+static void node_global(const ir_body *b, int k, double out[3]) {
+  double A[9];
+  quaternion_to_matrix(b->orientation, A);
+  const double *x = b->flex->nodes + 3 * k;
+  for (int i = 0; i < 3; i++) out[i] = b->position[i] + A[3 * i] * x[0] + A[3 * i + 1] * x[1] + A[3 * i + 2] * x[2];
 }
 
 static void parse_body(reader *r, yaml_node_t *key, yaml_node_t *value) {
@@ -1184,20 +1642,29 @@ static void parse_joint(reader *r, yaml_node_t *key, yaml_node_t *value) {
   }
   j->kind = (ir_joint_kind)type;
   map_describe(&m, "%s joint '%s'", joint_type_names[type], j->name);
-  reject_fe_nodes(&m);
 
-  static const char *const distance_keys[] = {"type", "bodies", "points", NULL};
+  static const char *const distance_keys[] = {"type", "bodies", "points", "node", "nodes", NULL};
   static const char *const universal_keys[] = {"type", "bodies", "point", "axes", "reference",
-                                               NULL};
-  static const char *const axis_keys[] = {"type", "bodies", "point", "axis", "reference", NULL};
+                                               "node", "nodes", NULL};
+  static const char *const axis_keys[] = {"type", "bodies", "point", "axis", "reference", "node",
+                                          "nodes", NULL};
   map_check_keys(&m, j->kind == JOINT_DISTANCE    ? distance_keys
                      : j->kind == JOINT_UNIVERSAL ? universal_keys
                                                   : axis_keys);
-  get_body_pair(&m, j->body, j->body_loc);
+  bool on_nodes = false;
+  if (get_body_pair(&m, j->body, j->body_loc))
+    on_nodes = get_fe_nodes(&m, j->body, j->node);
 
   if (j->kind == JOINT_DISTANCE) {
-    yaml_node_t *n = map_require(&m, "points", true, "a list of 2 points [x, y, z]");
-    if (n != NULL && to_vector_list(r, n, "'points'", 2, 3, &j->point[0][0])) {
+    yaml_node_t *n = map_require(&m, "points", !on_nodes, "a list of 2 points [x, y, z]");
+    bool given = n != NULL && to_vector_list(r, n, "'points'", 2, 3, &j->point[0][0]);
+    if (on_nodes) {
+      /* a side on a node without 'points': the node; the other side needs the points */
+      if (!given && (j->node[0] < 0 || j->node[1] < 0))
+        error_at(r, j->loc, "distance joint '%s' needs 'points' for its side that is not on a node", j->name);
+      check_node_point(r, model, n ? loc_of(n) : j->loc, j->body, j->node, given, &j->point[0][0]);
+    }
+    if (given || on_nodes) {
       double d[3];
       for (int i = 0; i < 3; i++)
         d[i] = j->point[1][i] - j->point[0][i];
@@ -1215,8 +1682,14 @@ static void parse_joint(reader *r, yaml_node_t *key, yaml_node_t *value) {
     return;
   }
 
-  if (get_vector(&m, "point", 3, true, j->point[0]))
+  bool point_given = get_vector(&m, "point", 3, !on_nodes, j->point[0]);
+  if (point_given)
     memcpy(j->point[1], j->point[0], sizeof j->point[0]);
+  if (on_nodes) {
+    check_node_point(r, model, point_given ? m.loc : j->loc, j->body, j->node, point_given, &j->point[0][0]);
+    if (!point_given) /* both sides at the node that was given */
+      memcpy(j->point[j->node[0] >= 0 ? 1 : 0], j->point[j->node[0] >= 0 ? 0 : 1], sizeof j->point[0]);
+  }
 
   if (j->kind == JOINT_UNIVERSAL) {
     yaml_node_t *n = map_require(&m, "axes", true, "a list of 2 perpendicular axes");
@@ -1479,14 +1952,17 @@ static void get_six(mapping *m, const char *key, bool required, bool nonnegative
 static void parse_point_load(mapping *m, ir_force *f) {
   reader *r = m->r;
   static const char *const force_keys[] = {"type",  "body",  "point", "value",
-                                           "frame", "scale", NULL};
-  static const char *const torque_keys[] = {"type", "body", "value", "frame", "scale", NULL};
+                                           "frame", "scale", "node", NULL};
+  static const char *const torque_keys[] = {"type", "body", "value", "frame", "scale", "node", NULL};
   bool is_force = f->kind == FORCE_POINT_FORCE;
   map_check_keys(m, is_force ? force_keys : torque_keys);
-  if (get_ref(m, "body", NAME_BODY, true, &f->body[0], &f->body_loc[0]))
+  bool on_node = false;
+  if (get_ref(m, "body", NAME_BODY, true, &f->body[0], &f->body_loc[0])) {
     memcpy(f->point[0], r->model->bodies[f->body[0]].position, sizeof f->point[0]);
-  if (is_force)
-    get_vector(m, "point", 3, false, f->point[0]);
+    on_node = get_fe_nodes(m, f->body, f->node);
+  }
+  bool given = is_force && get_vector(m, "point", 3, false, f->point[0]);
+  if (on_node) check_node_point(r, r->model, m->loc, f->body, f->node, given, &f->point[0][0]);
   get_vector(m, "value", 3, true, f->vector);
   int frame = FRAME_GLOBAL;
   if (get_choice(m, "frame", "frame", frame_names, false, &frame))
@@ -1502,15 +1978,17 @@ static void parse_point_load(mapping *m, ir_force *f) {
 static void parse_spring_damper(mapping *m, ir_force *f) {
   reader *r = m->r;
   static const char *const keys[] = {"type",    "bodies",      "points",  "stiffness",
-                                     "damping", "free_length", "preload", NULL};
+                                     "damping", "free_length", "preload", "node", "nodes", NULL};
   map_check_keys(m, keys);
-  get_body_pair(m, f->body, f->body_loc);
-  yaml_node_t *points = map_require(m, "points", true, "a list of 2 points [x, y, z]");
-  bool have_points = false;
-  if (points != NULL && to_vector_list(r, points, "'points'", 2, 3, &f->point[0][0])) {
+  bool on_nodes = get_body_pair(m, f->body, f->body_loc) && get_fe_nodes(m, f->body, f->node);
+  bool all_nodes = f->node[0] >= 0 && f->node[1] >= 0;
+  yaml_node_t *points = map_require(m, "points", !all_nodes, "a list of 2 points [x, y, z]");
+  bool have_points = false, given = points != NULL && to_vector_list(r, points, "'points'", 2, 3, &f->point[0][0]);
+  if (on_nodes) check_node_point(r, r->model, points ? loc_of(points) : m->loc, f->body, f->node, given, &f->point[0][0]);
+  if (given || all_nodes) {
     have_points = distance3(f->point[0], f->point[1]) > ZERO_LENGTH;
     if (!have_points)
-      error_at(r, loc_of(points),
+      error_at(r, points ? loc_of(points) : m->loc,
                "spring_damper end points coincide (the line of action would be undefined)");
   }
   bool has_law = false;
@@ -1539,11 +2017,17 @@ static void parse_spring_damper(mapping *m, ir_force *f) {
 static void parse_bushing(mapping *m, ir_force *f) {
   reader *r = m->r;
   static const char *const keys[] = {"type",    "bodies",  "point", "stiffness",
-                                     "damping", "preload", "axes",  NULL};
+                                     "damping", "preload", "axes",  "node", "nodes", NULL};
   map_check_keys(m, keys);
-  get_body_pair(m, f->body, f->body_loc);
-  if (get_vector(m, "point", 3, true, f->point[0]))
+  bool on_nodes = get_body_pair(m, f->body, f->body_loc) && get_fe_nodes(m, f->body, f->node);
+  bool given = get_vector(m, "point", 3, !on_nodes, f->point[0]);
+  if (given)
     memcpy(f->point[1], f->point[0], sizeof f->point[0]);
+  if (on_nodes) {
+    check_node_point(r, r->model, m->loc, f->body, f->node, given, &f->point[0][0]);
+    if (!given)
+      memcpy(f->point[f->node[0] >= 0 ? 1 : 0], f->point[f->node[0] >= 0 ? 0 : 1], sizeof f->point[0]);
+  }
   get_six(m, "stiffness", true, true, f->k6);
   get_six(m, "damping", false, true, f->c6);
   get_six(m, "preload", false, false, f->preload6);
@@ -1582,9 +2066,7 @@ static void parse_force(reader *r, yaml_node_t *key, yaml_node_t *value) {
   f->node[0] = f->node[1] = -1;
   f->active = true;
   f->axes[0] = f->axes[4] = f->axes[8] = 1;
-  f->scale.kind = PROFILE_CONSTANT; /* absent scale: constant 1 */
-  f->scale.c[0] = 1;
-  f->scale.nc = 1;
+  f->scale.kind = PROFILE_NONE; /* absent: constant 1, and no work for later stages */
   f->scale.loc = f->loc;
 
   mapping m;
@@ -1594,7 +2076,6 @@ static void parse_force(reader *r, yaml_node_t *key, yaml_node_t *value) {
   if (get_choice(&m, "type", "force type", force_type_names, true, &type)) {
     f->kind = (ir_force_kind)type;
     map_describe(&m, "%s '%s'", force_type_names[type], f->name);
-    reject_fe_nodes(&m);
     switch (f->kind) {
     case FORCE_POINT_FORCE:
     case FORCE_POINT_TORQUE:
@@ -1618,13 +2099,15 @@ static void parse_force(reader *r, yaml_node_t *key, yaml_node_t *value) {
 static const char *const output_type_names[] = {
     "position",     "orientation",          "angle",    "velocity",       "angular_velocity",
     "acceleration", "angular_acceleration", "reaction", "effort",         "kinetic_energy",
-    "potential_energy", "total_energy",     NULL};
+    "potential_energy", "total_energy",     "deflection", "modal", "momentum", NULL};
 static const char *const component_names[] = {"x", "y", "z", NULL};
 
 static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_outputs,
                          ir_output *o) {
   o->loc = loc_of(n);
   o->body = o->joint = o->driver = o->node = -1;
+  o->chord[0] = o->chord[1] = -1;
+  o->mode = -1;
   o->component = -1;
   o->scale = 1;
 
@@ -1646,12 +2129,11 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
   }
   o->kind = (ir_output_kind)type;
   map_describe(&m, "%s output '%s'", output_type_names[type], o->name ? o->name : "?");
-  reject_fe_nodes(&m);
 
   ir_output_kind k = o->kind;
-  bool of_body = k <= OUT_ANGULAR_ACCELERATION;
+  bool of_body = k <= OUT_ANGULAR_ACCELERATION || k == OUT_DEFLECTION || k == OUT_MODAL;
   bool has_point = k == OUT_POSITION || k == OUT_VELOCITY || k == OUT_ACCELERATION;
-  bool has_component = of_body && k != OUT_ORIENTATION && k != OUT_ANGLE;
+  bool has_component = of_body && k != OUT_ORIENTATION && k != OUT_ANGLE && k != OUT_MODAL;
   const char *keys[10];
   int nkeys = 0;
   keys[nkeys++] = "name";
@@ -1668,6 +2150,12 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
     keys[nkeys++] = "joint";
   if (k == OUT_EFFORT)
     keys[nkeys++] = "driver";
+  if (k == OUT_DEFLECTION) {
+    keys[nkeys++] = "node";
+    keys[nkeys++] = "chord";
+  }
+  if (k == OUT_MODAL)
+    keys[nkeys++] = "mode";
   keys[nkeys++] = "scale";
   keys[nkeys] = NULL;
   map_check_keys(&m, keys);
@@ -1684,6 +2172,28 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
     get_ref(&m, "joint", NAME_JOINT, true, &o->joint, NULL);
   if (k == OUT_EFFORT)
     get_ref(&m, "driver", NAME_DRIVER, true, &o->driver, NULL);
+  if ((k == OUT_DEFLECTION || k == OUT_MODAL) && o->body >= 0 &&
+      r->model->bodies[o->body].kind != BODY_FLEXIBLE) {
+    error_at(r, m.loc, "%s output '%s' needs a flexible body ('%s' is not)", output_type_names[k],
+             o->name ? o->name : "?", r->model->bodies[o->body].name);
+  } else if (k == OUT_DEFLECTION && o->body >= 0) {
+    const ir_body *b = &r->model->bodies[o->body];
+    yaml_node_t *nd = map_require(&m, "node", true, "a node number");
+    if (nd != NULL) o->node = to_fe_node(r, nd, b);
+    yaml_node_t *ch = map_get(&m, "chord");
+    if (ch != NULL) {
+      if (ch->type != YAML_SEQUENCE_NODE || seq_length(ch) != 2)
+        error_at(r, loc_of(ch), "'chord': expected [K0, K1], two node numbers");
+      else
+        for (int i = 0; i < 2; i++) o->chord[i] = to_fe_node(r, seq_item(r, ch, i), b);
+    }
+  } else if (k == OUT_MODAL) {
+    double mode;
+    if (get_positive(&m, "mode", true, &mode)) {
+      if (mode != floor(mode)) error_at(r, m.last_loc, "'mode' must be a mode number (1, 2, ...)");
+      o->mode = (int)mode - 1;
+    }
+  }
   get_number(&m, "scale", false, &o->scale);
   map_close(&m);
 }
@@ -1739,6 +2249,7 @@ enum {
 typedef enum { FROM_DEFAULT, FROM_BASE, FROM_SCENE } sim_source;
 
 typedef struct {
+  yaml_node_t *jof_list;    /* joints_on_flexible given as a list of joint names */
   double value[SIM_FIELDS]; /* choices hold their index */
   sim_source source[SIM_FIELDS];
   ir_loc loc[SIM_FIELDS];
@@ -1807,8 +2318,17 @@ static void parse_sim(reader *r, yaml_node_t *n, const char *what, sim_source so
   }
   static const char *const *const choices[] = {integrator_names, solver_names,
                                                stabilization_names, jof_names};
+  yaml_node_t *jof = map_get(&m, "joints_on_flexible");
+  if (jof != NULL && jof->type == YAML_SEQUENCE_NODE) {
+    s->jof_list = jof;
+    sim_set(s, SIM_JOINTS_ON_FLEXIBLE, JOF_LIST, source, loc_of(jof));
+  } else if (jof != NULL) {
+    s->jof_list = NULL;
+  }
   for (int field = SIM_INTEGRATOR; field < SIM_FIELDS; field++) {
     int choice;
+    if (field == SIM_JOINTS_ON_FLEXIBLE && jof != NULL && jof->type == YAML_SEQUENCE_NODE)
+      continue;
     if (get_choice(&m, sim_keys[field], sim_keys[field], choices[field - SIM_INTEGRATOR], false,
                    &choice))
       sim_set(s, field, choice, source, m.last_loc);
@@ -1961,6 +2481,7 @@ static void parse_scene(reader *r, yaml_node_t *key, yaml_node_t *value,
   s->driver_off = driver_off;
   s->force_off = force_off;
   s->sim = merged;
+  s->jof_list = sim.jof_list;
 }
 
 /* Every scene is validated; the one named 'chosen' is kept in r->scene. */
@@ -1996,6 +2517,33 @@ static void report_unknown_scene(reader *r, yaml_node_t *scenes, const char *cho
              "unknown scene '%s' (the model defines no scenes)", shown);
   else
     error_at(r, loc_of(scenes), "unknown scene '%s' (expected one of: %s)", shown, l.text);
+}
+
+/* joints on flexible nodes lowered through virtual bodies: all of them
+ * (joints_on_flexible: virtual) or those listed */
+static void mark_virtual_joints(reader *r, yaml_node_t *list) {
+  ir_model *model = r->model;
+  if (model->sim.joints_on_flexible == JOF_VIRTUAL)
+    for (int j = 0; j < model->njoints; j++)
+      model->joints[j].via_virtual = model->joints[j].node[0] >= 0 || model->joints[j].node[1] >= 0;
+  if (model->sim.joints_on_flexible != JOF_LIST || list == NULL)
+    return;
+  for (int i = 0; i < seq_length(list); i++) {
+    yaml_node_t *item = seq_item(r, list, i);
+    int j = -1;
+    if (item->type == YAML_SCALAR_NODE)
+      for (int k = 0; k < model->njoints; k++)
+        if (model->joints[k].name && scalar_equals(item, model->joints[k].name)) j = k;
+    if (j < 0) {
+      error_at(r, loc_of(item), "'joints_on_flexible': expected 'direct', 'virtual' or a list of joint names (%s is not a joint)", show_node(r, item));
+      continue;
+    }
+    if (model->joints[j].node[0] < 0 && model->joints[j].node[1] < 0) {
+      error_at(r, loc_of(item), "'joints_on_flexible': joint '%s' is not on an FE node", model->joints[j].name);
+      continue;
+    }
+    model->joints[j].via_virtual = true;
+  }
 }
 
 static void apply_scene(ir_model *model, chosen_scene *s) {
@@ -2142,9 +2690,11 @@ static void parse_model(reader *r, yaml_node_t *root, const char *chosen_scene_n
 
   /* last: replacing the outputs frees names the name table refers to */
   table_free(&r->names);
+  yaml_node_t *jof_list = r->scene.found ? r->scene.jof_list : base_sim.jof_list;
   if (r->scene.found)
     apply_scene(model, &r->scene);
   check_drivers(r);
+  mark_virtual_joints(r, jof_list);
 }
 
 /* ---------------------------------------------------------------------------
@@ -2278,14 +2828,31 @@ ir_model *ir_read(const char *path, const char *scene) {
   return model;
 }
 
+static void free_flex(ir_flex *fx) {
+  if (fx == NULL)
+    return;
+  free(fx->nodes);
+  free(fx->node_loc);
+  free(fx->beams);
+  free(fx->point_masses);
+  free(fx->reference);
+  free(fx->interface);
+  free(fx->modal_file);
+  free(fx->list);
+  free(fx->ratios);
+  free(fx);
+}
+
 void ir_free(ir_model *m) {
   if (m == NULL)
     return;
   free(m->path);
   free(m->name);
   free(m->scene);
-  for (int i = 0; i < m->nbodies; i++)
-    free(m->bodies[i].name); /* flex is always NULL until flexible bodies exist */
+  for (int i = 0; i < m->nbodies; i++) {
+    free(m->bodies[i].name);
+    free_flex(m->bodies[i].flex);
+  }
   free(m->bodies);
   for (int i = 0; i < m->njoints; i++)
     free(m->joints[i].name);

@@ -406,6 +406,35 @@ void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_r
       val[0] = q[B->qadr + 7 + o->node];
       break;
     }
+    case MB_OUT_MOMENTUM:
+      /* linear momentum and angular momentum about the global origin */
+      for (int b = 0; b < m->nbody; b++) {
+        const mb_body *B = &m->body[b];
+        mb_real p[3], h[3], Ah[3], rp[3];
+        if (B->kind == MB_BODY_FLEXIBLE) {
+          int nb = 6 + B->nm;
+          mb_real Mb[(6 + MB_MAX_MODES) * (6 + MB_MAX_MODES)], fb[6 + MB_MAX_MODES];
+          static const mb_real zero[3] = {0, 0, 0};
+          const mb_real *vb = v + B->vadr;
+          mb_flex_body(B->flex, &F[b], q + B->qadr + 7, vb + 6, zero, Mb, fb);
+          for (int i = 0; i < 3; i++) {
+            p[i] = h[i] = 0;
+            for (int l = 0; l < nb; l++) {
+              p[i] += Mb[nb * i + l] * vb[l];
+              h[i] += Mb[nb * (3 + i) + l] * vb[l];
+            }
+          }
+          /* h holds S~ A^T rd + J w' + M_thf wd: momentum about the frame origin, body axes */
+        } else {
+          for (int i = 0; i < 3; i++) p[i] = B->mass * F[b].rd[i];
+          mb_mul3(B->J, F[b].wl, h);
+        }
+        mb_mul3(F[b].A, h, Ah);
+        mb_cross3(F[b].r, p, rp);
+        for (int i = 0; i < 3; i++) { val[i] += p[i]; val[3 + i] += rp[i] + Ah[i]; }
+      }
+      nval = 6;
+      break;
     case MB_OUT_KINETIC_ENERGY: val[0] = kin; nval = 1; break;
     case MB_OUT_POTENTIAL_ENERGY: val[0] = pot; nval = 1; break;
     case MB_OUT_TOTAL_ENERGY: val[0] = kin + pot; nval = 1; break;

@@ -1,12 +1,15 @@
 #!/bin/sh
-# check_bad_models.sh: every tests/bad_models/*.yaml must be rejected with
-# exactly one error whose text contains its "# expect:" line and, if given,
-# at its "# expect-loc: LINE:COL".
+# check_bad_models.sh: the reader alone (tests/check_reader.c) on
+# tests/bad_models/*.yaml.  A model it rejects must get exactly one error,
+# containing its "# expect:" line and, if given, at its "# expect-loc:
+# LINE:COL".  Models it accepts hold errors for later stages (assembly...):
+# they are listed, not failed; tests/test_bad_models.c checks them via mbcc.
 # Usage: tests/check_bad_models.sh CHECK_READER_BINARY
 reader=${1:?usage: $0 path/to/check_reader}
 dir=$(dirname "$0")/bad_models
 failed=0
 total=0
+later=0
 for model in "$dir"/*.yaml; do
   total=$((total + 1))
   expect=$(sed -n 's/^# expect: //p' "$model" | head -n 1)
@@ -16,7 +19,11 @@ for model in "$dir"/*.yaml; do
   errors=$(printf '%s\n' "$stderr" | grep -c ': error: ')
   line=$(printf '%s\n' "$stderr" | grep ': error: ' | head -n 1)
   problem=""
-  if [ "$status" -ne 2 ]; then
+  if [ "$status" -eq 0 ]; then
+    later=$((later + 1))
+    echo "later stage: $model"
+    continue
+  elif [ "$status" -ne 2 ]; then
     problem="exit status $status, expected 2"
   elif [ "$errors" -ne 1 ]; then
     problem="$errors errors, expected 1"
@@ -30,5 +37,5 @@ for model in "$dir"/*.yaml; do
     printf 'FAIL %s: %s\n%s\n' "$model" "$problem" "$stderr"
   fi
 done
-echo "bad models: $((total - failed))/$total passed"
+echo "bad models: $((total - failed - later))/$((total - later)) rejected by the reader as expected, $later left to later stages"
 [ "$failed" -eq 0 ]

@@ -20,11 +20,16 @@ model_path() {
 }
 
 declare -A compiled
+# "model" or "model@scene"; the generated code is named model or model_scene
+gen_name() { if [[ $1 == *@* ]]; then echo "${1%@*}_${1#*@}"; else echo "$1"; fi; }
 compile_model() {
-  local m=$1
-  [ -n "${compiled[$m]:-}" ] && return 0
-  "$B/mbcc" compile "$(model_path "$m")" -o "$B/gen/$m" >/dev/null || return 1
-  compiled[$m]=1
+  local m=$1 base=${1%@*} g
+  g=$(gen_name "$m")
+  [ -n "${compiled[$g]:-}" ] && return 0
+  local scene=()
+  [[ $m == *@* ]] && scene=(--scene "${m#*@}")
+  "$B/mbcc" compile "$(model_path "$base")" "${scene[@]}" -o "$B/gen/$g" >/dev/null || return 1
+  compiled[$g]=1
 }
 
 for t in tests/test_*.c; do
@@ -34,7 +39,8 @@ for t in tests/test_*.c; do
   ok=1
   for m in $models; do
     if ! compile_model "$m"; then echo "FAIL $name: mbcc could not compile model $m"; ok=0; fi
-    srcs+=("$B/gen/$m/$m.c"); incs+=("-I$B/gen/$m")
+    g=$(gen_name "$m")
+    srcs+=("$B/gen/$g/$g.c"); incs+=("-I$B/gen/$g")
   done
   if [ $ok = 1 ] && ! $CC -std=c11 -Wall -Wextra -Werror $CFLAGS -Iruntime -Icompiler -Itests "${incs[@]}" \
         "$t" "${srcs[@]}" tests/support.c "$B/libmbrt.a" $LIBS -o "$B/tests/$name" 2> "$B/tests/$name.build.log"; then

@@ -3,7 +3,7 @@
  * joint type and driver profile; generalized spring forces against finite
  * differences of the potential energy; M and the gyroscopic forces against
  * hand-derived values; the generated evaluation against the generic one. */
-// models: fd_all fd_springs spatial_joints slider_crank
+// models: fd_all fd_springs spatial_joints slider_crank slider_crank_flexible slider_crank_flexible@virtual2 free_flexible
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,6 +13,9 @@
 #include "fd_springs.h"
 #include "spatial_joints.h"
 #include "slider_crank.h"
+#include "slider_crank_flexible.h"
+#include "slider_crank_flexible_virtual2.h"
+#include "free_flexible.h"
 
 typedef struct {
   const mb_model *m;
@@ -48,6 +51,28 @@ static void dense_D(const mb_model *m, const double *Kx, double *D) {
       if (m->Ki[p] >= m->nv) D[(size_t)(m->Ki[p] - m->nv) * (size_t)m->nv + (size_t)c] = Kx[p];
 }
 
+/* the largest nodal displacement or rotation of mode j per unit modal coordinate */
+static double shape_scale(const mb_body *B, int j) {
+  double mx = 1e-300;
+  const mb_flex *f = B->flex;
+  for (int k = 0; k < f->nnode; k++)
+    for (int i = 0; i < 3; i++) {
+      mx = fmax(mx, fabs(f->node_X[3 * (k * f->nm + j) + i]));
+      mx = fmax(mx, fabs(f->node_Psi[3 * (k * f->nm + j) + i]));
+    }
+  return mx;
+}
+
+/* the finite-difference step of velocity coordinate i: 1e-6 of a unit
+   translation or rotation, and likewise for a modal coordinate */
+static double fd_step(const mb_model *m, int i) {
+  for (int b = 0; b < m->nbody; b++) {
+    const mb_body *B = &m->body[b];
+    if (i >= B->vadr + 6 && i < B->vadr + 6 + B->nm) return 1e-6 / shape_scale(B, i - B->vadr - 6);
+  }
+  return 1e-6;
+}
+
 /* a random state: positions in [-1, 1], unit Euler parameters, velocities in [-2, 2] */
 static void random_state(const mb_model *m, double *q, double *v) {
   for (int b = 0; b < m->nbody; b++) {
@@ -55,8 +80,12 @@ static void random_state(const mb_model *m, double *q, double *v) {
     for (int j = 0; j < 3; j++) qb[j] = urand(-1, 1);
     for (int j = 0; j < 4; j++) { qb[3 + j] = urand(-1, 1); n += qb[3 + j] * qb[3 + j]; }
     for (int j = 0; j < 4; j++) qb[3 + j] /= sqrt(n);
+    for (int j = 0; j < m->body[b].nm; j++) /* modal amplitudes: shape-scaled deformations of ~1e-2 */
+      qb[7 + j] = urand(-1e-2, 1e-2) / shape_scale(&m->body[b], j);
   }
   for (int j = 0; j < m->nv; j++) v[j] = urand(-2, 2);
+  for (int b = 0; b < m->nbody; b++) /* modal rates: deformation rates of ~1 per second */
+    for (int j = 0; j < m->body[b].nm; j++) v[m->body[b].vadr + 6 + j] /= shape_scale(&m->body[b], j);
 }
 
 /* q (+) s dv */
@@ -97,6 +126,7 @@ static void check_constraints(const mb_model *m, int trials) {
     for (int j = 0; j < nv; j++) {
       memset(ej, 0, sizeof(double) * (size_t)nv);
       ej[j] = 1;
+      double h = fd_step(m, j);
       moved(m, q, ej, h, qp);
       moved(m, q, ej, -h, qm);
       ev(&e, t, qp, v);
@@ -104,8 +134,9 @@ static void check_constraints(const mb_model *m, int trials) {
       ev(&e, t, qm, v);
       memcpy(phim, e.phi, sizeof(double) * (size_t)nc);
       for (int r = 0; r < nc; r++) {
+        /* errors relative to the row's scale along this coordinate */
         double fd = (phip[r] - phim[r]) / (2 * h), an = D[(size_t)r * (size_t)nv + (size_t)j];
-        double err = fabs(fd - an) / (1 + fabs(an));
+        double err = fabs(fd - an) * h / 1e-6 / (1 + fabs(an) * h / 1e-6);
         if (err > worst_D) worst_D = err;
         if (err > 1e-7) print_error("%s: D[%d][%d] = %.12g, finite difference %.12g\n", m->name, r, j, an, fd);
       }
@@ -164,6 +195,13 @@ static void test_constraints_shipped(void **state) {
   (void)state;
   check_constraints(&spatial_joints_model, 3);
   check_constraints(&slider_crank_model, 3);
+}
+
+/* rows on flexible nodes (direct) and through virtual bodies */
+static void test_constraints_flexible(void **state) {
+  (void)state;
+  check_constraints(&slider_crank_flexible_model, 3);
+  check_constraints(&slider_crank_flexible_virtual2_model, 3);
 }
 
 /* generalized forces of conservative elements = -dU/dq (v = 0: no damping, no gyroscopic terms) */
@@ -228,8 +266,10 @@ static void test_mass_and_gyroscopic(void **state) {
 /* the generated code and the generic table walk give the same numbers */
 static void test_generated_equals_generic(void **state) {
   (void)state;
-  const mb_model *models[] = {&fd_all_model, &fd_springs_model, &spatial_joints_model, &slider_crank_model};
-  for (int k = 0; k < 4; k++) {
+  const mb_model *models[] = {&fd_all_model, &fd_springs_model, &spatial_joints_model, &slider_crank_model,
+                              &slider_crank_flexible_model, &slider_crank_flexible_virtual2_model,
+                              &free_flexible_model};
+  for (int k = 0; k < 7; k++) {
     const mb_model *m = models[k];
     mb_model g = generic_twin(m);
     evaluator a, b;
@@ -261,6 +301,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_constraints_all_joints),
       cmocka_unit_test(test_constraints_shipped),
+      cmocka_unit_test(test_constraints_flexible),
       cmocka_unit_test(test_spring_forces),
       cmocka_unit_test(test_mass_and_gyroscopic),
       cmocka_unit_test(test_generated_equals_generic),

@@ -1,0 +1,1294 @@
+/* fe.c: 3D beam finite elements (Euler-Bernoulli and Timoshenko stiffness,
+ * consistent and HRZ-lumped mass), dense assembly, and the modal reduction of
+ * a flexible body: constrained normal modes or Craig-Bampton (LAPACK: the
+ * generalized symmetric-definite eigenproblem, see gen_eig), mode selection,
+ * and the modal data file (docs/modal-file.md), read with libyaml and
+ * written back.
+ *
+ * Conventions.  6 DOFs per node: ux uy uz rx ry rz in body axes.  An
+ * element's local frame: x from node 0 to node 1, y = the section's yaxis
+ * made perpendicular to x, z = x cross y.  Bending in the local x-y plane
+ * (uy, rz) uses Iz and the shear area ratio shear_y; in the x-z plane (uz, ry)
+ * Iy and shear_z; torsion G J; axial E A.  Shear parameter (Przemieniecki)
+ * Phi = 12 E I / (G A_s L^2) with A_s = ratio * A (0 for Euler-Bernoulli).
+ * Mass:
+ *   consistent, Euler-Bernoulli: the standard cubic-Hermite translational
+ *     mass (rhoAL/420 [156 22L 54 -13L; ...]) without rotary inertia;
+ *   consistent, Timoshenko: Przemieniecki's shear-dependent translational
+ *     mass plus the rotary inertia of the sections (rho I terms), both with Phi;
+ *   axial rho A L/6 [2 1; 1 2]; torsion rho Ip L/6 [2 1; 1 2] with the polar
+ *     moment Ip = Iy + Iz (the mass moment of the section about the axis; the
+ *     torsion constant J is a stiffness property and is smaller than Ip for any
+ *     non-circular section);
+ *   lumped (HRZ): each node gets rho A L/2 in every direction, the bending
+ *     rotary inertia (rho A L/2) m22/m11 of the translational consistent matrix
+ *     (= rho A L^3/78 for Euler-Bernoulli) plus, for Timoshenko, half the
+ *     section rotary inertia rho I L/2; torsion rho Ip L/2.  In body axes the
+ *     node's rotary inertia is a full 3x3 block.
+ * Point masses add m to the three translational diagonal terms of their node
+ * and their 3x3 inertia to its rotational block, in either mass formulation. */
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <yaml.h>
+
+#include "fe.h"
+
+/* LAPACK / BLAS (Fortran interfaces; one-character arguments, no hidden lengths,
+ * as in runtime/solver_dense.c) */
+void dpotrf_(const char *uplo, const int *n, double *a, const int *lda, int *info);
+void dpotrs_(const char *uplo, const int *n, const int *nrhs, const double *a, const int *lda,
+             double *b, const int *ldb, int *info);
+void dsygst_(const int *itype, const char *uplo, const int *n, double *a, const int *lda,
+             const double *b, const int *ldb, int *info);
+void dsytrd_(const char *uplo, const int *n, double *a, const int *lda, double *d, double *e,
+             double *tau, double *work, const int *lwork, int *info);
+void dsterf_(const int *n, double *d, double *e, int *info);
+void dstemr_(const char *jobz, const char *range, const int *n, double *d, double *e,
+             const double *vl, const double *vu, const int *il, const int *iu, int *m, double *w,
+             double *z, const int *ldz, const int *nzc, int *isuppz, int *tryrac, double *work,
+             const int *lwork, int *iwork, const int *liwork, int *info);
+void dormtr_(const char *side, const char *uplo, const char *trans, const int *m, const int *n,
+             const double *a, const int *lda, const double *tau, double *c, const int *ldc,
+             double *work, const int *lwork, int *info);
+
+void dtrsm_(const char *side, const char *uplo, const char *transa, const char *diag, const int *m,
+            const int *n, const double *alpha, const double *a, const int *lda, double *b,
+            const int *ldb);
+void dgemm_(const char *transa, const char *transb, const int *m, const int *n, const int *k,
+            const double *alpha, const double *a, const int *lda, const double *b, const int *ldb,
+            const double *beta, double *c, const int *ldc);
+
+static const char *const dof_names[6] = {"ux", "uy", "uz", "rx", "ry", "rz"};
+
+#define FE_PI 3.14159265358979323846
+/* a pivot of K this small relative to its diagonal term means a mechanism */
+#define FE_PIVOT_TOL 1e-11
+/* modal data file: tolerance of X^T M X = I */
+#define FE_NORM_TOL 1e-6
+
+/* ------------------------------------------------------------------------- */
+/* errors                                                                    */
+
+typedef struct {
+  char *err;
+  size_t nerr;
+  ir_loc *where;
+} fe_ctx;
+
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((format(printf, 3, 4)))
+#endif
+static int fail_at(fe_ctx *c, ir_loc loc, const char *fmt, ...) {
+  if (c->err && c->nerr) {
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(c->err, c->nerr, fmt, ap);
+    va_end(ap);
+  }
+  if (c->where) *c->where = loc;
+  return -1;
+}
+
+static const ir_loc no_loc = {0, 0};
+
+static ir_loc node_loc(const ir_flex *fx, int k) {
+  if (fx->node_loc && k >= 0 && k < fx->nnodes) return fx->node_loc[k];
+  return fx->loc;
+}
+
+static void *xcalloc(size_t n, size_t size) { return calloc(n ? n : 1, size); }
+
+/* ------------------------------------------------------------------------- */
+/* element matrices                                                           */
+
+typedef struct {
+  double L;
+  double R[9];     /* rows: local x, y, z in body axes (u_local = R u_body) */
+  double K[144];   /* local 12x12, column-major */
+  double M[144];   /* local consistent mass */
+  double lump[12]; /* local HRZ-lumped diagonal: per node m m m Jx Jy Jz */
+} beam_el;
+
+static int finite_pos(double v) { return isfinite(v) && v > 0; }
+
+/* Check a beam's data and compute its frame and length. */
+static int beam_frame(const ir_flex *fx, int e, beam_el *el, fe_ctx *c) {
+  const ir_beam *b = &fx->beams[e];
+  int n0 = b->node[0], n1 = b->node[1];
+  if (n0 < 0 || n0 >= fx->nnodes || n1 < 0 || n1 >= fx->nnodes)
+    return fail_at(c, b->loc, "beam %d: node index out of range (the body has %d nodes)", e, fx->nnodes);
+  if (n0 == n1) return fail_at(c, b->loc, "beam %d: both ends are node %d (zero-length element)", e, n0);
+  struct { const char *name; double v; } props[] = {
+      {"Young's modulus E", b->E}, {"shear modulus G", b->G}, {"density rho", b->rho},
+      {"area A", b->A}, {"second moment Iy", b->Iy}, {"second moment Iz", b->Iz},
+      {"torsion constant J", b->J}};
+  for (size_t i = 0; i < sizeof props / sizeof props[0]; i++)
+    if (!finite_pos(props[i].v))
+      return fail_at(c, b->loc, "beam %d: %s must be positive (got %g)", e, props[i].name, props[i].v);
+  if (b->theory == BEAM_TIMOSHENKO && (!finite_pos(b->shear_y) || !finite_pos(b->shear_z)))
+    return fail_at(c, b->loc,
+                   "beam %d: a Timoshenko beam needs positive shear area ratios (got y %g, z %g)", e,
+                   b->shear_y, b->shear_z);
+  const double *p0 = fx->nodes + 3 * n0, *p1 = fx->nodes + 3 * n1;
+  double x[3], scale = 0;
+  for (int k = 0; k < 3; k++) {
+    x[k] = p1[k] - p0[k];
+    scale = fmax(scale, fmax(fabs(p0[k]), fabs(p1[k])));
+  }
+  double L = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+  if (!(L > 1e-12 * scale) || L == 0)
+    return fail_at(c, b->loc, "beam %d: zero-length element (nodes %d and %d coincide)", e, n0, n1);
+  for (int k = 0; k < 3; k++) x[k] /= L;
+  const double *ya = b->yaxis;
+  double yn = sqrt(ya[0] * ya[0] + ya[1] * ya[1] + ya[2] * ya[2]);
+  if (!(yn > 0) || !isfinite(yn))
+    return fail_at(c, b->loc, "beam %d: the section's yaxis is zero", e);
+  double d = (ya[0] * x[0] + ya[1] * x[1] + ya[2] * x[2]) / yn, y[3];
+  for (int k = 0; k < 3; k++) y[k] = ya[k] / yn - d * x[k];
+  double n = sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
+  if (n < 1e-6)
+    return fail_at(c, b->loc,
+                   "beam %d: the section's yaxis (%g, %g, %g) is parallel to the element (nodes %d-%d)",
+                   e, ya[0], ya[1], ya[2], n0, n1);
+  for (int k = 0; k < 3; k++) y[k] /= n;
+  double z[3] = {x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]};
+  for (int k = 0; k < 3; k++) {
+    el->R[0 + k] = x[k];
+    el->R[3 + k] = y[k];
+    el->R[6 + k] = z[k];
+  }
+  el->L = L;
+  return 0;
+}
+
+/* One bending plane, DOFs (v0, t0, v1, t1) with t = dv/dx (the x-y plane:
+ * v = uy, t = rz).  k, m: 4x4 row-major (symmetric).  EI, shear parameter phi,
+ * rhoA; rhoI > 0 adds the rotary inertia of the sections (Timoshenko).
+ * *lump_rot: HRZ rotary inertia of each node. */
+static void bending_plane(double L, double EI, double phi, double rhoA, double rhoI, double k[16],
+                          double m[16], double *lump_rot) {
+  double c = EI / (L * L * L * (1 + phi)), L2 = L * L;
+  double kk[16] = {12,      6 * L,             -12,     6 * L,
+                   6 * L,   (4 + phi) * L2,    -6 * L,  (2 - phi) * L2,
+                   -12,     -6 * L,            12,      -6 * L,
+                   6 * L,   (2 - phi) * L2,    -6 * L,  (4 + phi) * L2};
+  for (int i = 0; i < 16; i++) k[i] = c * kk[i];
+  double p = phi, p2 = phi * phi, a = rhoA * L / ((1 + p) * (1 + p));
+  double m11 = a * (13.0 / 35 + 7.0 / 10 * p + p2 / 3);
+  double m12 = a * L * (11.0 / 210 + 11.0 / 120 * p + p2 / 24);
+  double m13 = a * (9.0 / 70 + 3.0 / 10 * p + p2 / 6);
+  double m14 = -a * L * (13.0 / 420 + 3.0 / 40 * p + p2 / 24);
+  double m22 = a * L2 * (1.0 / 105 + p / 60 + p2 / 120);
+  double m24 = -a * L2 * (1.0 / 140 + p / 60 + p2 / 120);
+  double mm[16] = {m11, m12,  m13,  m14,
+                   m12, m22,  -m14, m24,
+                   m13, -m14, m11,  -m12,
+                   m14, m24,  -m12, m22};
+  *lump_rot = 0.5 * rhoA * L * m22 / m11;
+  if (rhoI > 0) {
+    double r = rhoI / (L * (1 + p) * (1 + p));
+    double r11 = r * 6.0 / 5, r12 = r * L * (1.0 / 10 - p / 2);
+    double r22 = r * L2 * (2.0 / 15 + p / 6 + p2 / 3), r24 = r * L2 * (-1.0 / 30 - p / 6 + p2 / 6);
+    double rr[16] = {r11,  r12,  -r11, r12,
+                     r12,  r22,  -r12, r24,
+                     -r11, -r12, r11,  -r12,
+                     r12,  r24,  -r12, r22};
+    for (int i = 0; i < 16; i++) mm[i] += rr[i];
+    *lump_rot += 0.5 * rhoI * L;
+  }
+  memcpy(m, mm, sizeof mm);
+}
+
+/* local 12x12 stiffness, consistent mass and HRZ lumped diagonal */
+static void beam_local(const ir_beam *b, beam_el *el) {
+  double L = el->L;
+  memset(el->K, 0, sizeof el->K);
+  memset(el->M, 0, sizeof el->M);
+  int timo = b->theory == BEAM_TIMOSHENKO;
+  double rhoA = b->rho * b->A, Ip = b->Iy + b->Iz;
+#define KL(i, j) el->K[(j) * 12 + (i)]
+#define ML(i, j) el->M[(j) * 12 + (i)]
+  /* axial (0, 6) and torsion (3, 9) */
+  double ka = b->E * b->A / L, kt = b->G * b->J / L;
+  double ma = rhoA * L / 6, mt = b->rho * Ip * L / 6;
+  int ax[2] = {0, 6}, tr[2] = {3, 9};
+  for (int i = 0; i < 2; i++)
+    for (int j = 0; j < 2; j++) {
+      double s = i == j ? 1 : -1;
+      KL(ax[i], ax[j]) = s * ka;
+      KL(tr[i], tr[j]) = s * kt;
+      ML(ax[i], ax[j]) = (i == j ? 2 : 1) * ma;
+      ML(tr[i], tr[j]) = (i == j ? 2 : 1) * mt;
+    }
+  /* x-y plane: (uy, rz), Iz, shear_y; x-z plane: (uz, -ry), Iy, shear_z */
+  double phiy = 0, phiz = 0;
+  if (timo) {
+    phiy = 12 * b->E * b->Iz / (b->G * b->shear_y * b->A * L * L);
+    phiz = 12 * b->E * b->Iy / (b->G * b->shear_z * b->A * L * L);
+  }
+  double k4[16], m4[16], rot_z, rot_y;
+  int py[4] = {1, 5, 7, 11};
+  double sy[4] = {1, 1, 1, 1};
+  bending_plane(L, b->E * b->Iz, phiy, rhoA, timo ? b->rho * b->Iz : 0, k4, m4, &rot_z);
+  for (int i = 0; i < 4; i++)
+    for (int j = 0; j < 4; j++) {
+      KL(py[i], py[j]) = sy[i] * sy[j] * k4[4 * i + j];
+      ML(py[i], py[j]) = sy[i] * sy[j] * m4[4 * i + j];
+    }
+  int pz[4] = {2, 4, 8, 10};
+  double sz[4] = {1, -1, 1, -1};
+  bending_plane(L, b->E * b->Iy, phiz, rhoA, timo ? b->rho * b->Iy : 0, k4, m4, &rot_y);
+  for (int i = 0; i < 4; i++)
+    for (int j = 0; j < 4; j++) {
+      KL(pz[i], pz[j]) = sz[i] * sz[j] * k4[4 * i + j];
+      ML(pz[i], pz[j]) = sz[i] * sz[j] * m4[4 * i + j];
+    }
+#undef KL
+#undef ML
+  for (int a = 0; a < 2; a++) {
+    double *l = el->lump + 6 * a;
+    l[0] = l[1] = l[2] = 0.5 * rhoA * L;
+    l[3] = 0.5 * b->rho * Ip * L;
+    l[4] = rot_y;
+    l[5] = rot_z;
+  }
+}
+
+/* body-axes 3x3 block B = R^T A R of a local 3x3 block (A column-major with
+ * leading dimension lda, B written with leading dimension ldb, added) */
+static void rotate_add(const double R[9], const double *A, int lda, double *B, int ldb, double s) {
+  double t[9];
+  /* t = A R  (t_ij = sum_k A_ik R_kj) */
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      double v = 0;
+      for (int k = 0; k < 3; k++) v += A[k * lda + i] * R[3 * k + j];
+      t[3 * i + j] = v;
+    }
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      double v = 0;
+      for (int k = 0; k < 3; k++) v += R[3 * k + i] * t[3 * k + j];
+      B[j * ldb + i] += s * v;
+    }
+}
+
+static int check_point_masses(const ir_flex *fx, fe_ctx *c) {
+  for (int p = 0; p < fx->npoint_masses; p++) {
+    const ir_point_mass *pm = &fx->point_masses[p];
+    if (pm->node < 0 || pm->node >= fx->nnodes)
+      return fail_at(c, pm->loc, "point mass %d: node %d out of range (the body has %d nodes)", p,
+                     pm->node, fx->nnodes);
+    if (!isfinite(pm->mass) || pm->mass < 0)
+      return fail_at(c, pm->loc, "point mass %d: mass must be nonnegative (got %g)", p, pm->mass);
+    const double *I = pm->inertia;
+    double big = 0;
+    for (int i = 0; i < 9; i++) {
+      if (!isfinite(I[i])) return fail_at(c, pm->loc, "point mass %d: inertia is not finite", p);
+      big = fmax(big, fabs(I[i]));
+    }
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < i; j++)
+        if (fabs(I[3 * i + j] - I[3 * j + i]) > 1e-9 * big)
+          return fail_at(c, pm->loc, "point mass %d: inertia is not symmetric", p);
+    double m2 = I[0] * I[4] - I[1] * I[3], det = I[0] * (I[4] * I[8] - I[5] * I[7]) -
+                                                 I[1] * (I[3] * I[8] - I[5] * I[6]) +
+                                                 I[2] * (I[3] * I[7] - I[4] * I[6]);
+    if (I[0] < 0 || I[4] < 0 || I[8] < 0 || m2 < -1e-9 * big * big || det < -1e-9 * big * big * big)
+      return fail_at(c, pm->loc, "point mass %d: inertia is not positive semidefinite", p);
+  }
+  return 0;
+}
+
+int fe_lumped_nodes(const ir_flex *fx, double *node_mass, double *node_inertia, char *err,
+                    size_t nerr, ir_loc *where) {
+  fe_ctx c = {err, nerr, where};
+  if (where) *where = no_loc;
+  memset(node_mass, 0, sizeof(double) * (size_t)fx->nnodes);
+  memset(node_inertia, 0, sizeof(double) * 9 * (size_t)fx->nnodes);
+  for (int e = 0; e < fx->nbeams; e++) {
+    beam_el el;
+    if (beam_frame(fx, e, &el, &c)) return -1;
+    beam_local(&fx->beams[e], &el);
+    for (int a = 0; a < 2; a++) {
+      int n = fx->beams[e].node[a];
+      node_mass[n] += el.lump[6 * a];
+      double J[9] = {0};
+      J[0] = el.lump[6 * a + 3];
+      J[4] = el.lump[6 * a + 4];
+      J[8] = el.lump[6 * a + 5];
+      double B[9] = {0};
+      rotate_add(el.R, J, 3, B, 3, 1.0); /* column-major B; symmetric */
+      for (int i = 0; i < 9; i++) node_inertia[9 * n + i] += B[i];
+    }
+  }
+  if (check_point_masses(fx, &c)) return -1;
+  for (int p = 0; p < fx->npoint_masses; p++) {
+    const ir_point_mass *pm = &fx->point_masses[p];
+    node_mass[pm->node] += pm->mass;
+    for (int i = 0; i < 9; i++) node_inertia[9 * pm->node + i] += pm->inertia[i];
+  }
+  /* exact symmetry */
+  for (int n = 0; n < fx->nnodes; n++) {
+    double *I = node_inertia + 9 * n;
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < i; j++) I[3 * i + j] = I[3 * j + i] = 0.5 * (I[3 * i + j] + I[3 * j + i]);
+  }
+  return 0;
+}
+
+static int check_flex_common(const ir_flex *fx, fe_ctx *c) {
+  if (fx->nnodes <= 0 || !fx->nodes) return fail_at(c, fx->loc, "the FE model has no nodes");
+  for (int k = 0; k < 3 * fx->nnodes; k++)
+    if (!isfinite(fx->nodes[k])) return fail_at(c, node_loc(fx, k / 3), "node %d: position is not finite", k / 3);
+  return 0;
+}
+
+int fe_assemble_at(const ir_flex *fx, fe_system *out, char *err, size_t nerr, ir_loc *where) {
+  fe_ctx c = {err, nerr, where};
+  memset(out, 0, sizeof *out);
+  if (where) *where = no_loc;
+  if (check_flex_common(fx, &c)) return -1;
+  int n = 6 * fx->nnodes;
+  size_t nn = (size_t)n * (size_t)n;
+  double *K = xcalloc(nn, sizeof(double)), *M = xcalloc(nn, sizeof(double));
+  double *nm = xcalloc((size_t)fx->nnodes, sizeof(double));
+  double *ni = xcalloc(9 * (size_t)fx->nnodes, sizeof(double));
+  if (!K || !M || !nm || !ni) {
+    free(K); free(M); free(nm); free(ni);
+    return fail_at(&c, fx->loc, "out of memory assembling %d DOFs", n);
+  }
+  for (int e = 0; e < fx->nbeams; e++) {
+    beam_el el;
+    if (beam_frame(fx, e, &el, &c)) goto fail;
+    beam_local(&fx->beams[e], &el);
+    for (int a = 0; a < 2; a++)
+      for (int bb = 0; bb < 2; bb++)
+        for (int p = 0; p < 2; p++)
+          for (int q = 0; q < 2; q++) {
+            int li = 6 * a + 3 * p, lj = 6 * bb + 3 * q;
+            int gi = 6 * fx->beams[e].node[a] + 3 * p, gj = 6 * fx->beams[e].node[bb] + 3 * q;
+            rotate_add(el.R, el.K + lj * 12 + li, 12, K + (size_t)gj * n + gi, n, 1.0);
+            if (fx->mass == MASS_CONSISTENT)
+              rotate_add(el.R, el.M + lj * 12 + li, 12, M + (size_t)gj * n + gi, n, 1.0);
+          }
+  }
+  if (fx->mass == MASS_CONSISTENT) {
+    if (check_point_masses(fx, &c)) goto fail;
+    for (int p = 0; p < fx->npoint_masses; p++) {
+      const ir_point_mass *pm = &fx->point_masses[p];
+      int g = 6 * pm->node;
+      for (int i = 0; i < 3; i++) {
+        M[(size_t)(g + i) * n + g + i] += pm->mass;
+        for (int j = 0; j < 3; j++) M[(size_t)(g + 3 + j) * n + g + 3 + i] += pm->inertia[3 * i + j];
+      }
+    }
+  } else {
+    if (fe_lumped_nodes(fx, nm, ni, err, nerr, where)) goto fail;
+    for (int k = 0; k < fx->nnodes; k++) {
+      int g = 6 * k;
+      for (int i = 0; i < 3; i++) {
+        M[(size_t)(g + i) * n + g + i] = nm[k];
+        for (int j = 0; j < 3; j++) M[(size_t)(g + 3 + j) * n + g + 3 + i] = ni[9 * k + 3 * i + j];
+      }
+    }
+  }
+  /* exact symmetry */
+  for (int j = 0; j < n; j++)
+    for (int i = 0; i < j; i++) {
+      size_t u = (size_t)j * n + i, l = (size_t)i * n + j;
+      K[u] = K[l] = 0.5 * (K[u] + K[l]);
+      M[u] = M[l] = 0.5 * (M[u] + M[l]);
+    }
+  free(nm);
+  free(ni);
+  out->ndof = n;
+  out->K = K;
+  out->M = M;
+  return 0;
+fail:
+  free(K); free(M); free(nm); free(ni);
+  return -1;
+}
+
+int fe_assemble(const ir_flex *fx, fe_system *out, char *err, size_t nerr) {
+  return fe_assemble_at(fx, out, err, nerr, NULL);
+}
+
+void fe_system_free(fe_system *s) {
+  if (!s) return;
+  free(s->K);
+  free(s->M);
+  memset(s, 0, sizeof *s);
+}
+
+/* ------------------------------------------------------------------------- */
+/* dense linear algebra helpers                                               */
+
+/* Generalized symmetric-definite eigenproblem K x = lambda M x (n x n,
+ * column-major, K and M positive definite, not modified).
+ *
+ * Accuracy: the usual reduction to a standard problem with the Cholesky
+ * factor of M leaves an absolute error of about eps * lambda_max in every
+ * eigenvalue.  The lowest frequencies, the ones a flexible body keeps, would
+ * then lose digits in proportion to lambda_max / lambda_min, which reaches
+ * 1e12 for a fine, slender mesh (measured: the two equal bending frequencies
+ * of a square cantilever split by 1e-4 with dsygvd on (K, M)).  So the
+ * inverse problem M x = mu K x (mu = 1/lambda) is reduced instead, with the
+ * Cholesky factor of K: C = L^-1 M L^-T, whose largest mu (the lowest
+ * frequencies) come out to a few eps.  C is tridiagonalized once (dsytrd);
+ * all eigenvalues come from dsterf (for the list of frequencies), and
+ * eigenvectors only for the index range needed, by MRRR (dstemr), then
+ * x = L^-T Q z.  The vectors are scaled to unit modal mass, re-orthonormalized
+ * in the M inner product by one Cholesky-QR sweep in ascending frequency
+ * order (the lowest modes are left as they are; the highest, whose mu carry
+ * the largest relative error, absorb the correction), and each lambda is the
+ * Rayleigh quotient x^T K x of its M-normalized vector. */
+typedef struct {
+  int n;
+  double *L;   /* Cholesky factor of K (lower) */
+  double *C;   /* L^-1 M L^-T, then its Householder vectors (lower) */
+  double *tau, *d, *e;
+} eig_ws;
+
+static void eig_free(eig_ws *w) {
+  free(w->L); free(w->C); free(w->tau); free(w->d); free(w->e);
+  memset(w, 0, sizeof *w);
+}
+
+/* reduce and return every lambda, ascending.  0, 2 if K is not positive
+ * definite, 1 if some mu <= 0 (M singular), -1 otherwise */
+static int eig_reduce(int n, const double *K, const double *M, eig_ws *w, double *lam) {
+  memset(w, 0, sizeof *w);
+  w->n = n;
+  if (n == 0) return 0;
+  size_t nn = (size_t)n * (size_t)n;
+  int info = 0, itype = 1, lwork = -1;
+  double wq = 0, *work = NULL, *d2 = NULL, *e2 = NULL;
+  w->L = malloc(nn * sizeof(double));
+  w->C = malloc(nn * sizeof(double));
+  w->tau = malloc((size_t)n * sizeof(double));
+  w->d = malloc((size_t)n * sizeof(double));
+  w->e = malloc((size_t)n * sizeof(double));
+  d2 = malloc((size_t)n * sizeof(double));
+  e2 = malloc((size_t)n * sizeof(double));
+  int rc = -1;
+  if (!w->L || !w->C || !w->tau || !w->d || !w->e || !d2 || !e2) goto done;
+  memcpy(w->L, K, nn * sizeof(double));
+  memcpy(w->C, M, nn * sizeof(double));
+  dpotrf_("L", &n, w->L, &n, &info);
+  if (info != 0) { rc = info > 0 ? 2 : -1; goto done; }
+  dsygst_(&itype, "L", &n, w->C, &n, w->L, &n, &info);
+  if (info != 0) goto done;
+  dsytrd_("L", &n, w->C, &n, w->d, w->e, w->tau, &wq, &lwork, &info);
+  lwork = (int)wq + 1;
+  if (info != 0 || !(work = malloc((size_t)lwork * sizeof(double)))) goto done;
+  dsytrd_("L", &n, w->C, &n, w->d, w->e, w->tau, work, &lwork, &info);
+  if (info != 0) goto done;
+  memcpy(d2, w->d, (size_t)n * sizeof(double));
+  memcpy(e2, w->e, (size_t)n * sizeof(double));
+  dsterf_(&n, d2, e2, &info);
+  if (info != 0) goto done;
+  for (int i = 0; i < n; i++) {
+    double mu = d2[n - 1 - i];
+    if (!(mu > 0)) { rc = 1; goto done; }
+    lam[i] = 1 / mu;
+  }
+  rc = 0;
+done:
+  free(work); free(d2); free(e2);
+  return rc;
+}
+
+/* eigenvectors lo..hi (0-based, ascending lambda) into X (n x (hi-lo+1)),
+ * M-orthonormal, with their Rayleigh-quotient lambdas in lam */
+static int eig_vectors(const eig_ws *w, const double *K, const double *M, int lo, int hi,
+                       double *lam, double *X) {
+  int n = w->n, m = hi - lo + 1, il = n - hi, iu = n - lo, found = 0, info = 0;
+  if (m <= 0) return 0;
+  int rc = -1, tryrac = 1, lwork = -1, liwork = -1, iwq = 0, nzc = m;
+  double vl = 0, vu = 0, wq = 0, one = 1, zero = 0;
+  double *d = malloc((size_t)n * sizeof(double)), *e = malloc((size_t)n * sizeof(double));
+  double *mu = malloc((size_t)n * sizeof(double)), *Z = malloc((size_t)n * m * sizeof(double));
+  double *P = malloc((size_t)n * m * sizeof(double)), *G = malloc((size_t)m * m * sizeof(double));
+  int *isuppz = malloc(2 * (size_t)m * sizeof(int)), *order = malloc((size_t)m * sizeof(int));
+  double *work = NULL;
+  int *iwork = NULL;
+  if (!d || !e || !mu || !Z || !P || !G || !isuppz || !order) goto done;
+  memcpy(d, w->d, (size_t)n * sizeof(double));
+  memcpy(e, w->e, (size_t)n * sizeof(double));
+  dstemr_("V", "I", &n, d, e, &vl, &vu, &il, &iu, &found, mu, Z, &n, &nzc, isuppz, &tryrac, &wq,
+          &lwork, &iwq, &liwork, &info);
+  if (info != 0) goto done;
+  lwork = (int)wq + 1;
+  liwork = iwq > 0 ? iwq : 1;
+  {
+    /* dormtr's workspace: query it too, take the larger */
+    int lw2 = -1;
+    double wq2 = 0;
+    dormtr_("L", "L", "N", &n, &m, w->C, &n, w->tau, Z, &n, &wq2, &lw2, &info);
+    if (info != 0) goto done;
+    if ((int)wq2 + 1 > lwork) lwork = (int)wq2 + 1;
+  }
+  work = malloc((size_t)lwork * sizeof(double));
+  iwork = malloc((size_t)liwork * sizeof(int));
+  if (!work || !iwork) goto done;
+  dstemr_("V", "I", &n, d, e, &vl, &vu, &il, &iu, &found, mu, Z, &n, &nzc, isuppz, &tryrac, work,
+          &lwork, iwork, &liwork, &info);
+  if (info != 0 || found != m) goto done;
+  dormtr_("L", "L", "N", &n, &m, w->C, &n, w->tau, Z, &n, work, &lwork, &info);
+  if (info != 0) goto done;
+  dtrsm_("L", "L", "T", "N", &n, &m, &one, w->L, &n, Z, &n); /* x = L^-T Q z */
+  /* ascending lambda = descending mu; unit modal mass */
+  for (int i = 0; i < m; i++) {
+    double mi = mu[m - 1 - i];
+    if (!(mi > 0)) goto done;
+    double s = 1 / sqrt(mi);
+    const double *z = Z + (size_t)(m - 1 - i) * n;
+    for (int r = 0; r < n; r++) X[(size_t)i * n + r] = s * z[r];
+  }
+  /* Cholesky-QR in the M inner product: G = X^T M X = R^T R, X <- X R^-1 */
+  dgemm_("N", "N", &n, &m, &n, &one, M, &n, X, &n, &zero, P, &n);
+  dgemm_("T", "N", &m, &m, &n, &one, X, &n, P, &n, &zero, G, &m);
+  dpotrf_("U", &m, G, &m, &info);
+  if (info != 0) goto done;
+  dtrsm_("R", "U", "N", "N", &n, &m, &one, G, &m, X, &n);
+  /* Rayleigh quotients, then ascending order */
+  dgemm_("N", "N", &n, &m, &n, &one, K, &n, X, &n, &zero, P, &n);
+  for (int i = 0; i < m; i++) {
+    double q = 0;
+    for (int r = 0; r < n; r++) q += X[(size_t)i * n + r] * P[(size_t)i * n + r];
+    mu[i] = q;
+    order[i] = i;
+  }
+  for (int i = 1; i < m; i++) { /* insertion sort: sorted already up to round-off */
+    int o = order[i], j = i;
+    while (j > 0 && mu[order[j - 1]] > mu[o]) { order[j] = order[j - 1]; j--; }
+    order[j] = o;
+  }
+  memcpy(P, X, (size_t)n * m * sizeof(double));
+  for (int i = 0; i < m; i++) {
+    lam[i] = mu[order[i]];
+    memcpy(X + (size_t)i * n, P + (size_t)order[i] * n, (size_t)n * sizeof(double));
+  }
+  rc = 0;
+done:
+  free(d); free(e); free(mu); free(Z); free(P); free(G); free(isuppz); free(order);
+  free(work); free(iwork);
+  return rc;
+}
+
+/* all eigenpairs: lambda ascending in w, M-orthonormal vectors in X (n x n).
+ * Returns 0, or as eig_reduce */
+static int gen_eig(int n, const double *K, const double *M, double *w, double *X, int *bad) {
+  eig_ws ws;
+  (void)bad;
+  int rc = eig_reduce(n, K, M, &ws, w);
+  if (rc == 0 && eig_vectors(&ws, K, M, 0, n - 1, w, X)) rc = -1;
+  eig_free(&ws);
+  return rc;
+}
+
+/* a deterministic sign: the component of largest magnitude (the first one
+ * within a relative 1e-8 of it) is positive */
+static void fix_sign(double *x, int n) {
+  double big = 0;
+  for (int i = 0; i < n; i++) big = fmax(big, fabs(x[i]));
+  for (int i = 0; i < n; i++)
+    if (fabs(x[i]) >= (1 - 1e-8) * big) {
+      if (x[i] < 0)
+        for (int j = 0; j < n; j++) x[j] = -x[j];
+      return;
+    }
+}
+
+static void gather(const double *A, int lda, const int *rows, int nr, const int *cols, int nc,
+                   double *B) {
+  for (int j = 0; j < nc; j++)
+    for (int i = 0; i < nr; i++) B[(size_t)j * nr + i] = A[(size_t)cols[j] * lda + rows[i]];
+}
+
+static double lam_to_hz(double lam) { return sqrt(lam > 0 ? lam : 0) / (2 * FE_PI); }
+
+/* ------------------------------------------------------------------------- */
+/* mode selection                                                             */
+
+static int cmp_int(const void *a, const void *b) {
+  int x = *(const int *)a, y = *(const int *)b;
+  return (x > y) - (x < y);
+}
+
+/* indices (0-based, ascending) of the selected modes among n with ascending
+ * frequencies freq; 'what' names them in messages */
+static int select_modes(const ir_flex *fx, const double *freq, int n, int *idx, int *nsel,
+                        const char *what, fe_ctx *c) {
+  int k = 0;
+  switch (fx->select) {
+  case MODES_ALL:
+    for (int i = 0; i < n; i++) idx[k++] = i;
+    break;
+  case MODES_COUNT:
+    if (fx->count < 0) return fail_at(c, fx->loc, "mode count must be nonnegative (got %d)", fx->count);
+    if (fx->count > n)
+      return fail_at(c, fx->loc, "mode count %d exceeds the %d %s available", fx->count, n, what);
+    for (int i = 0; i < fx->count; i++) idx[k++] = i;
+    break;
+  case MODES_MAX_FREQUENCY:
+    if (!(fx->max_frequency >= 0))
+      return fail_at(c, fx->loc, "maximum mode frequency must be nonnegative (got %g Hz)", fx->max_frequency);
+    for (int i = 0; i < n; i++)
+      if (freq[i] <= fx->max_frequency) idx[k++] = i;
+    break;
+  case MODES_LIST: {
+    int *l = xcalloc((size_t)fx->nlist, sizeof(int));
+    if (!l) return fail_at(c, fx->loc, "out of memory");
+    for (int i = 0; i < fx->nlist; i++) {
+      if (fx->list[i] < 1 || fx->list[i] > n) {
+        int v = fx->list[i];
+        free(l);
+        return fail_at(c, fx->loc, "mode number %d out of range (there are %d %s, numbered from 1)",
+                       v, n, what);
+      }
+      l[i] = fx->list[i] - 1;
+    }
+    qsort(l, (size_t)fx->nlist, sizeof(int), cmp_int);
+    for (int i = 0; i < fx->nlist; i++) {
+      if (i > 0 && l[i] == l[i - 1]) {
+        int v = l[i] + 1;
+        free(l);
+        return fail_at(c, fx->loc, "mode number %d is listed twice", v);
+      }
+      idx[k++] = l[i];
+    }
+    free(l);
+    break;
+  }
+  default:
+    return fail_at(c, fx->loc, "unknown mode selection %d", (int)fx->select);
+  }
+  *nsel = k;
+  return 0;
+}
+
+/* ------------------------------------------------------------------------- */
+/* modes from the FE model                                                    */
+
+static int uf_find(int *p, int i) {
+  while (p[i] != i) i = p[i] = p[p[i]];
+  return i;
+}
+
+/* every node reaches a reference node through beams */
+static int check_connectivity(const ir_flex *fx, const char *is_ref, fe_ctx *c) {
+  int n = fx->nnodes;
+  int *p = xcalloc((size_t)n, sizeof(int)), *deg = xcalloc((size_t)n, sizeof(int));
+  char *held = xcalloc((size_t)n, 1);
+  if (!p || !deg || !held) { free(p); free(deg); free(held); return fail_at(c, fx->loc, "out of memory"); }
+  for (int i = 0; i < n; i++) p[i] = i;
+  for (int e = 0; e < fx->nbeams; e++) {
+    int a = fx->beams[e].node[0], b = fx->beams[e].node[1];
+    deg[a]++; deg[b]++;
+    p[uf_find(p, a)] = uf_find(p, b);
+  }
+  for (int i = 0; i < n; i++)
+    if (is_ref[i]) held[uf_find(p, i)] = 1;
+  int rc = 0;
+  for (int i = 0; i < n && !rc; i++) {
+    if (is_ref[i]) continue;
+    if (deg[i] == 0)
+      rc = fail_at(c, node_loc(fx, i),
+                   "node %d is not connected to any beam and is not a reference node: its DOFs "
+                   "have no stiffness (a mechanism)", i);
+    else if (!held[uf_find(p, i)])
+      rc = fail_at(c, node_loc(fx, i),
+                   "node %d is not connected through beams to any reference node: that part of the "
+                   "structure is free-floating (a mechanism not held by the reference nodes)", i);
+  }
+  free(p); free(deg); free(held);
+  return rc;
+}
+
+/* Cholesky of the free-DOF stiffness or mass (a copy); a failing or tiny
+ * pivot means a mechanism (K) or a DOF without mass (M) */
+static int check_definite(const ir_flex *fx, const double *Kf, int nf, const int *dof, int is_mass,
+                          fe_ctx *c) {
+  if (nf == 0) return 0;
+  size_t nn = (size_t)nf * (size_t)nf;
+  double *A = malloc(nn * sizeof(double));
+  if (!A) return fail_at(c, fx->loc, "out of memory");
+  memcpy(A, Kf, nn * sizeof(double));
+  int info = 0, bad = -1;
+  dpotrf_("U", &nf, A, &nf, &info);
+  if (info > 0) bad = info - 1;
+  else
+    for (int j = 0; j < nf; j++) {
+      double piv = A[(size_t)j * nf + j];
+      if (!(piv * piv > FE_PIVOT_TOL * Kf[(size_t)j * nf + j])) { bad = j; break; }
+    }
+  free(A);
+  if (bad >= 0) {
+    int node = dof[bad] / 6;
+    if (is_mass)
+      return fail_at(c, node_loc(fx, node),
+                     "the mass matrix is singular at node %d DOF %s: a free DOF without mass or "
+                     "rotary inertia", node, dof_names[dof[bad] % 6]);
+    return fail_at(c, node_loc(fx, node),
+                   "the stiffness matrix is singular at node %d DOF %s: a mechanism not held by the "
+                   "reference nodes", node, dof_names[dof[bad] % 6]);
+  }
+  return 0;
+}
+
+static int alloc_modes(fe_modes *out, int nnodes, int nmodes, int nall) {
+  out->nnodes = nnodes;
+  out->nmodes = nmodes;
+  out->nall = nall;
+  out->x = xcalloc(3 * (size_t)nnodes, sizeof(double));
+  out->freq_hz = xcalloc((size_t)nmodes, sizeof(double));
+  out->shapes = xcalloc(6 * (size_t)nnodes * (size_t)nmodes, sizeof(double));
+  out->node_mass = xcalloc((size_t)nnodes, sizeof(double));
+  out->node_inertia = xcalloc(9 * (size_t)nnodes, sizeof(double));
+  out->all_freq_hz = xcalloc((size_t)nall, sizeof(double));
+  return out->x && out->freq_hz && out->shapes && out->node_mass && out->node_inertia &&
+                 out->all_freq_hz
+             ? 0
+             : -1;
+}
+
+static void mul(const char *ta, const char *tb, int m, int n, int k, const double *A, int lda,
+                const double *B, int ldb, double *C, int ldc) {
+  if (m == 0 || n == 0) return;
+  double one = 1, zero = 0;
+  if (k == 0) {
+    for (int j = 0; j < n; j++)
+      for (int i = 0; i < m; i++) C[(size_t)j * ldc + i] = 0;
+    return;
+  }
+  dgemm_(ta, tb, &m, &n, &k, &one, A, &lda, B, &ldb, &zero, C, &ldc);
+}
+
+/* Eigen-analysis of (K, M) with the body's mode selection: all frequencies
+ * in all_hz (n), the selected modes' indices in sel (*ns of them, ascending),
+ * their frequencies in hz and M-orthonormal shapes in X (n x *ns).  The
+ * selected entries of all_hz are the refined (Rayleigh-quotient) values. */
+static int eig_select(const ir_flex *fx, int n, const double *K, const double *M, const char *what,
+                      double *all_hz, int *sel, int *ns, double *hz, double *X, fe_ctx *c) {
+  eig_ws ws;
+  int rc = eig_reduce(n, K, M, &ws, all_hz);
+  if (rc) {
+    eig_free(&ws);
+    return fail_at(c, fx->loc, "the eigensolver failed (%s)",
+                   rc == 2 ? "the stiffness matrix is not positive definite"
+                           : rc == 1 ? "the mass matrix is not positive definite" : "LAPACK error");
+  }
+  for (int i = 0; i < n; i++) all_hz[i] = lam_to_hz(all_hz[i]);
+  if (select_modes(fx, all_hz, n, sel, ns, what, c)) { eig_free(&ws); return -1; }
+  if (*ns > 0) {
+    int lo = sel[0], hi = sel[*ns - 1], m = hi - lo + 1;
+    double *lam = malloc((size_t)m * sizeof(double)), *Xr = malloc((size_t)n * m * sizeof(double));
+    if (!lam || !Xr || eig_vectors(&ws, K, M, lo, hi, lam, Xr)) {
+      free(lam); free(Xr); eig_free(&ws);
+      return fail_at(c, fx->loc, "the eigensolver failed (LAPACK error computing mode shapes)");
+    }
+    for (int j = 0; j < *ns; j++) {
+      int i = sel[j] - lo;
+      hz[j] = all_hz[sel[j]] = lam_to_hz(lam[i]);
+      memcpy(X + (size_t)j * n, Xr + (size_t)i * n, (size_t)n * sizeof(double));
+    }
+    free(lam); free(Xr);
+  }
+  eig_free(&ws);
+  return 0;
+}
+
+static int modes_from_fe(const ir_flex *fx, fe_modes *out, fe_ctx *c) {
+  if (check_flex_common(fx, c)) return -1;
+  int nnodes = fx->nnodes, ndof = 6 * nnodes;
+  if (fx->nreference < 1 || !fx->reference)
+    return fail_at(c, fx->loc,
+                   "an FE flexible body needs at least one reference node (nodes fixed to the body "
+                   "frame)");
+  char *is_ref = xcalloc((size_t)nnodes, 1), *is_int = xcalloc((size_t)nnodes, 1);
+  int *perm = xcalloc((size_t)ndof, sizeof(int));
+  int *sel = NULL;
+  double *Kf = NULL, *Mf = NULL, *X = NULL, *w = NULL, *T = NULL, *Kr = NULL, *Mr = NULL,
+         *tmp = NULL, *Y = NULL, *wi = NULL, *Phi = NULL, *Kii = NULL, *Mii = NULL;
+  fe_system sys = {0, NULL, NULL};
+  int rc = -1;
+  if (!is_ref || !is_int || !perm) { fail_at(c, fx->loc, "out of memory"); goto done; }
+  for (int r = 0; r < fx->nreference; r++) {
+    int k = fx->reference[r];
+    if (k < 0 || k >= nnodes) {
+      fail_at(c, fx->loc, "reference node %d out of range (the body has %d nodes)", k, nnodes);
+      goto done;
+    }
+    is_ref[k] = 1;
+  }
+  for (int r = 0; r < fx->ninterface; r++) {
+    int k = fx->interface[r];
+    if (k < 0 || k >= nnodes) {
+      fail_at(c, fx->loc, "interface node %d out of range (the body has %d nodes)", k, nnodes);
+      goto done;
+    }
+    is_int[k] = !is_ref[k];
+  }
+  if (fe_assemble_at(fx, &sys, c->err, c->nerr, c->where)) goto done;
+  if (check_connectivity(fx, is_ref, c)) goto done;
+
+  /* free DOFs, ordered interface (b) first, then internal (i) */
+  int nb = 0, ni = 0;
+  for (int k = 0; k < nnodes; k++)
+    if (is_int[k])
+      for (int d = 0; d < 6; d++) perm[nb++] = 6 * k + d;
+  for (int k = 0; k < nnodes; k++)
+    if (!is_ref[k] && !is_int[k])
+      for (int d = 0; d < 6; d++) perm[nb + ni++] = 6 * k + d;
+  int nf = nb + ni;
+  size_t nnf = (size_t)nf * (size_t)nf;
+  Kf = xcalloc(nnf, sizeof(double));
+  Mf = xcalloc(nnf, sizeof(double));
+  if (!Kf || !Mf) { fail_at(c, fx->loc, "out of memory"); goto done; }
+  gather(sys.K, ndof, perm, nf, perm, nf, Kf);
+  gather(sys.M, ndof, perm, nf, perm, nf, Mf);
+  if (check_definite(fx, Kf, nf, perm, 0, c) || check_definite(fx, Mf, nf, perm, 1, c)) goto done;
+
+  int nmodes, nall, bad = -1, e;
+  if (nb == 0) {
+    /* constrained normal modes */
+    X = xcalloc(nnf, sizeof(double));
+    w = xcalloc((size_t)nf, sizeof(double));
+    wi = xcalloc((size_t)nf, sizeof(double));
+    sel = xcalloc((size_t)nf, sizeof(int));
+    if (!X || !w || !wi || !sel) { fail_at(c, fx->loc, "out of memory"); goto done; }
+    int ns = 0;
+    if (eig_select(fx, nf, Kf, Mf, "constrained normal modes", wi, sel, &ns, w, X, c)) goto done;
+    nmodes = ns;
+    nall = nf;
+    if (alloc_modes(out, nnodes, nmodes, nall)) { fail_at(c, fx->loc, "out of memory"); goto done; }
+    memcpy(out->all_freq_hz, wi, (size_t)nf * sizeof(double));
+    for (int j = 0; j < nmodes; j++) {
+      double *x = X + (size_t)j * nf;
+      fix_sign(x, nf);
+      out->freq_hz[j] = w[j];
+      for (int i = 0; i < nf; i++) out->shapes[(size_t)j * ndof + perm[i]] = x[i];
+    }
+  } else {
+    /* Craig-Bampton: T = [I 0; Psi Phi_n] on (b, i) */
+    size_t nni = (size_t)ni * (size_t)ni;
+    Kii = xcalloc(nni, sizeof(double));
+    Mii = xcalloc(nni, sizeof(double));
+    Phi = xcalloc(nni, sizeof(double));
+    wi = xcalloc((size_t)ni, sizeof(double));
+    sel = xcalloc((size_t)ni, sizeof(int));
+    if (!Kii || !Mii || !Phi || !wi || !sel) { fail_at(c, fx->loc, "out of memory"); goto done; }
+    for (int j = 0; j < ni; j++)
+      for (int i = 0; i < ni; i++) {
+        Kii[(size_t)j * ni + i] = Kf[(size_t)(nb + j) * nf + nb + i];
+        Mii[(size_t)j * ni + i] = Mf[(size_t)(nb + j) * nf + nb + i];
+      }
+    int ns = 0;
+    double *hzi = xcalloc((size_t)ni, sizeof(double));
+    if (!hzi) { fail_at(c, fx->loc, "out of memory"); goto done; }
+    e = eig_select(fx, ni, Kii, Mii, "fixed-interface normal modes", wi, sel, &ns, hzi, Phi, c);
+    free(hzi);
+    if (e) goto done;
+    int nr = nb + ns;
+    T = xcalloc((size_t)nf * (size_t)nr, sizeof(double));
+    if (!T) { fail_at(c, fx->loc, "out of memory"); goto done; }
+    /* T column j < nb: unit displacement of interface DOF j, Psi_c = -K_ii^-1 K_ib */
+    for (int j = 0; j < nb; j++) {
+      double *t = T + (size_t)j * nf;
+      t[j] = 1;
+      for (int i = 0; i < ni; i++) t[nb + i] = -Kf[(size_t)j * nf + nb + i];
+    }
+    if (ni > 0) {
+      int info = 0;
+      /* Kii still holds K_ii: the eigensolver works on copies */
+      dpotrf_("U", &ni, Kii, &ni, &info);
+      if (info == 0) dpotrs_("U", &ni, &nb, Kii, &ni, T + nb, &nf, &info);
+      if (info != 0) { fail_at(c, fx->loc, "the internal stiffness K_ii is singular"); goto done; }
+    }
+    for (int j = 0; j < ns; j++) {
+      double *t = T + (size_t)(nb + j) * nf;
+      memcpy(t + nb, Phi + (size_t)j * ni, (size_t)ni * sizeof(double));
+    }
+    size_t nnr = (size_t)nr * (size_t)nr;
+    Kr = xcalloc(nnr, sizeof(double));
+    Mr = xcalloc(nnr, sizeof(double));
+    tmp = xcalloc((size_t)nf * (size_t)nr, sizeof(double));
+    Y = xcalloc(nnr, sizeof(double));
+    w = xcalloc((size_t)nr, sizeof(double));
+    X = xcalloc((size_t)nf * (size_t)nr, sizeof(double));
+    if (!Kr || !Mr || !tmp || !Y || !w || !X) { fail_at(c, fx->loc, "out of memory"); goto done; }
+    mul("N", "N", nf, nr, nf, Kf, nf, T, nf, tmp, nf);
+    mul("T", "N", nr, nr, nf, T, nf, tmp, nf, Kr, nr);
+    mul("N", "N", nf, nr, nf, Mf, nf, T, nf, tmp, nf);
+    mul("T", "N", nr, nr, nf, T, nf, tmp, nf, Mr, nr);
+    for (int j = 0; j < nr; j++)
+      for (int i = 0; i < j; i++) {
+        size_t u = (size_t)j * nr + i, l = (size_t)i * nr + j;
+        Kr[u] = Kr[l] = 0.5 * (Kr[u] + Kr[l]);
+        Mr[u] = Mr[l] = 0.5 * (Mr[u] + Mr[l]);
+      }
+    if (gen_eig(nr, Kr, Mr, w, Y, &bad) != 0) {
+      fail_at(c, fx->loc, "the reduced Craig-Bampton eigenproblem failed (LAPACK)");
+      goto done;
+    }
+    mul("N", "N", nf, nr, nr, T, nf, Y, nr, X, nf);
+    nmodes = nr;
+    nall = ni;
+    if (alloc_modes(out, nnodes, nmodes, nall)) { fail_at(c, fx->loc, "out of memory"); goto done; }
+    memcpy(out->all_freq_hz, wi, (size_t)ni * sizeof(double));
+    for (int j = 0; j < nmodes; j++) {
+      double *x = X + (size_t)j * nf;
+      fix_sign(x, nf);
+      out->freq_hz[j] = lam_to_hz(w[j]);
+      for (int i = 0; i < nf; i++) out->shapes[(size_t)j * ndof + perm[i]] = x[i];
+    }
+  }
+  memcpy(out->x, fx->nodes, 3 * (size_t)nnodes * sizeof(double));
+  if (fe_lumped_nodes(fx, out->node_mass, out->node_inertia, c->err, c->nerr, c->where)) goto done;
+  rc = 0;
+done:
+  fe_system_free(&sys);
+  free(is_ref); free(is_int); free(perm); free(sel);
+  free(Kf); free(Mf); free(X); free(w); free(T); free(Kr); free(Mr); free(tmp); free(Y);
+  free(wi); free(Phi); free(Kii); free(Mii);
+  return rc;
+}
+
+/* ------------------------------------------------------------------------- */
+/* modal data file                                                            */
+
+typedef struct {
+  const char *path;
+  yaml_document_t *doc;
+  fe_ctx *c;
+} mf_ctx;
+
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((format(printf, 3, 4)))
+#endif
+static int mf_fail(mf_ctx *m, const yaml_node_t *node, const char *fmt, ...) {
+  char msg[768];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  va_end(ap);
+  if (node)
+    return fail_at(m->c, no_loc, "%s:%lu:%lu: error: %s", m->path,
+                   (unsigned long)node->start_mark.line + 1, (unsigned long)node->start_mark.column + 1,
+                   msg);
+  return fail_at(m->c, no_loc, "%s: error: %s", m->path, msg);
+}
+
+static const char *node_kind(const yaml_node_t *n) {
+  switch (n->type) {
+  case YAML_SCALAR_NODE: return "a scalar";
+  case YAML_SEQUENCE_NODE: return "a sequence";
+  case YAML_MAPPING_NODE: return "a mapping";
+  default: return "nothing";
+  }
+}
+
+static int mf_number(mf_ctx *m, const yaml_node_t *n, const char *what, double *v) {
+  if (n->type != YAML_SCALAR_NODE)
+    return mf_fail(m, n, "%s must be a number (got %s)", what, node_kind(n));
+  const char *s = (const char *)n->data.scalar.value;
+  char *end = NULL;
+  errno = 0;
+  double d = strtod(s, &end);
+  if (end == s || (size_t)(end - s) != n->data.scalar.length || !isfinite(d))
+    return mf_fail(m, n, "%s must be a finite number (got '%s')", what, s);
+  *v = d;
+  return 0;
+}
+
+/* a flow or block sequence of numbers; its length must be one of len1, len2 */
+static int mf_numbers(mf_ctx *m, const yaml_node_t *n, const char *what, int len1, int len2,
+                      double *v, int *len) {
+  if (n->type != YAML_SEQUENCE_NODE)
+    return mf_fail(m, n, "%s must be a sequence of %d numbers (got %s)", what, len1, node_kind(n));
+  int k = (int)(n->data.sequence.items.top - n->data.sequence.items.start);
+  if (k != len1 && k != len2) {
+    if (len2 != len1)
+      return mf_fail(m, n, "%s must have %d or %d numbers (got %d)", what, len1, len2, k);
+    return mf_fail(m, n, "%s must have %d numbers (got %d)", what, len1, k);
+  }
+  for (int i = 0; i < k; i++)
+    if (mf_number(m, yaml_document_get_node(m->doc, n->data.sequence.items.start[i]), what, v + i))
+      return -1;
+  if (len) *len = k;
+  return 0;
+}
+
+static int mf_seq_len(const yaml_node_t *n) {
+  return (int)(n->data.sequence.items.top - n->data.sequence.items.start);
+}
+
+static yaml_node_t *mf_item(mf_ctx *m, const yaml_node_t *seq, int i) {
+  return yaml_document_get_node(m->doc, seq->data.sequence.items.start[i]);
+}
+
+/* the values of a mapping's keys (from 'keys', NULL-terminated); unknown and
+ * repeated keys are errors */
+static int mf_mapping(mf_ctx *m, const yaml_node_t *n, const char *what, const char *const *keys,
+                      yaml_node_t **vals) {
+  if (n->type != YAML_MAPPING_NODE) return mf_fail(m, n, "%s must be a mapping (got %s)", what, node_kind(n));
+  int nk = 0;
+  while (keys[nk]) vals[nk++] = NULL;
+  for (yaml_node_pair_t *p = n->data.mapping.pairs.start; p < n->data.mapping.pairs.top; p++) {
+    yaml_node_t *k = yaml_document_get_node(m->doc, p->key);
+    if (k->type != YAML_SCALAR_NODE) return mf_fail(m, k, "%s: keys must be scalars", what);
+    const char *s = (const char *)k->data.scalar.value;
+    int i = 0;
+    while (i < nk && strcmp(keys[i], s)) i++;
+    if (i == nk) {
+      char exp[256] = "";
+      for (int j = 0; j < nk; j++) {
+        size_t l = strlen(exp);
+        snprintf(exp + l, sizeof exp - l, "%s%s", j ? (j == nk - 1 ? " or " : ", ") : "", keys[j]);
+      }
+      return mf_fail(m, k, "unknown key '%s' in %s (expected %s)", s, what, exp);
+    }
+    if (vals[i]) return mf_fail(m, k, "key '%s' given twice in %s", s, what);
+    vals[i] = yaml_document_get_node(m->doc, p->value);
+  }
+  return 0;
+}
+
+#define MODAL_FORMAT "mbcc-modal-1"
+
+static int modes_from_file(const ir_flex *fx, fe_modes *out, fe_ctx *c) {
+  const char *path = fx->modal_file;
+  FILE *f = fopen(path, "rb");
+  if (!f) return fail_at(c, no_loc, "%s: error: cannot open the modal data file: %s", path, strerror(errno));
+  yaml_parser_t parser;
+  yaml_document_t doc;
+  if (!yaml_parser_initialize(&parser)) {
+    fclose(f);
+    return fail_at(c, no_loc, "%s: error: out of memory", path);
+  }
+  yaml_parser_set_input_file(&parser, f);
+  if (!yaml_parser_load(&parser, &doc)) {
+    const yaml_mark_t *mk = &parser.problem_mark;
+    fail_at(c, no_loc, "%s:%lu:%lu: error: %s%s%s", path, (unsigned long)mk->line + 1,
+            (unsigned long)mk->column + 1, parser.problem ? parser.problem : "invalid YAML",
+            parser.context ? " " : "", parser.context ? parser.context : "");
+    yaml_parser_delete(&parser);
+    fclose(f);
+    return -1;
+  }
+  yaml_parser_delete(&parser);
+  fclose(f);
+  mf_ctx m = {path, &doc, c};
+  int rc = -1, nn = 0, nm = 0, *sel = NULL;
+  double *pos = NULL, *mass = NULL, *inertia = NULL, *freq = NULL, *shapes = NULL;
+  yaml_node_t *root = yaml_document_get_root_node(&doc);
+  if (!root) { mf_fail(&m, NULL, "the modal data file is empty"); goto done; }
+  static const char *const top_keys[] = {"format", "description", "nodes", "modes", NULL};
+  yaml_node_t *top[4];
+  if (mf_mapping(&m, root, "the modal data file", top_keys, top)) goto done;
+  if (!top[0]) { mf_fail(&m, root, "missing 'format: " MODAL_FORMAT "'"); goto done; }
+  if (top[0]->type != YAML_SCALAR_NODE || strcmp((const char *)top[0]->data.scalar.value, MODAL_FORMAT)) {
+    mf_fail(&m, top[0], "unsupported format (expected '" MODAL_FORMAT "')");
+    goto done;
+  }
+  if (top[1] && top[1]->type != YAML_SCALAR_NODE) { mf_fail(&m, top[1], "description must be a string"); goto done; }
+  if (!top[2]) { mf_fail(&m, root, "missing 'nodes'"); goto done; }
+  if (!top[3]) { mf_fail(&m, root, "missing 'modes'"); goto done; }
+  if (top[2]->type != YAML_SEQUENCE_NODE || mf_seq_len(top[2]) == 0) {
+    mf_fail(&m, top[2], "nodes must be a nonempty sequence (got %s)", node_kind(top[2]));
+    goto done;
+  }
+  if (top[3]->type != YAML_SEQUENCE_NODE) {
+    mf_fail(&m, top[3], "modes must be a sequence (got %s)", node_kind(top[3]));
+    goto done;
+  }
+  nn = mf_seq_len(top[2]);
+  nm = mf_seq_len(top[3]);
+  pos = xcalloc(3 * (size_t)nn, sizeof(double));
+  mass = xcalloc((size_t)nn, sizeof(double));
+  inertia = xcalloc(9 * (size_t)nn, sizeof(double));
+  freq = xcalloc((size_t)nm, sizeof(double));
+  shapes = xcalloc(6 * (size_t)nn * (size_t)nm, sizeof(double));
+  sel = xcalloc((size_t)nm, sizeof(int));
+  if (!pos || !mass || !inertia || !freq || !shapes || !sel) { mf_fail(&m, NULL, "out of memory"); goto done; }
+  static const char *const node_keys[] = {"position", "mass", "inertia", NULL};
+  for (int k = 0; k < nn; k++) {
+    yaml_node_t *nd = mf_item(&m, top[2], k), *v[3];
+    char what[64];
+    snprintf(what, sizeof what, "node %d", k);
+    if (mf_mapping(&m, nd, what, node_keys, v)) goto done;
+    if (!v[0]) { mf_fail(&m, nd, "node %d: missing 'position'", k); goto done; }
+    if (!v[1]) { mf_fail(&m, nd, "node %d: missing 'mass'", k); goto done; }
+    if (mf_numbers(&m, v[0], "position", 3, 3, pos + 3 * k, NULL)) goto done;
+    if (mf_number(&m, v[1], "mass", mass + k)) goto done;
+    if (mass[k] < 0) { mf_fail(&m, v[1], "node %d: mass must be nonnegative (got %g)", k, mass[k]); goto done; }
+    if (v[2]) {
+      double I[9];
+      int len = 0;
+      if (mf_numbers(&m, v[2], "inertia", 3, 9, I, &len)) goto done;
+      double *J = inertia + 9 * k;
+      if (len == 3) {
+        J[0] = I[0]; J[4] = I[1]; J[8] = I[2];
+      } else
+        memcpy(J, I, sizeof I);
+      double big = 0;
+      for (int i = 0; i < 9; i++) big = fmax(big, fabs(J[i]));
+      for (int i = 0; i < 3; i++)
+        for (int j = 0; j < i; j++)
+          if (fabs(J[3 * i + j] - J[3 * j + i]) > 1e-9 * big) {
+            mf_fail(&m, v[2], "node %d: inertia is not symmetric", k);
+            goto done;
+          }
+      if (J[0] < 0 || J[4] < 0 || J[8] < 0) {
+        mf_fail(&m, v[2], "node %d: inertia has a negative diagonal term", k);
+        goto done;
+      }
+    }
+  }
+  static const char *const mode_keys[] = {"frequency", "shape", NULL};
+  for (int j = 0; j < nm; j++) {
+    yaml_node_t *md = mf_item(&m, top[3], j), *v[2];
+    char what[64];
+    snprintf(what, sizeof what, "mode %d", j + 1);
+    if (mf_mapping(&m, md, what, mode_keys, v)) goto done;
+    if (!v[0]) { mf_fail(&m, md, "mode %d: missing 'frequency'", j + 1); goto done; }
+    if (!v[1]) { mf_fail(&m, md, "mode %d: missing 'shape'", j + 1); goto done; }
+    if (mf_number(&m, v[0], "frequency", freq + j)) goto done;
+    if (freq[j] < 0) { mf_fail(&m, v[0], "mode %d: frequency must be nonnegative (got %g Hz)", j + 1, freq[j]); goto done; }
+    if (j > 0 && freq[j] < freq[j - 1]) {
+      mf_fail(&m, v[0], "mode %d: frequencies must be ascending (%.17g Hz after %.17g Hz)", j + 1,
+              freq[j], freq[j - 1]);
+      goto done;
+    }
+    if (v[1]->type != YAML_SEQUENCE_NODE || mf_seq_len(v[1]) != nn) {
+      mf_fail(&m, v[1], "mode %d: shape must be a sequence of one row per node (%d), got %s%s", j + 1,
+              nn, node_kind(v[1]), v[1]->type == YAML_SEQUENCE_NODE ? " of another length" : "");
+      goto done;
+    }
+    for (int k = 0; k < nn; k++)
+      if (mf_numbers(&m, mf_item(&m, v[1], k), "a shape row (ux uy uz rx ry rz)", 6, 6,
+                     shapes + (size_t)j * 6 * nn + 6 * k, NULL))
+        goto done;
+  }
+  /* X^T M X = I with the lumped nodal masses and inertias */
+  for (int a = 0; a < nm; a++)
+    for (int b = 0; b <= a; b++) {
+      const double *xa = shapes + (size_t)a * 6 * nn, *xb = shapes + (size_t)b * 6 * nn;
+      double g = 0;
+      for (int k = 0; k < nn; k++) {
+        const double *u = xa + 6 * k, *v = xb + 6 * k, *J = inertia + 9 * k;
+        g += mass[k] * (u[0] * v[0] + u[1] * v[1] + u[2] * v[2]);
+        for (int i = 0; i < 3; i++)
+          for (int l = 0; l < 3; l++) g += u[3 + i] * J[3 * i + l] * v[3 + l];
+      }
+      yaml_node_t *md = mf_item(&m, top[3], a);
+      if (a == b && fabs(g - 1) > FE_NORM_TOL) {
+        mf_fail(&m, md,
+                "mode %d is not mass-normalized with respect to the nodal masses and inertias: "
+                "x^T M x = %.10g (expected 1 to %g)", a + 1, g, FE_NORM_TOL);
+        goto done;
+      }
+      if (a != b && fabs(g) > FE_NORM_TOL) {
+        mf_fail(&m, md,
+                "modes %d and %d are not orthogonal with respect to the nodal masses and inertias: "
+                "x%d^T M x%d = %.10g (expected 0 to %g)", b + 1, a + 1, b + 1, a + 1, g, FE_NORM_TOL);
+        goto done;
+      }
+    }
+  int ns = 0;
+  if (select_modes(fx, freq, nm, sel, &ns, "modes in the modal data file", c)) goto done;
+  if (alloc_modes(out, nn, ns, nm)) { mf_fail(&m, NULL, "out of memory"); goto done; }
+  memcpy(out->x, pos, 3 * (size_t)nn * sizeof(double));
+  memcpy(out->node_mass, mass, (size_t)nn * sizeof(double));
+  memcpy(out->node_inertia, inertia, 9 * (size_t)nn * sizeof(double));
+  memcpy(out->all_freq_hz, freq, (size_t)nm * sizeof(double));
+  for (int j = 0; j < ns; j++) {
+    out->freq_hz[j] = freq[sel[j]];
+    memcpy(out->shapes + (size_t)j * 6 * nn, shapes + (size_t)sel[j] * 6 * nn, 6 * (size_t)nn * sizeof(double));
+  }
+  rc = 0;
+done:
+  yaml_document_delete(&doc);
+  free(pos); free(mass); free(inertia); free(freq); free(shapes); free(sel);
+  return rc;
+}
+
+static void write_string(FILE *f, const char *s) {
+  fputc('"', f);
+  for (; *s; s++) {
+    unsigned char ch = (unsigned char)*s;
+    if (ch == '"' || ch == '\\') fprintf(f, "\\%c", ch);
+    else if (ch == '\n') fputs("\\n", f);
+    else if (ch < 0x20) fprintf(f, "\\x%02x", ch);
+    else fputc(ch, f);
+  }
+  fputc('"', f);
+}
+
+int fe_modes_write(const fe_modes *m, const char *path, const char *description, char *err,
+                   size_t nerr) {
+  fe_ctx c = {err, nerr, NULL};
+  FILE *f = fopen(path, "w");
+  if (!f) return fail_at(&c, no_loc, "%s: error: cannot write the modal data file: %s", path, strerror(errno));
+  fprintf(f, "# modal data file of a flexible body (format: docs/modal-file.md); SI units.\n");
+  fprintf(f, "# Shapes are mass-normalized with respect to the nodal masses and inertias.\n");
+  fprintf(f, "format: " MODAL_FORMAT "\n");
+  if (description) {
+    fprintf(f, "description: ");
+    write_string(f, description);
+    fputc('\n', f);
+  }
+  fprintf(f, "nodes:            # position (body axes, m), mass (kg), inertia (kg m^2, 3x3 row-major)\n");
+  for (int k = 0; k < m->nnodes; k++) {
+    const double *x = m->x + 3 * k, *J = m->node_inertia + 9 * k;
+    fprintf(f, "  - {position: [%.17g, %.17g, %.17g], mass: %.17g,\n     inertia: [", x[0], x[1], x[2],
+            m->node_mass[k]);
+    for (int i = 0; i < 9; i++) fprintf(f, "%.17g%s", J[i], i < 8 ? ", " : "]}\n");
+  }
+  fprintf(f, "modes:%s\n", m->nmodes ? "            # frequency (Hz), shape: one row per node, ux uy uz rx ry rz" : " []");
+  for (int j = 0; j < m->nmodes; j++) {
+    fprintf(f, "  - frequency: %.17g\n    shape:\n", m->freq_hz[j]);
+    for (int k = 0; k < m->nnodes; k++) {
+      const double *s = m->shapes + (size_t)j * 6 * m->nnodes + 6 * k;
+      fprintf(f, "      - [%.17g, %.17g, %.17g, %.17g, %.17g, %.17g]\n", s[0], s[1], s[2], s[3], s[4], s[5]);
+    }
+  }
+  int bad = ferror(f);
+  if (fclose(f) != 0 || bad)
+    return fail_at(&c, no_loc, "%s: error: writing the modal data file failed", path);
+  return 0;
+}
+
+/* ------------------------------------------------------------------------- */
+
+int fe_compute_modes_at(const ir_flex *fx, fe_modes *out, char *err, size_t nerr, ir_loc *where) {
+  fe_ctx c = {err, nerr, where};
+  memset(out, 0, sizeof *out);
+  if (where) *where = no_loc;
+  int rc = fx->modal_file ? modes_from_file(fx, out, &c) : modes_from_fe(fx, out, &c);
+  if (rc) fe_modes_free(out);
+  return rc ? -1 : 0;
+}
+
+int fe_compute_modes(const ir_flex *fx, fe_modes *out, char *err, size_t nerr) {
+  return fe_compute_modes_at(fx, out, err, nerr, NULL);
+}
+
+void fe_modes_free(fe_modes *m) {
+  if (!m) return;
+  free(m->x);
+  free(m->freq_hz);
+  free(m->shapes);
+  free(m->node_mass);
+  free(m->node_inertia);
+  free(m->all_freq_hz);
+  memset(m, 0, sizeof *m);
+}

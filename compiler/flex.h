@@ -1,0 +1,21 @@
+/* flex.h: a flexible body's runtime description (mb_flex) built from its
+ * modes at compile time: inertia invariants, modal stiffness and damping. */
+#ifndef MBCC_FLEX_H
+#define MBCC_FLEX_H
+
+#include "fe.h"
+#include "ir.h"
+#include "mb_flex.h"
+
+typedef struct {
+  mb_flex flex; /* points into the arrays below */
+  double *S1, *E, *F, *G, *C0, *CPsi, *Mff, *stiffness, *damping;
+  double *node_x, *node_X, *node_Psi;
+} flex_data;
+
+int flex_build(const ir_flex *fx, const fe_modes *fm, flex_data *out, char *err, size_t nerr);
+void flex_data_free(flex_data *d);
+/* 0: structurally zero, 1: constant, 2: varying entry (i, l) of the mass block */
+int flex_mass_entry(const mb_flex *f, int i, int l);
+
+#endif
