@@ -48,6 +48,14 @@ static void dense_D(const mb_model *m, const double *Kx, double *D) {
       if (m->Ki[p] >= m->nv) D[(size_t)c * (size_t)m->nc + (size_t)(m->Ki[p] - m->nv)] = Kx[p];
 }
 
+/* zero the modal columns of D: the model is given undeformed and at rest
+ * relative to its flexible bodies' frames, so assembly moves only the frames */
+static void freeze_modes(const mb_model *m, double *D) {
+  for (int b = 0; b < m->nbody; b++)
+    for (int j = 0; j < m->body[b].nm; j++)
+      memset(D + (size_t)(m->body[b].vadr + 6 + j) * (size_t)m->nc, 0, sizeof(double) * (size_t)m->nc);
+}
+
 /* minimum-norm least-squares solution of A x = b, A: mr x nc col-major
  * (destroyed); b has max(mr, nc) entries, x returned in b */
 static int min_norm_solve(int mr, int nc, double *A, double *b) {
@@ -139,6 +147,7 @@ int assemble_model(lmodel *L, int verbose) {
     res = max_abs(e.phi, m->nc, &worst);
     if (res <= 1e-12) break;
     dense_D(m, e.Kx, D);
+    if (it < 25) freeze_modes(m, D); /* then deform the bodies if they must */
     for (int r = 0; r < m->nc; r++) b[r] = -e.phi[r];
     if (min_norm_solve(m->nc, m->nv, D, b)) goto out;
     mb_model_qincrement(m, L->q0, b);
@@ -203,6 +212,7 @@ int assemble_model(lmodel *L, int verbose) {
     for (int r = 0; r < m->nc; r++) b[r] = e.nu[r];
     for (int r = 0; r < m->nc; r++)
       for (int j = 0; j < m->nv; j++) b[r] -= D[(size_t)j * (size_t)m->nc + (size_t)r] * L->v0[j];
+    freeze_modes(m, D);
     if (min_norm_solve(m->nc, m->nv, D, b)) goto out;
     for (int j = 0; j < m->nv; j++) L->v0[j] += b[j];
   }

@@ -204,6 +204,90 @@ static void test_constraints_flexible(void **state) {
   check_constraints(&slider_crank_flexible_virtual2_model, 3);
 }
 
+/* The flexible body's quadratic-velocity forces s against Lagrange's equations
+ * evaluated by finite differences of its mass matrix M(q) (independent of how
+ * s was derived):  r:  s_r = -d/dt(M_r. v);  w (true coordinates):
+ * s_f = -d/dt(M_f. v) + dT/dw;  w' (quasi-velocities, Boltzmann-Hamel):
+ * s_th = -d/dt(M_th. v) - w' x (M_th. v) + u x A^T rd, u = w' x S + S1 wd,
+ * with T = 1/2 v^T M v and d/dt along q (+) tau v at constant v. */
+static void flex_mass(const mb_flex *fx, const double *q, const double *v, double *Mb, double *fb) {
+  static const double zero[3] = {0, 0, 0};
+  mb_frame f;
+  mb_frame_rigid(q, v, &f);
+  mb_flex_body(fx, &f, q + 7, v + 6, zero, Mb, fb);
+}
+
+static void test_flexible_inertia(void **state) {
+  (void)state;
+  const mb_model *m = &free_flexible_model;
+  const mb_body *B = &m->body[0];
+  const mb_flex *fx = B->flex;
+  int nm = fx->nm, n = 6 + nm;
+  double q[64], v[64], qp[64], qm[64], Mb[4096], Mp[4096], Mm[4096], fb[64], fp[64], worst = 0;
+  assert_true(n <= 64);
+  for (int trial = 0; trial < 5; trial++) {
+    random_state(m, q, v);
+    flex_mass(fx, q, v, Mb, fb);
+    /* s = fb + K w + C wd (no gravity here) */
+    double s[64];
+    for (int i = 0; i < n; i++) s[i] = fb[i];
+    for (int j = 0; j < nm; j++) s[6 + j] += fx->stiffness[j] * q[7 + j] + fx->damping[j] * v[6 + j];
+    double h = 1e-6 / fmax(1, sqrt(mb_dot3(v + 3, v + 3)));
+    moved(m, q, v, h, qp);
+    moved(m, q, v, -h, qm);
+    flex_mass(fx, qp, v, Mp, fp);
+    flex_mass(fx, qm, v, Mm, fp);
+    double dMv[64], Mv[64];
+    for (int i = 0; i < n; i++) {
+      dMv[i] = Mv[i] = 0;
+      for (int l = 0; l < n; l++) {
+        dMv[i] += (Mp[n * i + l] - Mm[n * i + l]) / (2 * h) * v[l];
+        Mv[i] += Mb[n * i + l] * v[l];
+      }
+    }
+    double ref[64];
+    /* translation */
+    for (int i = 0; i < 3; i++) ref[i] = -dMv[i];
+    /* rotation: -d/dt(M_th. v) - w' x (M_th. v) + u x A^T rd */
+    double A[9], S[3], S1wd[3], u[3], Ard[3], t1[3], t2[3];
+    mb_euler_to_A(q + 3, A);
+    mb_modal3(fx->S1, nm, q + 7, S);
+    for (int i = 0; i < 3; i++) S[i] += fx->S0[i];
+    mb_modal3(fx->S1, nm, v + 6, S1wd);
+    mb_cross3(v + 3, S, u);
+    for (int i = 0; i < 3; i++) u[i] += S1wd[i];
+    mb_mul3t(A, v, Ard);
+    mb_cross3(v + 3, Mv + 3, t1);
+    mb_cross3(u, Ard, t2);
+    for (int i = 0; i < 3; i++) ref[3 + i] = -dMv[3 + i] - t1[i] + t2[i];
+    /* modes: -d/dt(M_f. v) + dT/dw */
+    for (int j = 0; j < nm; j++) {
+      double e = 1e-6 / shape_scale(B, j), Tp = 0, Tm = 0;
+      memcpy(qp, q, sizeof(double) * (size_t)m->nq);
+      memcpy(qm, q, sizeof(double) * (size_t)m->nq);
+      qp[7 + j] += e;
+      qm[7 + j] -= e;
+      flex_mass(fx, qp, v, Mp, fp);
+      flex_mass(fx, qm, v, Mm, fp);
+      for (int i = 0; i < n; i++)
+        for (int l = 0; l < n; l++) {
+          Tp += 0.5 * v[i] * Mp[n * i + l] * v[l];
+          Tm += 0.5 * v[i] * Mm[n * i + l] * v[l];
+        }
+      ref[6 + j] = -dMv[6 + j] + (Tp - Tm) / (2 * e);
+    }
+    double scale = 0;
+    for (int i = 0; i < n; i++) scale = fmax(scale, fabs(ref[i]));
+    for (int i = 0; i < n; i++) {
+      double err = fabs(s[i] - ref[i]) / scale;
+      worst = fmax(worst, err);
+      if (err > 1e-6) print_error("s[%d] = %.12g, from Lagrange's equations %.12g\n", i, s[i], ref[i]);
+    }
+  }
+  print_message("free_flexible: quadratic-velocity forces against Lagrange's equations: worst %.2e\n", worst);
+  assert_true(worst < 1e-6);
+}
+
 /* generalized forces of conservative elements = -dU/dq (v = 0: no damping, no gyroscopic terms) */
 static void test_spring_forces(void **state) {
   (void)state;
@@ -303,6 +387,7 @@ int main(void) {
       cmocka_unit_test(test_constraints_shipped),
       cmocka_unit_test(test_constraints_flexible),
       cmocka_unit_test(test_spring_forces),
+      cmocka_unit_test(test_flexible_inertia),
       cmocka_unit_test(test_mass_and_gyroscopic),
       cmocka_unit_test(test_generated_equals_generic),
   };
