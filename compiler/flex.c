@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "diag.h"
 #include "flex.h"
 
 /* modal damping ratio of a mode of frequency f (Hz) */
@@ -132,4 +133,17 @@ int flex_mass_entry(const mb_flex *f, int i, int l) {
   if (bi == 1 && bl == 1) return cst ? (f->J0[3 * (i - 3) + (l - 3)] != 0 ? 1 : 0) : 2;
   if (bi == 1 && bl == 2) return cst ? (f->C0[3 * (l - 6) + (i - 3)] != 0 ? 1 : 0) : 2;
   return f->Mff[(size_t)(i - 6) * nm + (l - 6)] != 0 ? 1 : 0;
+}
+
+int flex_compute_modes(const char *path, const ir_body *B, fe_modes *fm) {
+  char err[512];
+  ir_loc where = {0, 0};
+  if (!fe_compute_modes_at(B->flex, fm, err, sizeof err, &where)) return 0;
+  if (where.line > 0)
+    diag_error(path, where, "flexible body '%s': %s", B->name, err);
+  else if (strstr(err, ": error: ")) /* a modal data file's own diagnostic */
+    fprintf(stderr, "%s\n", err), diag_error(path, B->loc, "flexible body '%s': its modal data file is invalid", B->name);
+  else
+    diag_error(path, B->loc, "flexible body '%s': %s", B->name, err);
+  return 2;
 }

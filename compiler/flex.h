@@ -18,4 +18,7 @@ void flex_data_free(flex_data *d);
 /* 0: structurally zero, 1: constant, 2: varying entry (i, l) of the mass block */
 int flex_mass_entry(const mb_flex *f, int i, int l);
 
+/* fe_compute_modes with diagnostics at the faulty element; 0 or 2 */
+int flex_compute_modes(const char *path, const ir_body *B, fe_modes *fm);
+
 #endif

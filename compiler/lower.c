@@ -279,8 +279,11 @@ lmodel *lower_model(const ir_model *ir) {
     d->vadr = nv;
     if (B->kind == BODY_FLEXIBLE) {
       char err[512];
-      if (fe_compute_modes(B->flex, &L->modes[b], err, sizeof err) ||
-          flex_build(B->flex, &L->modes[b], &L->flexd[b], err, sizeof err)) {
+      if (flex_compute_modes(ir->path, B, &L->modes[b])) {
+        lower_free(L);
+        return NULL;
+      }
+      if (flex_build(B->flex, &L->modes[b], &L->flexd[b], err, sizeof err)) {
         diag_error(ir->path, B->loc, "flexible body '%s': %s", B->name, err);
         lower_free(L);
         return NULL;

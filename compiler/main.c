@@ -11,6 +11,7 @@
 
 #include "diag.h"
 #include "fe.h"
+#include "flex.h"
 #include "lower.h"
 #include "mb_driver.h"
 
@@ -117,7 +118,10 @@ static int cmd_check(const options *o) {
     else nrigid++;
   }
   printf("model %s%s%s: ok\n", m->name, ir->scene ? ", scene " : "", ir->scene ? ir->scene : "");
-  printf("  bodies            %d (%d rigid, %d virtual) + ground\n", m->nbody, nrigid, nvirtual);
+  int nflex = 0;
+  for (int b = 0; b < m->nbody; b++) nflex += m->body[b].kind == MB_BODY_FLEXIBLE;
+  printf("  bodies            %d (%d rigid, %d flexible, %d virtual) + ground\n", m->nbody,
+         nrigid - nflex, nflex, nvirtual);
   printf("  coordinates       %d position, %d velocity\n", m->nq, m->nv);
   printf("  joints            %d, drivers %d, forces %d, outputs %d (%d columns)\n", ir->njoints,
          ir->ndrivers, ir->nforces, ir->noutputs, m->ncols);
@@ -158,21 +162,20 @@ static int cmd_modes(const options *o) {
     return 2;
   }
   fe_modes fm;
-  char err[512];
-  if (fe_compute_modes(ir->bodies[ib].flex, &fm, err, sizeof err)) {
-    diag_error(o->model, ir->bodies[ib].loc, "flexible body '%s': %s", o->body, err);
+  if (flex_compute_modes(o->model, &ir->bodies[ib], &fm)) {
     ir_free(ir);
     return 2;
   }
-  printf("flexible body '%s': %d nodes, %d DOFs computed, %d modes selected\n", o->body, fm.nnodes,
-         fm.nall, fm.nmodes);
-  printf("mode  frequency_hz  selected\n");
-  for (int j = 0; j < fm.nall; j++) {
-    int sel = 0;
-    for (int k = 0; k < fm.nmodes; k++)
-      if (fabs(fm.freq_hz[k] - fm.all_freq_hz[j]) <= 1e-12 * fabs(fm.all_freq_hz[j])) sel = 1;
-    printf("%4d  %12.6g  %s\n", j + 1, fm.all_freq_hz[j], sel ? "yes" : "");
-  }
+  const ir_flex *fx = ir->bodies[ib].flex;
+  int cb = fx->ninterface > 0;
+  printf("flexible body '%s': %d nodes, %d modes selected%s\n", o->body, fm.nnodes, fm.nmodes,
+         cb ? " (Craig-Bampton: interface constraint modes and fixed-interface normal modes, "
+              "orthonormalized)" : " (constrained normal modes)");
+  printf("mode  frequency_hz\n");
+  for (int j = 0; j < fm.nmodes; j++) printf("%4d  %12.6g\n", j + 1, fm.freq_hz[j]);
+  printf("%s (%d):", cb ? "fixed-interface normal modes computed, Hz" : "all modes computed, Hz", fm.nall);
+  for (int j = 0; j < fm.nall; j++) printf(" %.6g", fm.all_freq_hz[j]);
+  printf("\n");
   int st = 0;
   if (o->shapes) {
     char tmp[4200];
