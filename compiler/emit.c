@@ -172,7 +172,8 @@ static void emit_tables(FILE *f, const lmodel *L) {
           fputs(", 0, 0}, ", f);
       }
       num(f, d->L0); fputs(", ", f); num(f, d->preload); fputs(", ", f);
-      vec(f, d->k6, 6); fputs(", ", f); vec(f, d->c6, 6); fputs(", ", f); vec(f, d->pre6, 6);
+      vec(f, d->d0, 3); fputs(", ", f); vec(f, d->K, 36); fputs(", ", f); vec(f, d->C, 36); fputs(", ", f);
+      vec(f, d->pre, 6);
       fputs("},\n", f);
     }
     fputs("};\n", f);
@@ -390,10 +391,10 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
         add_cols(f, L->body[b1].vadr, emit_cols(f, L, d->m1, P, "F1", "zero3", "    "));
       }
       break;
-    case MB_FORCE_BUSHING:
+    case MB_FORCE_FIELD:
       fprintf(f, "    mb_real F[3], T[3];\n"
-                 "    mb_force_bushing(&k[%d], &k[%d], forces[%d].k6, forces[%d].c6, forces[%d].pre6, F, T);\n",
-              d->m0, d->m1, k, k, k);
+                 "    mb_force_field(&k[%d], &k[%d], forces[%d].d0, forces[%d].K, forces[%d].C, forces[%d].pre, F, T);\n",
+              d->m0, d->m1, k, k, k, k);
       if (b0 >= 0)
         fputs("    mb_real mF[3] = {-F[0], -F[1], -F[2]}, mT[3] = {-T[0], -T[1], -T[2]};\n", f);
       if (b1 >= 0) {

@@ -154,7 +154,9 @@ typedef enum {
   FORCE_POINT_FORCE,   /* a force at a point of one body */
   FORCE_POINT_TORQUE,  /* a torque on one body */
   FORCE_SPRING_DAMPER, /* along the line between two points */
-  FORCE_BUSHING        /* 6 diagonal stiffness and damping terms in a frame */
+  FORCE_BUSHING,       /* 6 diagonal stiffness and damping terms in a frame */
+  FORCE_FIELD,         /* general 6x6 stiffness and damping in a frame */
+  FORCE_BEAM           /* massless Euler-Bernoulli / Timoshenko beam between two points */
 } ir_force_kind;
 
 typedef enum { LAW_NONE = 0, LAW_LINEAR, LAW_POWER, LAW_TABLE } ir_law_kind;
@@ -190,7 +192,12 @@ typedef struct {
   /* bushing: in the frame 'axes' (rows are the global x, y, z axes of the
      bushing frame at t = 0; default identity), forces -k x - c v + preload */
   double k6[6], c6[6], preload6[6];
-  double axes[9];
+  double axes[9];     /* rows: the element frame's x, y, z (beam: x along it, y the section's) */
+  /* field: 6x6 stiffness and damping, row-major, in the frame 'axes' */
+  double K[36], C[36];
+  /* beam: section and material (node[] unused), damping = ratio * stiffness */
+  ir_beam beam;
+  double damping_ratio;
   bool active;
 } ir_force;
 

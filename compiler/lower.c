@@ -414,12 +414,15 @@ lmodel *lower_model(const ir_model *ir) {
       if (F->scale.kind != PROFILE_NONE) d->profile = add_profile(L, &F->scale, -1, e);
       break;
     case FORCE_SPRING_DAMPER:
-    case FORCE_BUSHING: {
+    case FORCE_BUSHING:
+    case FORCE_FIELD:
+    case FORCE_BEAM: {
+      /* marker axes: the element's frame (rows of 'axes', global at t = 0) */
       double Cg[9];
       for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++) Cg[3 * i + j] = F->axes[3 * j + i]; /* columns = axes rows */
       int spring = F->kind == FORCE_SPRING_DAMPER;
-      d->kind = spring ? MB_FORCE_SPRING : MB_FORCE_BUSHING;
+      d->kind = spring ? MB_FORCE_SPRING : MB_FORCE_FIELD;
       for (int s = 0; s < 2; s++) {
         int mk = add_marker(L, F->body[s] - 1, F->node[s], F->point[s], spring ? I3 : Cg,
                             xstrdup_printf("force '%s', on body '%s'%s", F->name,
@@ -438,10 +441,25 @@ lmodel *lower_model(const ir_model *ir) {
         }
         d->L0 = F->free_length;
         d->preload = F->preload;
-      } else {
-        memcpy(d->k6, F->k6, sizeof d->k6);
-        memcpy(d->c6, F->c6, sizeof d->c6);
-        memcpy(d->pre6, F->preload6, sizeof d->pre6);
+      } else if (F->kind == FORCE_BUSHING) {
+        for (int i = 0; i < 6; i++) {
+          d->K[7 * i] = F->k6[i];
+          d->C[7 * i] = F->c6[i];
+          d->pre[i] = F->preload6[i];
+        }
+      } else if (F->kind == FORCE_FIELD) {
+        memcpy(d->K, F->K, sizeof d->K);
+        memcpy(d->C, F->C, sizeof d->C);
+        memcpy(d->pre, F->preload6, sizeof d->pre);
+      } else { /* beam: x from point 0 to point 1, clamped at marker 0 */
+        const ir_beam *bm = &F->beam;
+        double len = 0;
+        for (int i = 0; i < 3; i++) len += (F->point[1][i] - F->point[0][i]) * (F->point[1][i] - F->point[0][i]);
+        len = sqrt(len);
+        d->d0[0] = len;
+        mb_beam_stiffness(len, bm->E, bm->G, bm->A, bm->Iy, bm->Iz, bm->J, bm->shear_y * bm->A,
+                          bm->shear_z * bm->A, d->K);
+        for (int i = 0; i < 36; i++) d->C[i] = F->damping_ratio * d->K[i];
       }
       break;
     }

@@ -1889,7 +1889,7 @@ static void parse_driver(reader *r, yaml_node_t *key, yaml_node_t *value) {
  * forces
  * ------------------------------------------------------------------------- */
 
-static const char *const force_type_names[] = {"force", "torque", "spring_damper", "bushing", NULL};
+static const char *const force_type_names[] = {"force", "torque", "spring_damper", "bushing", "field", "beam", NULL};
 static const char *const frame_names[] = {"global", "body", NULL};
 
 /* A number (linear), {coefficient, exponent} (power) or {table: ...}. */
@@ -2014,6 +2014,133 @@ static void parse_spring_damper(mapping *m, ir_force *f) {
              f->name);
 }
 
+/* 'axes': rows x, y, z of an orthonormal right-handed frame (global) */
+static void parse_axes(mapping *m, ir_force *f) {
+  reader *r = m->r;
+  yaml_node_t *axes = map_get(m, "axes");
+  double rows[9];
+  if (axes == NULL || !to_vector_list(r, axes, "'axes'", 3, 3, rows))
+    return;
+  for (int i = 0; i < 3; i++) {
+    for (int k = i; k < 3; k++) {
+      double expected = i == k ? 1 : 0;
+      if (fabs(dot3(rows + 3 * i, rows + 3 * k) - expected) > ANGLE_TOLERANCE) {
+        error_at(r, loc_of(axes),
+                 "'axes' must be orthonormal (row %d . row %d = %g, expected %g)", i + 1,
+                 k + 1, dot3(rows + 3 * i, rows + 3 * k), expected);
+        return;
+      }
+    }
+  }
+  double cross_z = rows[0] * rows[4] - rows[1] * rows[3]; /* (x cross y) . z */
+  double cross_y = rows[2] * rows[3] - rows[0] * rows[5];
+  double cross_x = rows[1] * rows[5] - rows[2] * rows[4];
+  if (cross_x * rows[6] + cross_y * rows[7] + cross_z * rows[8] < 0) {
+    error_at(r, loc_of(axes), "'axes' must be right-handed (z = x cross y)");
+    return;
+  }
+  memcpy(f->axes, rows, sizeof rows);
+}
+
+/* a 6x6 matrix as a list of 6 rows of 6 numbers */
+static bool to_matrix6(reader *r, yaml_node_t *n, const char *label, double out[36]) {
+  if (n->type != YAML_SEQUENCE_NODE || seq_length(n) != 6) {
+    error_at(r, loc_of(n), "%s: expected a 6x6 matrix (a list of 6 rows of 6 numbers)", label);
+    return false;
+  }
+  bool ok = true;
+  for (int i = 0; i < 6; i++) {
+    char row_label[SHOWN_SIZE];
+    snprintf(row_label, sizeof row_label, "row %d of %s", i + 1, label);
+    yaml_node_t *row = seq_item(r, n, i);
+    if (row->type != YAML_SEQUENCE_NODE || seq_length(row) != 6) {
+      error_at(r, loc_of(row), "%s: expected 6 numbers", row_label);
+      ok = false;
+      continue;
+    }
+    for (int j = 0; j < 6; j++) {
+      char item_label[SHOWN_SIZE + 32];
+      snprintf(item_label, sizeof item_label, "element %d of %s", j + 1, row_label);
+      ok = to_number(r, seq_item(r, row, j), item_label, &out[6 * i + j]) && ok;
+    }
+  }
+  return ok;
+}
+
+/* field: a general 6x6 stiffness and damping between two bodies (seed 001 3.2.6) */
+static void parse_field(mapping *m, ir_force *f) {
+  reader *r = m->r;
+  static const char *const keys[] = {"type", "bodies", "point", "stiffness", "damping",
+                                     "preload", "axes", "node", "nodes", NULL};
+  map_check_keys(m, keys);
+  bool on_nodes = get_body_pair(m, f->body, f->body_loc) && get_fe_nodes(m, f->body, f->node);
+  bool given = get_vector(m, "point", 3, !on_nodes, f->point[0]);
+  if (given)
+    memcpy(f->point[1], f->point[0], sizeof f->point[0]);
+  if (on_nodes) {
+    check_node_point(r, r->model, m->loc, f->body, f->node, given, &f->point[0][0]);
+    if (!given)
+      memcpy(f->point[f->node[0] >= 0 ? 1 : 0], f->point[f->node[0] >= 0 ? 0 : 1], sizeof f->point[0]);
+  }
+  yaml_node_t *k = map_require(m, "stiffness", true, "a 6x6 matrix");
+  if (k != NULL && to_matrix6(r, k, "'stiffness'", f->K))
+    for (int i = 0; i < 6; i++)
+      for (int j = 0; j < i; j++)
+        if (fabs(f->K[6 * i + j] - f->K[6 * j + i]) > 1e-9 * (fabs(f->K[6 * i + j]) + fabs(f->K[6 * j + i]) + 1e-300)) {
+          error_at(r, loc_of(k), "field 'stiffness' must be symmetric (row %d, column %d differs from row %d, column %d)", i + 1, j + 1, j + 1, i + 1);
+          i = 6;
+          break;
+        }
+  yaml_node_t *c = map_get(m, "damping");
+  if (c != NULL) to_matrix6(r, c, "'damping'", f->C);
+  get_six(m, "preload", false, false, f->preload6);
+  parse_axes(m, f);
+}
+
+/* beam: a massless Euler-Bernoulli or Timoshenko beam from point 0 (clamped on
+ * body 0) to point 1 (seed 001 3.2.5), damping = damping_ratio * stiffness */
+static void parse_beam_force(mapping *m, ir_force *f) {
+  reader *r = m->r;
+  static const char *const keys[] = {"type", "bodies", "points", "node", "nodes", "section",
+                                     "material", "theory", "damping_ratio", NULL};
+  map_check_keys(m, keys);
+  bool on_nodes = get_body_pair(m, f->body, f->body_loc) && get_fe_nodes(m, f->body, f->node);
+  bool all_nodes = f->node[0] >= 0 && f->node[1] >= 0;
+  yaml_node_t *points = map_require(m, "points", !all_nodes, "a list of 2 points [x, y, z]");
+  bool given = points != NULL && to_vector_list(r, points, "'points'", 2, 3, &f->point[0][0]);
+  if (on_nodes)
+    check_node_point(r, r->model, points ? loc_of(points) : m->loc, f->body, f->node, given, &f->point[0][0]);
+  int th = 0;
+  if (get_choice(m, "theory", "beam theory", theory_names, false, &th)) f->beam.theory = (ir_beam_theory)th;
+  f->beam.yaxis[1] = 1;
+  parse_beam_properties(r, m, &f->beam);
+  get_nonnegative(m, "damping_ratio", false, &f->damping_ratio);
+  double x[3];
+  for (int i = 0; i < 3; i++) x[i] = f->point[1][i] - f->point[0][i];
+  double len = norm3(x);
+  if ((given || all_nodes) && !(len > ZERO_LENGTH)) {
+    error_at(r, points ? loc_of(points) : m->loc, "beam end points coincide (a beam needs a length)");
+    return;
+  }
+  if (!(len > ZERO_LENGTH)) return;
+  scale3(x, 1 / len);
+  /* the section's y axis across the beam: given, else global y (global z for a beam along y) */
+  double y[3];
+  memcpy(y, f->beam.yaxis, sizeof y);
+  if (fabs(dot3(x, y)) > 0.9) { y[0] = y[1] = 0; y[2] = 1; }
+  double along = dot3(x, y);
+  for (int i = 0; i < 3; i++) y[i] -= along * x[i];
+  if (!(norm3(y) > 1e-6)) {
+    error_at(r, m->loc, "the beam's section 'yaxis' is parallel to the beam");
+    return;
+  }
+  scale3(y, 1 / norm3(y));
+  double z[3] = {x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]};
+  memcpy(f->axes, x, sizeof x);
+  memcpy(f->axes + 3, y, sizeof y);
+  memcpy(f->axes + 6, z, sizeof z);
+}
+
 static void parse_bushing(mapping *m, ir_force *f) {
   reader *r = m->r;
   static const char *const keys[] = {"type",    "bodies",  "point", "stiffness",
@@ -2031,29 +2158,7 @@ static void parse_bushing(mapping *m, ir_force *f) {
   get_six(m, "stiffness", true, true, f->k6);
   get_six(m, "damping", false, true, f->c6);
   get_six(m, "preload", false, false, f->preload6);
-  yaml_node_t *axes = map_get(m, "axes");
-  double rows[9];
-  if (axes == NULL || !to_vector_list(r, axes, "'axes'", 3, 3, rows))
-    return;
-  for (int i = 0; i < 3; i++) {
-    for (int k = i; k < 3; k++) {
-      double expected = i == k ? 1 : 0;
-      if (fabs(dot3(rows + 3 * i, rows + 3 * k) - expected) > ANGLE_TOLERANCE) {
-        error_at(r, loc_of(axes),
-                 "bushing 'axes' must be orthonormal (row %d . row %d = %g, expected %g)", i + 1,
-                 k + 1, dot3(rows + 3 * i, rows + 3 * k), expected);
-        return;
-      }
-    }
-  }
-  double cross_z = rows[0] * rows[4] - rows[1] * rows[3]; /* (x cross y) . z */
-  double cross_y = rows[2] * rows[3] - rows[0] * rows[5];
-  double cross_x = rows[1] * rows[5] - rows[2] * rows[4];
-  if (cross_x * rows[6] + cross_y * rows[7] + cross_z * rows[8] < 0) {
-    error_at(r, loc_of(axes), "bushing 'axes' must be right-handed (z = x cross y)");
-    return;
-  }
-  memcpy(f->axes, rows, sizeof rows);
+  parse_axes(m, f);
 }
 
 static void parse_force(reader *r, yaml_node_t *key, yaml_node_t *value) {
@@ -2086,6 +2191,12 @@ static void parse_force(reader *r, yaml_node_t *key, yaml_node_t *value) {
       break;
     case FORCE_BUSHING:
       parse_bushing(&m, f);
+      break;
+    case FORCE_FIELD:
+      parse_field(&m, f);
+      break;
+    case FORCE_BEAM:
+      parse_beam_force(&m, f);
       break;
     }
   }

@@ -404,22 +404,26 @@ static inline mb_real mb_force_spring(const mb_marker *m0, const mb_marker *m1, 
   return E + preload * x;
 }
 
-/* bushing: in the axes R0 of marker 0, force -K x - C xdot + preload and torque
- * -K th - C wrel + preload on marker 1 (th: rotation vector of R0^T R1);
- * the reaction acts on body 0 at the same point P1.  Returns the potential energy. */
-static inline mb_real mb_force_bushing(const mb_marker *m0, const mb_marker *m1, const mb_real k[6],
-                                       const mb_real c[6], const mb_real pre[6], mb_real F[3],
-                                       mb_real T[3]) {
-  mb_real d[3], dd[3], wd[3], x[3], xd[3], Rr[9], th[3], wr[3], wrel[3], fl[3], tl[3];
+/* field: a general 6x6 stiffness and damping between two markers (bushing,
+ * massless beam, field element).  In the axes R0 of marker 0, with
+ * u = [R0^T (P1 - P0) - d0; th] (th: rotation vector of R0^T R1) and its rate
+ * ud = [R0^T (V1 - V0 - W0 x (P1 - P0)); R0^T (W1 - W0)], the force and torque
+ * on marker 1 at P1 are R0 (-K u - C ud + pre); the reaction acts on body 0
+ * at the same point.  Returns 1/2 u^T K u - pre . u (exact potential for the
+ * translations; for rotations when K's rotational part is isotropic). */
+static inline mb_real mb_force_field(const mb_marker *m0, const mb_marker *m1, const mb_real d0[3],
+                                     const mb_real K[36], const mb_real C[36], const mb_real pre[6],
+                                     mb_real F[3], mb_real T[3]) {
+  mb_real d[3], dd[3], wd[3], u[6], ud[6], Rr[9], f[6], wxd[3];
   for (int j = 0; j < 3; j++) {
     d[j] = m1->P[j] - m0->P[j];
     wd[j] = m1->W[j] - m0->W[j];
   }
-  mb_real wxd[3];
   mb_cross3(m0->W, d, wxd);
   for (int j = 0; j < 3; j++) dd[j] = m1->V[j] - m0->V[j] - wxd[j];
-  mb_mul3t(m0->R, d, x);
-  mb_mul3t(m0->R, dd, xd);
+  mb_mul3t(m0->R, d, u);
+  for (int j = 0; j < 3; j++) u[j] -= d0[j];
+  mb_mul3t(m0->R, dd, ud);
   /* relative rotation R0^T R1 and its rotation vector */
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++)
@@ -427,18 +431,38 @@ static inline mb_real mb_force_bushing(const mb_marker *m0, const mb_marker *m1,
   mb_real v[3] = {0.5 * (Rr[7] - Rr[5]), 0.5 * (Rr[2] - Rr[6]), 0.5 * (Rr[3] - Rr[1])};
   mb_real sn = sqrt(mb_dot3(v, v)), cs = 0.5 * (Rr[0] + Rr[4] + Rr[8] - 1);
   mb_real ang = atan2(sn, cs), fac = (sn > 1e-12) ? ang / sn : 1;
-  for (int j = 0; j < 3; j++) th[j] = fac * v[j];
-  mb_mul3t(m0->R, wd, wr);
-  (void)wrel;
+  for (int j = 0; j < 3; j++) u[3 + j] = fac * v[j];
+  mb_mul3t(m0->R, wd, ud + 3);
   mb_real E = 0;
-  for (int j = 0; j < 3; j++) {
-    fl[j] = -k[j] * x[j] - c[j] * xd[j] + pre[j];
-    tl[j] = -k[3 + j] * th[j] - c[3 + j] * wr[j] + pre[3 + j];
-    E += 0.5 * k[j] * x[j] * x[j] - pre[j] * x[j] + 0.5 * k[3 + j] * th[j] * th[j] - pre[3 + j] * th[j];
+  for (int i = 0; i < 6; i++) {
+    f[i] = pre[i];
+    for (int j = 0; j < 6; j++) {
+      f[i] -= K[6 * i + j] * u[j] + C[6 * i + j] * ud[j];
+      E += 0.5 * u[i] * K[6 * i + j] * u[j];
+    }
+    E -= pre[i] * u[i];
   }
-  mb_mul3(m0->R, fl, F);
-  mb_mul3(m0->R, tl, T);
+  mb_mul3(m0->R, f, F);
+  mb_mul3(m0->R, f + 3, T);
   return E;
+}
+
+/* the 6x6 stiffness of a massless beam of length L clamped at marker 0 and
+ * loaded at marker 1 (local x along the beam, y and z the section axes):
+ * Euler-Bernoulli, or Timoshenko with shear flexibility phi = 12 E I / (G As L^2) */
+static inline void mb_beam_stiffness(mb_real L, mb_real E, mb_real G, mb_real A, mb_real Iy,
+                                     mb_real Iz, mb_real J, mb_real Asy, mb_real Asz, mb_real K[36]) {
+  mb_real py = Asy > 0 ? 12 * E * Iz / (G * Asy * L * L) : 0;
+  mb_real pz = Asz > 0 ? 12 * E * Iy / (G * Asz * L * L) : 0;
+  for (int i = 0; i < 36; i++) K[i] = 0;
+  K[0] = E * A / L;
+  K[7] = 12 * E * Iz / (L * L * L * (1 + py));
+  K[11] = K[31] = -6 * E * Iz / (L * L * (1 + py));
+  K[14] = 12 * E * Iy / (L * L * L * (1 + pz));
+  K[16] = K[26] = 6 * E * Iy / (L * L * (1 + pz));
+  K[21] = G * J / L;
+  K[28] = (4 + pz) * E * Iy / (L * (1 + pz));
+  K[35] = (4 + py) * E * Iz / (L * (1 + py));
 }
 
 #endif

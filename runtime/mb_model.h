@@ -46,17 +46,18 @@ typedef struct {
   int driver;        /* the source driver (effort), or -1 */
 } mb_rowdef;
 
-enum { MB_FORCE_POINT = 1, MB_FORCE_TORQUE, MB_FORCE_SPRING, MB_FORCE_BUSHING };
+enum { MB_FORCE_POINT = 1, MB_FORCE_TORQUE, MB_FORCE_SPRING, MB_FORCE_FIELD };
 
 typedef struct {
   int kind;
-  int m0, m1;        /* POINT/TORQUE: m0 only; SPRING/BUSHING: both */
+  int m0, m1;        /* POINT/TORQUE: m0 only; SPRING/FIELD: both */
   mb_real vec[3];    /* POINT/TORQUE: value */
   int body_frame;    /* POINT/TORQUE: 1 when vec is in body axes */
   int profile;       /* POINT/TORQUE: scale profile, or -1 */
   mb_law stiffness, damping; /* SPRING */
   mb_real L0, preload;       /* SPRING */
-  mb_real k6[6], c6[6], pre6[6]; /* BUSHING */
+  mb_real d0[3];             /* FIELD: undeformed offset of marker 1 in marker 0's axes */
+  mb_real K[36], C[36], pre[6]; /* FIELD (bushings and beams too): 6x6 row-major */
 } mb_forcedef;
 
 enum {

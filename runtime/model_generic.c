@@ -124,10 +124,10 @@ static mb_real forces_eval(const mb_model *m, mb_real t, const mb_real *q, const
       add_wrench(m, F, MK, d->m1, q, F1, zero, f);
       break;
     }
-    case MB_FORCE_BUSHING: {
+    case MB_FORCE_FIELD: {
       mb_real Fv[3], T[3], mF[3], mT[3];
       const mb_marker *m1 = &MK[d->m1];
-      E += mb_force_bushing(m0, m1, d->k6, d->c6, d->pre6, Fv, T);
+      E += mb_force_field(m0, m1, d->d0, d->K, d->C, d->pre, Fv, T);
       for (int j = 0; j < 3; j++) { mF[j] = -Fv[j]; mT[j] = -T[j]; }
       add_wrench(m, F, MK, d->m1, q, Fv, T, f);
       add_wrench_at(m, F, b0, m1->P, mF, mT, f); /* reaction at the same point */
@@ -272,9 +272,9 @@ void mb_model_energy(const mb_model *m, mb_real t, const mb_real *q, const mb_re
       mb_real F0[3], F1[3];
       U += mb_force_spring(&MK[d->m0], &MK[d->m1], &d->stiffness, &d->damping, d->L0, d->preload,
                            F0, F1);
-    } else if (d->kind == MB_FORCE_BUSHING) {
+    } else if (d->kind == MB_FORCE_FIELD) {
       mb_real Fv[3], Tq[3];
-      U += mb_force_bushing(&MK[d->m0], &MK[d->m1], d->k6, d->c6, d->pre6, Fv, Tq);
+      U += mb_force_field(&MK[d->m0], &MK[d->m1], d->d0, d->K, d->C, d->pre, Fv, Tq);
     }
   }
   (void)t;
