@@ -33,6 +33,7 @@ demo: all
 	$(B)/mbcc run models/slider_crank.yaml
 
 include tests/tests.mk
+include docs/results.mk
 
 clean:
 	rm -rf $(B) generated/*/ results

@@ -234,7 +234,7 @@ int assemble_model(lmodel *L, int verbose) {
                  "neither mass nor a constraint");
       for (int b2 = 0; b2 < m->nbody; b2++)
         if (L->body[b2].kind == MB_BODY_VIRTUAL)
-          diag_note(file, L->ir->bodies[b2 + 1].loc,
+          diag_note(file, b2 + 1 < L->ir->nbodies ? L->ir->bodies[b2 + 1].loc : (ir_loc){0, 0},
                     "massless body '%s' must be fully determined by its joints",
                     L->body[b2].name);
       goto out;

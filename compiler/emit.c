@@ -100,9 +100,14 @@ static void emit_tables(FILE *f, const lmodel *L) {
     fprintf(f, "static const mb_body bodies[%d] = {\n", m->nbody);
     for (int b = 0; b < m->nbody; b++) {
       const mb_body *B = &L->body[b];
-      fprintf(f, "  /* body '%s' (", B->name);
-      loc_comment(f, L, L->ir->bodies[b + 1].loc);
-      fprintf(f, ") */\n  {\"%s\", %s, ", B->name, B->kind == MB_BODY_VIRTUAL    ? "MB_BODY_VIRTUAL"
+      if (b + 1 < L->ir->nbodies) {
+        fprintf(f, "  /* body '%s' (", B->name);
+        loc_comment(f, L, L->ir->bodies[b + 1].loc);
+        fputs(") */\n", f);
+      } else {
+        fprintf(f, "  /* body '%s': massless, inserted for a joint on a flexible node */\n", B->name);
+      }
+      fprintf(f, "  {\"%s\", %s, ", B->name, B->kind == MB_BODY_VIRTUAL    ? "MB_BODY_VIRTUAL"
                                           : B->kind == MB_BODY_FLEXIBLE ? "MB_BODY_FLEXIBLE"
                                                                         : "MB_BODY_RIGID");
       num(f, B->mass);

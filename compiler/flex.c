@@ -45,6 +45,11 @@ int flex_build(const ir_flex *fx, const fe_modes *fm, flex_data *out, char *err,
     snprintf(err, nerr, "out of memory");
     return -1;
   }
+  if (fx->damping == DAMPING_LIST && fx->nratios != nm) {
+    snprintf(err, nerr, "'damping' lists %d ratios for %d selected modes (expected one per mode)",
+             fx->nratios, nm);
+    return -1;
+  }
   mb_flex *f = &out->flex;
   f->nm = nm;
   f->coupling = fx->coupling == COUPLING_PARTIAL ? MB_COUPLING_PARTIAL

@@ -504,6 +504,7 @@ lmodel *lower_model(const ir_model *ir) {
       d->chord[1] = o->chord[1];
     }
     if (o->kind == OUT_MODAL) d->node = o->mode;
+    if (o->kind == OUT_POSITION || o->kind == OUT_VELOCITY) d->node = o->node;
     if ((o->kind == OUT_DEFLECTION || o->kind == OUT_MODAL) &&
         (d->body < 0 || L->body[d->body].kind != MB_BODY_FLEXIBLE ||
          (o->kind == OUT_MODAL && o->mode >= L->body[d->body].nm))) {

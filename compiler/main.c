@@ -134,10 +134,12 @@ static int cmd_check(const options *o) {
     if (m->body[b].kind != MB_BODY_FLEXIBLE) continue;
     const fe_modes *fm = &L->modes[b];
     static const char *coupling[] = {"full", "partial", "constant"};
+    int rigid = L->ir->bodies[b + 1 < L->ir->nbodies ? b + 1 : 0].flex &&
+                L->ir->bodies[b + 1].flex->coupling == COUPLING_RIGID;
     printf("  flexible body '%s': %d nodes, %d modes (coordinates q %d..%d, v %d..%d), coupling %s\n",
            m->body[b].name, fm->nnodes, m->body[b].nm, m->body[b].qadr + 7,
            m->body[b].qadr + 6 + m->body[b].nm, m->body[b].vadr + 6, m->body[b].vadr + 5 + m->body[b].nm,
-           coupling[m->body[b].flex->coupling]);
+           rigid ? "rigid (no modes)" : coupling[m->body[b].flex->coupling]);
     printf("    frequencies (Hz):");
     for (int j = 0; j < m->body[b].nm; j++) printf(" %.6g", fm->freq_hz[j]);
     printf("\n    mass %.6g kg, damping ratios:", m->body[b].flex->mass);

@@ -932,6 +932,12 @@ static bool get_fe_nodes(mapping *m, const int body[2], int node[2]) {
 
 static void node_global(const ir_body *b, int k, double out[3]);
 
+/* whether the element is given on FE nodes (true also when the nodes given
+ * were wrong: that was reported, and the point is then not required) */
+static bool fe_nodes_given(mapping *m, const int body[2], int node[2]) {
+  return get_fe_nodes(m, body, node) || map_has(m, "node") || map_has(m, "nodes");
+}
+
 /* the point of side s: the node's position when a node is given (a point
  * given as well must coincide with it) */
 static void check_node_point(reader *r, const ir_model *model, ir_loc loc, const int body[2],
@@ -1233,8 +1239,8 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
       "type",    "position",  "orientation", "velocity", "angular_velocity", "line",
       "nodes",   "beams",     "section",     "material", "theory",           "mass",
       "point_masses", "reference", "interface", "modes", "damping", "coupling", "modal_file", NULL};
-  map_check_keys(m, keys);
   map_reject(m, "inertia", "flexible body '%s': its inertia comes from its FE model", b->name);
+  map_check_keys(m, keys);
   ir_flex *fx = xcalloc(1, sizeof *fx);
   b->flex = fx;
   fx->loc = b->loc;
@@ -1653,7 +1659,7 @@ static void parse_joint(reader *r, yaml_node_t *key, yaml_node_t *value) {
                                                   : axis_keys);
   bool on_nodes = false;
   if (get_body_pair(&m, j->body, j->body_loc))
-    on_nodes = get_fe_nodes(&m, j->body, j->node);
+    on_nodes = fe_nodes_given(&m, j->body, j->node);
 
   if (j->kind == JOINT_DISTANCE) {
     yaml_node_t *n = map_require(&m, "points", !on_nodes, "a list of 2 points [x, y, z]");
@@ -1959,7 +1965,7 @@ static void parse_point_load(mapping *m, ir_force *f) {
   bool on_node = false;
   if (get_ref(m, "body", NAME_BODY, true, &f->body[0], &f->body_loc[0])) {
     memcpy(f->point[0], r->model->bodies[f->body[0]].position, sizeof f->point[0]);
-    on_node = get_fe_nodes(m, f->body, f->node);
+    on_node = fe_nodes_given(m, f->body, f->node);
   }
   bool given = is_force && get_vector(m, "point", 3, false, f->point[0]);
   if (on_node) check_node_point(r, r->model, m->loc, f->body, f->node, given, &f->point[0][0]);
@@ -1980,7 +1986,7 @@ static void parse_spring_damper(mapping *m, ir_force *f) {
   static const char *const keys[] = {"type",    "bodies",      "points",  "stiffness",
                                      "damping", "free_length", "preload", "node", "nodes", NULL};
   map_check_keys(m, keys);
-  bool on_nodes = get_body_pair(m, f->body, f->body_loc) && get_fe_nodes(m, f->body, f->node);
+  bool on_nodes = get_body_pair(m, f->body, f->body_loc) && fe_nodes_given(m, f->body, f->node);
   bool all_nodes = f->node[0] >= 0 && f->node[1] >= 0;
   yaml_node_t *points = map_require(m, "points", !all_nodes, "a list of 2 points [x, y, z]");
   bool have_points = false, given = points != NULL && to_vector_list(r, points, "'points'", 2, 3, &f->point[0][0]);
@@ -2073,7 +2079,7 @@ static void parse_field(mapping *m, ir_force *f) {
   static const char *const keys[] = {"type", "bodies", "point", "stiffness", "damping",
                                      "preload", "axes", "node", "nodes", NULL};
   map_check_keys(m, keys);
-  bool on_nodes = get_body_pair(m, f->body, f->body_loc) && get_fe_nodes(m, f->body, f->node);
+  bool on_nodes = get_body_pair(m, f->body, f->body_loc) && fe_nodes_given(m, f->body, f->node);
   bool given = get_vector(m, "point", 3, !on_nodes, f->point[0]);
   if (given)
     memcpy(f->point[1], f->point[0], sizeof f->point[0]);
@@ -2104,7 +2110,7 @@ static void parse_beam_force(mapping *m, ir_force *f) {
   static const char *const keys[] = {"type", "bodies", "points", "node", "nodes", "section",
                                      "material", "theory", "damping_ratio", NULL};
   map_check_keys(m, keys);
-  bool on_nodes = get_body_pair(m, f->body, f->body_loc) && get_fe_nodes(m, f->body, f->node);
+  bool on_nodes = get_body_pair(m, f->body, f->body_loc) && fe_nodes_given(m, f->body, f->node);
   bool all_nodes = f->node[0] >= 0 && f->node[1] >= 0;
   yaml_node_t *points = map_require(m, "points", !all_nodes, "a list of 2 points [x, y, z]");
   bool given = points != NULL && to_vector_list(r, points, "'points'", 2, 3, &f->point[0][0]);
@@ -2146,7 +2152,7 @@ static void parse_bushing(mapping *m, ir_force *f) {
   static const char *const keys[] = {"type",    "bodies",  "point", "stiffness",
                                      "damping", "preload", "axes",  "node", "nodes", NULL};
   map_check_keys(m, keys);
-  bool on_nodes = get_body_pair(m, f->body, f->body_loc) && get_fe_nodes(m, f->body, f->node);
+  bool on_nodes = get_body_pair(m, f->body, f->body_loc) && fe_nodes_given(m, f->body, f->node);
   bool given = get_vector(m, "point", 3, !on_nodes, f->point[0]);
   if (given)
     memcpy(f->point[1], f->point[0], sizeof f->point[0]);
@@ -2253,6 +2259,8 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
     keys[nkeys++] = "body";
   if (has_point)
     keys[nkeys++] = "point";
+  if (k == OUT_POSITION || k == OUT_VELOCITY)
+    keys[nkeys++] = "node";
   if (k == OUT_ANGLE)
     keys[nkeys++] = "axis";
   if (has_component)
@@ -2275,6 +2283,16 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
     get_ref(&m, "body", NAME_BODY, true, &o->body, NULL);
   if (has_point)
     o->has_point = get_vector(&m, "point", 3, false, o->point);
+  if ((k == OUT_POSITION || k == OUT_VELOCITY) && map_has(&m, "node") && o->body >= 0) {
+    const ir_body *b = &r->model->bodies[o->body];
+    yaml_node_t *nd = map_get(&m, "node");
+    if (b->kind != BODY_FLEXIBLE)
+      error_at(r, loc_of(nd), "'node' needs a flexible body ('%s' is not)", b->name);
+    else if (o->has_point)
+      error_at(r, loc_of(nd), "give either 'point' or 'node', not both");
+    else
+      o->node = to_fe_node(r, nd, b);
+  }
   if (k == OUT_ANGLE)
     get_axis(&m, "axis", true, o->axis);
   if (has_component)

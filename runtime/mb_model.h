@@ -81,7 +81,8 @@ typedef struct {
   int driver_row;    /* EFFORT: the driver's row, or -1 when redundant */
   int driver_marker; /* EFFORT: marker 0 of the driven joint (its z axis) */
   int driver_rotation; /* EFFORT: 1 rotation, 0 translation */
-  int node;          /* DEFLECTION: the node; deflection X_k w in body axes */
+  int node;          /* DEFLECTION: the node (deflection X_k w, body axes); POSITION, VELOCITY:
+                        a node of a flexible body, or -1; MODAL: the mode */
   int chord[2];      /* DEFLECTION: minus the chord between these nodes' deflections, or -1 */
   mb_real scale;
   int ncols, col;    /* columns in the output vector and the first of them */

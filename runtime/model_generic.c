@@ -317,6 +317,17 @@ void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_r
     const mb_frame *f = o->body >= 0 ? &F[o->body] : 0;
     mb_real val[6] = {0, 0, 0, 0, 0, 0}, u[3], tmp[3], tmp2[3];
     int nval = 3;
+    if ((o->kind == MB_OUT_POSITION || o->kind == MB_OUT_VELOCITY) && o->node >= 0) {
+      /* a node of a flexible body */
+      const mb_body *B = &m->body[o->body];
+      static const mb_real I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+      mb_marker nk;
+      mb_marker_node(f, B->flex, o->node, q + B->qadr + 7, v + B->vadr + 6, I3, &nk);
+      for (int j = 0; j < 3; j++) val[j] = o->kind == MB_OUT_POSITION ? nk.P[j] : nk.V[j];
+      if (o->component >= 0) out[o->col] = o->scale * val[o->component];
+      else for (int j = 0; j < 3; j++) out[o->col + j] = o->scale * val[j];
+      continue;
+    }
     switch (o->kind) {
     case MB_OUT_POSITION:
       mb_mul3(f->A, o->s, u);
