@@ -1246,6 +1246,7 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
   fx->loc = b->loc;
   fx->select = MODES_ALL;
   fx->coupling = COUPLING_FULL;
+  fx->damping = DAMPING_BANDS; /* seed 001 section 2.6: the three-band default */
   yaml_node_t *orientation = map_get(m, "orientation");
   if (orientation != NULL) parse_orientation(r, orientation, m->what, b->orientation);
   get_vector(m, "velocity", 3, false, b->velocity);
