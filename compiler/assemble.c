@@ -205,13 +205,11 @@ int assemble_model(lmodel *L, int verbose) {
   }
   L->dof = m->nv - rank;
 
-  /* 3. velocities: minimum-norm correction onto D v = nu */
+  /* 3. velocities: minimum-norm correction onto D v = nu (e.nu holds phid = D v - nu) */
   evaluate(m, &e, L->q0, L->v0);
   if (m->nc > 0) {
     dense_D(m, e.Kx, D);
-    for (int r = 0; r < m->nc; r++) b[r] = e.nu[r];
-    for (int r = 0; r < m->nc; r++)
-      for (int j = 0; j < m->nv; j++) b[r] -= D[(size_t)j * (size_t)m->nc + (size_t)r] * L->v0[j];
+    for (int r = 0; r < m->nc; r++) b[r] = -e.nu[r];
     freeze_modes(m, D);
     if (min_norm_solve(m->nc, m->nv, D, b)) goto out;
     for (int j = 0; j < m->nv; j++) L->v0[j] += b[j];

@@ -286,13 +286,13 @@ static void emit_flex_tables(FILE *f, const lmodel *L, int b) {
 static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
   const mb_model *m = &L->m;
   fprintf(f,
-          "\n/* Fill the varying entries of K, rhs = [f; gamma], phi and nu at (t, q, v). */\n"
+          "\n/* Fill the varying entries of K, rhs = [f; gamma], phi and phid = D v - nu at (t, q, v). */\n"
           "void %s_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,\n"
-          "    mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *nu, void *work) {\n"
+          "    mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *phid, void *work) {\n"
           "  static const mb_real zero3[3] = {0, 0, 0};\n"
           "  mb_frame f[%d];\n  mb_marker k[%d];\n  mb_row r;\n  mb_real c[6 + MB_MAX_MODES], x[3];\n"
           "  (void)m; (void)work; (void)t; (void)x; (void)c; (void)r; (void)zero3;\n"
-          "  (void)Kx; (void)phi; (void)nu; (void)f; (void)k;\n",
+          "  (void)Kx; (void)phi; (void)phid; (void)f; (void)k;\n",
           nm, m->nbody ? m->nbody : 1, m->nmarker ? m->nmarker : 1);
   fprintf(f, "\n  /* body frames */\n");
   for (int b = 0; b < m->nbody; b++)
@@ -415,7 +415,7 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
     }
     fputs("  }\n", f);
   }
-  fprintf(f, "\n  /* constraint rows: D in both triangles of K, gamma, phi, nu */\n");
+  fprintf(f, "\n  /* constraint rows: D in both triangles of K, gamma, phi, phid */\n");
   static const char *prim[] = {"", "sph", "dot1", "dot2", "dist", "rot", "trans"};
   for (int r = 0; r < m->nrow; r++) {
     const mb_rowdef *R = &L->row[r];
@@ -439,7 +439,8 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
       break;
     default: fprintf(f, "  /* unknown primitive %s */\n", prim[0]); break;
     }
-    fprintf(f, "  phi[%d] = r.phi;\n  nu[%d] = r.nu;\n  rhs[%d] = mb_row_gamma(&r, &k[%d], &k[%d]);\n", r, r,
+    fprintf(f, "  phi[%d] = r.phi;\n  phid[%d] = mb_row_phidot(&r, &k[%d], &k[%d]);\n"
+               "  rhs[%d] = mb_row_gamma(&r, &k[%d], &k[%d]);\n", r, r, R->m0, R->m1,
             m->nv + r, R->m0, R->m1);
     for (int s = 0; s < 2; s++) {
       int mk = s ? R->m1 : R->m0, b = L->marker[mk].body, any = 0;
@@ -537,7 +538,7 @@ static void emit_header(FILE *f, const lmodel *L, const char *nm) {
   fprintf(f, "#define %s_NCOLS %d /* output columns */\n\n", U, m->ncols);
   fprintf(f, "extern const mb_model %s_model;\n", nm);
   fprintf(f, "void %s_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,\n"
-             "    mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *nu, void *work);\n", nm);
+             "    mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *phid, void *work);\n", nm);
   fprintf(f, "void %s_init(const mb_model *m, mb_real *Kx);\n\n#endif\n", nm);
 }
 

@@ -101,25 +101,15 @@ static int solve(mb_sim *s, double *b) {
   return st;
 }
 
-/* D v, from the constraint rows of K (columns 0..nv-1, rows nv..n-1) */
-static void D_times(const mb_model *m, const double *Kx, const double *v, double *out) {
-  for (int r = 0; r < m->nc; r++) out[r] = 0;
-  for (int j = 0; j < m->nv; j++)
-    for (int p = m->Kp[j]; p < m->Kp[j + 1]; p++)
-      if (m->Ki[p] >= m->nv) out[m->Ki[p] - m->nv] += Kx[p] * v[j];
-}
-
 int mb_sim_accel(mb_sim *s, double t, const double *q, const double *v, double *vd,
                  double *lambda) {
   const mb_model *m = s->m;
   int st = assemble_factor(s, t, q, v);
   if (st) return fail(s, t, st, "factorization of K");
   if (s->set.stabilization == MB_STAB_BAUMGARTE) {
-    /* gamma - 2 alpha phidot - beta^2 phi, phidot = D v - nu */
-    D_times(m, s->Kx, v, s->dv);
+    /* gamma - 2 alpha phidot - beta^2 phi */
     for (int r = 0; r < m->nc; r++)
-      s->rhs[m->nv + r] -= 2 * s->set.alpha * (s->dv[r] - s->nu[r]) +
-                           s->set.beta * s->set.beta * s->phi[r];
+      s->rhs[m->nv + r] -= 2 * s->set.alpha * s->nu[r] + s->set.beta * s->set.beta * s->phi[r];
   }
   memcpy(s->x, s->rhs, sizeof(double) * (size_t)m->n);
   st = solve(s, s->x);
@@ -155,10 +145,9 @@ int mb_sim_project(mb_sim *s, double t, double *q, double *v) {
     mb_model_normalize(m, q);
     s->stats.projections++;
   }
-  /* velocities: K [dv; mu] = [0; nu - D v] (K is factored at this q) */
-  D_times(m, s->Kx, v, s->dv + nv);
+  /* velocities: K [dv; mu] = [0; -phid] (K is factored at this q; phid = D v - nu) */
   for (int i = 0; i < nv; i++) s->dv[i] = 0;
-  for (int r = 0; r < m->nc; r++) s->dv[nv + r] = s->nu[r] - s->dv[nv + r];
+  for (int r = 0; r < m->nc; r++) s->dv[nv + r] = -s->nu[r];
   int st = solve(s, s->dv);
   if (st) return fail(s, t, st, "velocity projection");
   for (int i = 0; i < nv; i++) v[i] += s->dv[i];

@@ -251,6 +251,12 @@ static inline mb_real mb_row_gamma(const mb_row *r, const mb_marker *m0, const m
            mb_dot3(r->dV[1], m1->aP) + mb_dot3(r->dW[1], m1->aW) + r->quad);
 }
 
+/* phidot = D v - nu: the velocity-level constraint violation */
+static inline mb_real mb_row_phidot(const mb_row *r, const mb_marker *m0, const mb_marker *m1) {
+  return mb_dot3(r->dV[0], m0->V) + mb_dot3(r->dW[0], m0->W) + mb_dot3(r->dV[1], m1->V) +
+         mb_dot3(r->dW[1], m1->W) - r->nu;
+}
+
 /* spherical, component k: phi = (P1 - P0)_k */
 static inline void mb_prim_sph(const mb_marker *m0, const mb_marker *m1, int k, mb_row *r) {
   mb_row_zero(r);

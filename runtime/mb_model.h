@@ -90,12 +90,13 @@ typedef struct {
 
 struct mb_model;
 
-/* Fill the varying entries of Kx, rhs = [f; gamma] (length n), phi and nu
- * (length nc) at time t, positions q and velocities v.  'work' has
- * mb_model_worksize bytes (the generated eval needs none). */
+/* Fill the varying entries of Kx, rhs = [f; gamma] (length n), and the
+ * position and velocity constraint violations phi and phid = D v - nu (length
+ * nc) at time t, positions q and velocities v.  'work' has mb_model_worksize
+ * bytes (the generated eval needs none). */
 typedef void (*mb_eval_fn)(const struct mb_model *m, mb_real t, const mb_real *q,
                            const mb_real *v, mb_real *Kx, mb_real *rhs, mb_real *phi,
-                           mb_real *nu, void *work);
+                           mb_real *phid, void *work);
 
 typedef struct mb_model {
   const char *name;
@@ -121,7 +122,7 @@ typedef struct mb_model {
 /* generic (table-walking) implementations; freestanding: no allocation, no I/O */
 size_t mb_model_worksize(const mb_model *m);
 void mb_generic_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
-                     mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *nu, void *work);
+                     mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *phid, void *work);
 void mb_generic_init(const mb_model *m, mb_real *Kx);
 
 /* qd = G(q) v: position-coordinate rates */

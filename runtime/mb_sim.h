@@ -41,7 +41,7 @@ typedef struct {
   double fail_time;         /* time of a failure */
   char fail_detail[160];    /* what failed */
   /* workspaces */
-  double *Kx, *rhs, *x, *phi, *nu, *y, *ytmp, *k[7], *qsave, *dv;
+  double *Kx, *rhs, *x, *phi, *nu, *y, *ytmp, *k[7], *qsave, *dv; /* nu: phid = D v - nu */
   void *work;
   int factored_valid;       /* Kx factorization matches qsave */
 } mb_sim;

@@ -164,7 +164,7 @@ void mb_generic_init(const mb_model *m, mb_real *Kx) {
 }
 
 void mb_generic_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
-                     mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *nu, void *work) {
+                     mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *phid, void *work) {
   mb_frame *F = (mb_frame *)work;
   mb_marker *MK = (mb_marker *)(F + m->nbody);
   frames_and_markers(m, q, v, F, MK);
@@ -187,13 +187,13 @@ void mb_generic_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_re
   }
   forces_eval(m, t, q, F, MK, rhs);
 
-  /* constraint rows: D (both triangles of K), gamma, phi, nu */
+  /* constraint rows: D (both triangles of K), gamma, phi, phid */
   for (int r = 0; r < m->nrow; r++) {
     const mb_rowdef *rd = &m->row[r];
     mb_row row;
     row_eval(m, rd, MK, t, &row);
     phi[r] = row.phi;
-    nu[r] = row.nu;
+    phid[r] = mb_row_phidot(&row, &MK[rd->m0], &MK[rd->m1]);
     rhs[m->nv + r] = mb_row_gamma(&row, &MK[rd->m0], &MK[rd->m1]);
     for (int s = 0; s < 2; s++) {
       int k = s ? rd->m1 : rd->m0;

@@ -141,7 +141,7 @@ static void check_constraints(const mb_model *m, int trials) {
         if (err > 1e-7) print_error("%s: D[%d][%d] = %.12g, finite difference %.12g\n", m->name, r, j, an, fd);
       }
     }
-    /* phidot = D v - nu: central difference of phi along (q (+) tau v, t + tau) */
+    /* phid = D v - nu: central difference of phi along (q (+) tau v, t + tau) */
     moved(m, q, v, h, qp);
     moved(m, q, v, -h, qm);
     ev(&e, t + h, qp, v);
@@ -149,24 +149,31 @@ static void check_constraints(const mb_model *m, int trials) {
     ev(&e, t - h, qm, v);
     memcpy(phim, e.phi, sizeof(double) * (size_t)nc);
     for (int r = 0; r < nc; r++) {
-      double fd = (phip[r] - phim[r]) / (2 * h), an = Dv[r] - nu[r];
+      double fd = (phip[r] - phim[r]) / (2 * h), an = nu[r];
       double err = fabs(fd - an) / (1 + fabs(an));
       if (err > worst_nu) worst_nu = err;
       if (err > 1e-7) print_error("%s: phidot[%d] = %.12g, finite difference %.12g\n", m->name, r, an, fd);
     }
+    /* phid = D v - nu, with D from K: nu = D v - phid must not depend on v */
+    {
+      double *v2 = malloc(sizeof(double) * (size_t)nv);
+      for (int j = 0; j < nv; j++) v2[j] = urand(-2, 2);
+      ev(&e, t, q, v2);
+      for (int r = 0; r < nc; r++) {
+        double Dv2 = 0;
+        for (int j = 0; j < nv; j++) Dv2 += D[(size_t)r * (size_t)nv + (size_t)j] * v2[j];
+        double nu1 = Dv[r] - nu[r], nu2 = Dv2 - e.nu[r];
+        double err = fabs(nu1 - nu2) / (1 + fabs(nu1));
+        if (err > worst_nu) worst_nu = err;
+        if (err > 1e-9) print_error("%s: nu[%d] depends on v: %.12g vs %.12g\n", m->name, r, nu1, nu2);
+      }
+      free(v2);
+    }
     /* gamma = -d/dt (D v - nu) at constant v */
     ev(&e, t + h, qp, v);
-    dense_D(m, e.Kx, D);
-    for (int r = 0; r < nc; r++) {
-      cp[r] = -e.nu[r];
-      for (int j = 0; j < nv; j++) cp[r] += D[(size_t)r * (size_t)nv + (size_t)j] * v[j];
-    }
+    for (int r = 0; r < nc; r++) cp[r] = e.nu[r];
     ev(&e, t - h, qm, v);
-    dense_D(m, e.Kx, D);
-    for (int r = 0; r < nc; r++) {
-      cm[r] = -e.nu[r];
-      for (int j = 0; j < nv; j++) cm[r] += D[(size_t)r * (size_t)nv + (size_t)j] * v[j];
-    }
+    for (int r = 0; r < nc; r++) cm[r] = e.nu[r];
     for (int r = 0; r < nc; r++) {
       double fd = -(cp[r] - cm[r]) / (2 * h);
       double err = fabs(fd - gamma[r]) / (1 + fabs(gamma[r]));

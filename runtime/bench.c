@@ -1,0 +1,340 @@
+/* bench.c: `mbcc bench`: the same simulation through every path (generated
+ * and generic evaluation x ldl, klu, dense; SUNDIALS IDA), timed as medians
+ * over repetitions, with the trajectories compared against the first path. */
+#define _POSIX_C_SOURCE 199309L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "mb_bench.h"
+#include "mb_ida.h"
+
+static double now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+enum { EVAL_GENERATED, EVAL_GENERIC, EVAL_IDA };
+
+typedef struct {
+  const char *name;    /* as in the table and the CSV: generated+ldl, ..., ida */
+  int eval;            /* EVAL_* */
+  const char *solver;  /* mb_solver_new name; NULL for IDA */
+} path_def;
+
+static const path_def PATHS[] = {
+    {"generated+ldl", EVAL_GENERATED, "ldl"},  {"generated+klu", EVAL_GENERATED, "klu"},
+    {"generated+dense", EVAL_GENERATED, "dense"}, {"generic+klu", EVAL_GENERIC, "klu"},
+    {"generic+dense", EVAL_GENERIC, "dense"},  {"ida", EVAL_IDA, NULL},
+};
+#define NPATH ((int)(sizeof PATHS / sizeof PATHS[0]))
+
+/* the outputs at every output time, kept in one preallocated block */
+typedef struct {
+  const mb_model *m;
+  int cap, nrows;
+  double *y;           /* cap x ncols */
+  void *work;
+} recorder;
+
+static int record(void *user, double t, const double *q, const double *v, const double *vd,
+                  const double *lambda) {
+  recorder *r = user;
+  (void)t;
+  if (r->nrows >= r->cap) return 0; /* more outputs than expected: keep the first cap */
+  int nc = r->m->ncols;
+  double *row = r->y + (size_t)r->nrows * (size_t)nc;
+  mb_model_outputs(r->m, t, q, v, vd, lambda, r->nrows ? row - nc : NULL, row, r->work);
+  r->nrows++;
+  return 0;
+}
+
+typedef struct {
+  int state;           /* 0 not selected, 1 ran, 2 skipped, 3 failed */
+  char note[200];
+  int n, nnz;          /* system dimension and nnz of its matrix */
+  double step_med, run_med;
+  long steps, evals;
+  double max_rel;      /* against the reference path */
+  int worst_col;
+  recorder rec;
+} path_result;
+
+static int cmp_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+static double median(double *a, int n) {
+  qsort(a, (size_t)n, sizeof *a, cmp_double);
+  return n % 2 ? a[n / 2] : 0.5 * (a[n / 2 - 1] + a[n / 2]);
+}
+
+/* one run of path p; its wall time, steps and the recorded outputs */
+static int run_once(const path_def *p, const mb_model *m, const mb_settings *set, recorder *rec,
+                    double *wall, long *steps, long *evals, double *fail_time, char *detail,
+                    size_t ndetail) {
+  rec->nrows = 0;
+  detail[0] = 0;
+  int st;
+  double t0 = now();
+  if (p->eval == EVAL_IDA) {
+    mb_stats stats;
+    st = mb_ida_simulate(m, set, record, rec, &stats, fail_time);
+    *wall = now() - t0;
+    *steps = stats.steps;
+    *evals = stats.evals;
+    if (st) snprintf(detail, ndetail, "%s", mb_status_text(st));
+    return st;
+  }
+  mb_solver *ls = mb_solver_new(p->solver, m);
+  if (!ls) return -1;
+  mb_sim sim;
+  st = mb_sim_init(&sim, m, ls, set);
+  if (!st) st = mb_sim_run(&sim, record, rec);
+  *wall = now() - t0;
+  *steps = sim.stats.steps;
+  *evals = sim.stats.evals;
+  *fail_time = sim.fail_time;
+  if (st) snprintf(detail, ndetail, "%s", sim.fail_detail[0] ? sim.fail_detail : mb_status_text(st));
+  mb_sim_free(&sim);
+  ls->destroy(ls);
+  return st;
+}
+
+/* max over columns and output times of |a - ref| / (range of ref's column) */
+static double compare(const mb_model *m, const recorder *ref, const recorder *a, int *worst) {
+  int nc = m->ncols, nr = ref->nrows < a->nrows ? ref->nrows : a->nrows;
+  double mx = 0;
+  *worst = -1;
+  for (int j = 0; j < nc; j++) {
+    double lo = INFINITY, hi = -INFINITY, big = 0;
+    for (int k = 0; k < ref->nrows; k++) {
+      double x = ref->y[(size_t)k * (size_t)nc + (size_t)j];
+      lo = fmin(lo, x);
+      hi = fmax(hi, x);
+      big = fmax(big, fabs(x));
+    }
+    double scale = hi > lo ? hi - lo : big > 0 ? big : 1;
+    for (int k = 0; k < nr; k++) {
+      double d = fabs(a->y[(size_t)k * (size_t)nc + (size_t)j] - ref->y[(size_t)k * (size_t)nc + (size_t)j]) / scale;
+      if (!(d <= mx)) { mx = isfinite(d) ? d : INFINITY; *worst = j; }
+    }
+  }
+  return mx;
+}
+
+static void usage(const char *prog) {
+  fprintf(stderr,
+          "usage: %s [--reps N] [--csv FILE] [--paths a,b,...] [--nnz-l N] [--quiet]\n"
+          "          [--integrator rk4|dopri5] [--stabilization projection|baumgarte|none]\n"
+          "          [--end T] [--output-step H] [--step H] [--rtol R] [--atol A]\n"
+          "paths: generated+ldl generated+klu generated+dense generic+klu generic+dense ida\n",
+          prog);
+}
+
+static int selected(const char *list, const char *name) {
+  if (!list) return 1;
+  size_t n = strlen(name);
+  for (const char *s = list; *s;) {
+    const char *e = strchr(s, ',');
+    size_t len = e ? (size_t)(e - s) : strlen(s);
+    if (len == n && !strncmp(s, name, n)) return 1;
+    if (!e) break;
+    s = e + 1;
+  }
+  return 0;
+}
+
+static void fmt_long(char *buf, size_t n, long v) {
+  if (v < 0) snprintf(buf, n, "-");
+  else snprintf(buf, n, "%ld", v);
+}
+
+int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *defaults) {
+  mb_settings set = *defaults;
+  const char *csv_path = NULL, *paths = NULL;
+  int reps = 5, quiet = 0;
+  long nnz_l = -1;
+  for (int i = 1; i < argc; i++) {
+    const char *a = argv[i], *val = (i + 1 < argc) ? argv[i + 1] : NULL;
+    if (!strcmp(a, "--quiet")) { quiet = 1; continue; }
+    if (!val) { usage(argv[0]); return 2; }
+    i++;
+    if (!strcmp(a, "--csv")) csv_path = val;
+    else if (!strcmp(a, "--paths")) {
+      paths = val;
+      for (const char *s = val; *s;) {
+        const char *e = strchr(s, ',');
+        size_t len = e ? (size_t)(e - s) : strlen(s);
+        int known = 0;
+        for (int p = 0; p < NPATH; p++)
+          known |= strlen(PATHS[p].name) == len && !strncmp(PATHS[p].name, s, len);
+        if (!known) {
+          fprintf(stderr, "%s: error: unknown path '%.*s'\n", argv[0], (int)len, s);
+          usage(argv[0]);
+          return 2;
+        }
+        if (!e) break;
+        s = e + 1;
+      }
+    } else if (!strcmp(a, "--integrator")) {
+      if (!strcmp(val, "rk4")) set.integrator = MB_RK4;
+      else if (!strcmp(val, "dopri5")) set.integrator = MB_DOPRI5;
+      else { fprintf(stderr, "%s: error: unknown integrator '%s' (expected rk4 or dopri5)\n", argv[0], val); return 2; }
+    } else if (!strcmp(a, "--stabilization")) {
+      if (!strcmp(val, "projection")) set.stabilization = MB_STAB_PROJECTION;
+      else if (!strcmp(val, "baumgarte")) set.stabilization = MB_STAB_BAUMGARTE;
+      else if (!strcmp(val, "none")) set.stabilization = MB_STAB_NONE;
+      else { fprintf(stderr, "%s: error: unknown stabilization '%s'\n", argv[0], val); return 2; }
+    } else {
+      char *end;
+      double x = strtod(val, &end);
+      if (*end || !(x > 0) || !isfinite(x)) {
+        fprintf(stderr, "%s: error: '%s' needs a positive number, got '%s'\n", argv[0], a, val);
+        return 2;
+      }
+      if (!strcmp(a, "--reps")) {
+        if (x != floor(x) || x > 1000) { fprintf(stderr, "%s: error: '--reps' needs a whole number from 1 to 1000\n", argv[0]); return 2; }
+        reps = (int)x;
+      } else if (!strcmp(a, "--nnz-l")) nnz_l = (long)x;
+      else if (!strcmp(a, "--end")) set.end_time = x;
+      else if (!strcmp(a, "--output-step")) set.output_step = x;
+      else if (!strcmp(a, "--step")) set.step = x;
+      else if (!strcmp(a, "--rtol")) set.rtol = x;
+      else if (!strcmp(a, "--atol")) set.atol = x;
+      else { fprintf(stderr, "%s: error: unknown option '%s'\n", argv[0], a); usage(argv[0]); return 2; }
+    }
+  }
+  if (set.output_step > set.end_time) set.output_step = set.end_time;
+  if (set.max_step > set.output_step) set.max_step = set.output_step;
+
+  mb_model generic = *m;
+  generic.eval = mb_generic_eval;
+  generic.init = mb_generic_init;
+  long nout = (long)floor(set.end_time / set.output_step + 1e-9) + 1;
+  path_result res[NPATH];
+  memset(res, 0, sizeof res);
+  double *walls = malloc(sizeof(double) * (size_t)reps), *per = malloc(sizeof(double) * (size_t)reps);
+  if (!walls || !per) { free(walls); free(per); fprintf(stderr, "%s: error: out of memory\n", argv[0]); return 1; }
+  int rc = 0, ref = -1;
+
+  for (int p = 0; p < NPATH; p++) {
+    const path_def *pd = &PATHS[p];
+    path_result *r = &res[p];
+    if (!selected(paths, pd->name)) continue;
+    const mb_model *pm = pd->eval == EVAL_GENERIC ? &generic : m;
+    r->n = pd->eval == EVAL_IDA ? mb_ida_size(m) : m->n;
+    r->nnz = pd->eval == EVAL_IDA ? r->n * r->n : m->nnz;
+    if (pd->solver) {
+      mb_solver *probe = mb_solver_new(pd->solver, pm);
+      if (!probe) {
+        r->state = 2;
+        snprintf(r->note, sizeof r->note, "skipped: solver '%s' is not available in this runtime", pd->solver);
+        if (!quiet) fprintf(stderr, "bench: %-16s %s\n", pd->name, r->note);
+        continue;
+      }
+      probe->destroy(probe);
+    }
+    r->rec.m = m;
+    r->rec.cap = (int)nout + 1;
+    r->rec.y = malloc(sizeof(double) * (size_t)r->rec.cap * (size_t)(m->ncols + 1));
+    r->rec.work = malloc(mb_model_worksize(m) + 16);
+    if (!r->rec.y || !r->rec.work) { r->state = 3; snprintf(r->note, sizeof r->note, "out of memory"); rc = 1; continue; }
+    if (!quiet) fprintf(stderr, "bench: %-16s", pd->name);
+    r->state = 1;
+    for (int k = 0; k < reps; k++) {
+      double ft = 0;
+      char detail[160];
+      int st = run_once(pd, pm, &set, &r->rec, &walls[k], &r->steps, &r->evals, &ft, detail, sizeof detail);
+      if (st) {
+        r->state = 3;
+        snprintf(r->note, sizeof r->note, "failed at t = %.6g: %s", ft, detail);
+        rc = 1;
+        break;
+      }
+      per[k] = r->steps > 0 ? walls[k] / (double)r->steps : walls[k];
+      if (!quiet) fprintf(stderr, " %.3gs", walls[k]);
+    }
+    if (!quiet) fprintf(stderr, "%s%s\n", r->state == 3 ? " " : "", r->state == 3 ? r->note : "");
+    if (r->state != 1) continue;
+    r->run_med = median(walls, reps);
+    r->step_med = median(per, reps);
+    if (ref < 0) ref = p;
+    r->max_rel = compare(m, &res[ref].rec, &r->rec, &r->worst_col);
+    if (r->rec.nrows != res[ref].rec.nrows)
+      snprintf(r->note, sizeof r->note, "%d output rows, reference %d", r->rec.nrows, res[ref].rec.nrows);
+  }
+  free(walls);
+  free(per);
+
+  double best_run = INFINITY, best_step = INFINITY;
+  for (int p = 0; p < NPATH; p++)
+    if (res[p].state == 1) {
+      best_run = fmin(best_run, res[p].run_med);
+      best_step = fmin(best_step, res[p].step_med);
+    }
+
+  char nl[32];
+  fmt_long(nl, sizeof nl, nnz_l);
+  printf("model %s: n = %d, nnz(K) = %d, nnz(L) = %s; nq = %d, nv = %d, nc = %d\n", m->name, m->n,
+         m->nnz, nl, m->nq, m->nv, m->nc);
+  printf("%s, rtol %g, atol %g, t = 0 .. %g, output step %g, %s; medians of %d run%s\n",
+         set.integrator == MB_RK4 ? "rk4" : "dopri5", set.rtol, set.atol, set.end_time,
+         set.output_step,
+         set.stabilization == MB_STAB_PROJECTION ? "projection"
+         : set.stabilization == MB_STAB_BAUMGARTE ? "baumgarte" : "no stabilization",
+         reps, reps == 1 ? "" : "s");
+  printf("\n%-16s %5s %7s %7s %8s %13s %10s %7s %7s %12s\n", "path", "n", "nnz(K)", "nnz(L)",
+         "steps", "per step [s]", "run [s]", "ratio", "r.step", "max rel diff");
+  for (int p = 0; p < NPATH; p++) {
+    const path_result *r = &res[p];
+    if (!r->state) continue;
+    if (r->state != 1) { printf("%-16s %5d %7d %7s  %s\n", PATHS[p].name, r->n, r->nnz, "-", r->note); continue; }
+    printf("%-16s %5d %7d %7s %8ld %13.4g %10.4g %7.2f %7.2f %12.3g", PATHS[p].name, r->n, r->nnz,
+           PATHS[p].eval == EVAL_IDA ? "-" : nl, r->steps, r->step_med, r->run_med,
+           r->run_med / best_run, r->step_med / best_step, r->max_rel);
+    if (p == ref) printf("  (reference)");
+    else if (r->worst_col >= 0 && r->max_rel > 0) printf("  (%s)", m->col_name[r->worst_col]);
+    if (r->note[0]) printf("  %s", r->note);
+    printf("\n");
+  }
+  printf("\nratio: whole-run time / the fastest path's; r.step: per-step time / the fastest per-step time.\n"
+         "max rel diff: largest |difference| from the reference path over all outputs and output times,\n"
+         "relative to the range of that output over the run.  ida: DAE of dimension nq + nv + nc,\n"
+         "dense Jacobian by difference quotients (BDF steps are not comparable to %s steps).\n",
+         set.integrator == MB_RK4 ? "rk4" : "dopri5");
+
+  if (csv_path) {
+    char tmp[4096];
+    snprintf(tmp, sizeof tmp, "%s.part", csv_path);
+    FILE *f = fopen(tmp, "w");
+    if (!f) { fprintf(stderr, "%s: error: cannot write '%s'\n", argv[0], tmp); rc = 2; goto out; }
+    fprintf(f, "path,n,nnz_K,nnz_L,step_median_s,run_s,ratio,steps,max_rel_diff,step_ratio,status\n");
+    for (int p = 0; p < NPATH; p++) {
+      const path_result *r = &res[p];
+      if (!r->state) continue;
+      const char *l = PATHS[p].eval == EVAL_IDA ? "-" : nl;
+      if (r->state == 1)
+        fprintf(f, "%s,%d,%d,%s,%.6g,%.6g,%.4f,%ld,%.3g,%.4f,ok\n", PATHS[p].name, r->n, r->nnz, l,
+                r->step_med, r->run_med, r->run_med / best_run, r->steps, r->max_rel,
+                r->step_med / best_step);
+      else
+        fprintf(f, "%s,%d,%d,%s,,,,,,,%s\n", PATHS[p].name, r->n, r->nnz, l,
+                r->state == 2 ? "skipped" : "failed");
+    }
+    if (fclose(f) || rename(tmp, csv_path)) {
+      remove(tmp);
+      fprintf(stderr, "%s: error: cannot write '%s'\n", argv[0], csv_path);
+      rc = 2;
+    } else if (!quiet) {
+      printf("wrote %s\n", csv_path);
+    }
+  }
+out:
+  for (int p = 0; p < NPATH; p++) { free(res[p].rec.y); free(res[p].rec.work); }
+  return rc;
+}

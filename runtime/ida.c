@@ -1,0 +1,224 @@
+/* ida.c: the model's DAE F(t, y, y') = 0, y = [q; v; lambda], integrated by
+ * SUNDIALS IDA with dense LU and a difference-quotient Jacobian (mb_ida.h). */
+#define _POSIX_C_SOURCE 199309L
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include <ida/ida.h>
+#include <nvector/nvector_serial.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+
+#include "mb_ida.h"
+
+static double now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+typedef struct {
+  const mb_model *m;
+  double *Kx;        /* nnz: K, constant entries from m->init */
+  double *rhs;       /* n: [f; gamma] */
+  double *phi, *nu;  /* nc */
+  double *x, *Kxv;   /* n: [vdot; lambda] and K times it */
+  double *qd;        /* nq: G(q) v */
+  double *qn;        /* nq: normalized positions for the outputs */
+  void *work;        /* mb_model_worksize */
+  mb_solver *ls;     /* dense: consistent initial values and output accelerations */
+  double t_eval;
+} ida_ctx;
+
+int mb_ida_size(const mb_model *m) { return m->nq + m->nv + m->nc; }
+
+/* F = [qdot - G(q) v; K [vdot; lambda] - [f; gamma]] */
+static int residual(sunrealtype t, N_Vector yy, N_Vector yp, N_Vector rr, void *user) {
+  ida_ctx *c = user;
+  const mb_model *m = c->m;
+  const double *y = N_VGetArrayPointer(yy), *d = N_VGetArrayPointer(yp);
+  double *r = N_VGetArrayPointer(rr);
+  int nq = m->nq, nv = m->nv, n = m->n;
+  const double *q = y, *v = y + nq, *lam = y + nq + nv;
+  double t0 = now();
+  m->eval(m, t, q, v, c->Kx, c->rhs, c->phi, c->nu, c->work);
+  c->t_eval += now() - t0;
+  mb_model_qdot(m, q, v, c->qd);
+  for (int i = 0; i < nq; i++) r[i] = d[i] - c->qd[i];
+  memcpy(c->x, d + nq, sizeof(double) * (size_t)nv);
+  memcpy(c->x + nv, lam, sizeof(double) * (size_t)m->nc);
+  for (int i = 0; i < n; i++) c->Kxv[i] = 0;
+  for (int j = 0; j < n; j++) {
+    double xj = c->x[j];
+    for (int p = m->Kp[j]; p < m->Kp[j + 1]; p++) c->Kxv[m->Ki[p]] += c->Kx[p] * xj;
+  }
+  for (int i = 0; i < n; i++) r[nq + i] = c->Kxv[i] - c->rhs[i];
+  for (int i = 0; i < nq + n; i++)
+    if (!isfinite(r[i])) return 1; /* recoverable: IDA retries with a smaller step */
+  return 0;
+}
+
+/* IDA reports errors through this hook; the runtime never prints */
+static void silent(int code, const char *module, const char *function, char *msg, void *user) {
+  (void)code; (void)module; (void)function; (void)msg; (void)user;
+}
+
+/* vdot and lambda at (t, q, v): eval, factor, solve (into c->x) */
+static int accel(ida_ctx *c, double t, const double *q, const double *v) {
+  const mb_model *m = c->m;
+  double t0 = now();
+  m->eval(m, t, q, v, c->Kx, c->rhs, c->phi, c->nu, c->work);
+  c->t_eval += now() - t0;
+  int st = c->ls->factor(c->ls, c->Kx);
+  if (st) return st;
+  memcpy(c->x, c->rhs, sizeof(double) * (size_t)m->n);
+  st = c->ls->solve(c->ls, c->x);
+  if (st) return st;
+  for (int i = 0; i < m->n; i++)
+    if (!isfinite(c->x[i])) return MB_ERR_NONFINITE;
+  return MB_OK;
+}
+
+/* the output at t: positions with normalized Euler parameters */
+static int emit(ida_ctx *c, double t, const double *y, mb_output_fn out, void *user, int *stop) {
+  const mb_model *m = c->m;
+  memcpy(c->qn, y, sizeof(double) * (size_t)m->nq);
+  mb_model_normalize(m, c->qn);
+  const double *v = y + m->nq;
+  int st = accel(c, t, c->qn, v);
+  if (st) return st;
+  if (out && out(user, t, c->qn, v, c->x, c->x + m->nv)) *stop = 1;
+  return MB_OK;
+}
+
+static int map_flag(int flag) {
+  switch (flag) {
+  case IDA_MEM_FAIL: return MB_ERR_NOMEM;
+  case IDA_ILL_INPUT: return MB_ERR_INVALID;
+  case IDA_LSETUP_FAIL: case IDA_LSOLVE_FAIL: case IDA_LINIT_FAIL: return MB_ERR_SINGULAR;
+  case IDA_RES_FAIL: case IDA_REP_RES_ERR: case IDA_FIRST_RES_FAIL: return MB_ERR_NONFINITE;
+  default: return MB_ERR_STEP_TOO_SMALL; /* too much work, error test or convergence failures */
+  }
+}
+
+int mb_ida_simulate(const mb_model *m, const mb_settings *s, mb_output_fn out, void *user,
+                    mb_stats *stats, double *fail_time) {
+  double wall0 = now();
+  if (stats) memset(stats, 0, sizeof *stats);
+  if (fail_time) *fail_time = 0;
+  if (!(s->end_time > 0) || !(s->output_step > 0) || !(s->rtol > 0) || !(s->atol > 0))
+    return MB_ERR_INVALID;
+  int nq = m->nq, nv = m->nv, nc = m->nc, n = m->n, N = nq + nv + nc;
+  ida_ctx c = {0};
+  c.m = m;
+  c.Kx = calloc((size_t)m->nnz + 1, sizeof(double));
+  c.rhs = calloc((size_t)n + 1, sizeof(double));
+  c.phi = calloc((size_t)nc + 1, sizeof(double));
+  c.nu = calloc((size_t)nc + 1, sizeof(double));
+  c.x = calloc((size_t)n + 1, sizeof(double));
+  c.Kxv = calloc((size_t)n + 1, sizeof(double));
+  c.qd = calloc((size_t)nq + 1, sizeof(double));
+  c.qn = calloc((size_t)nq + 1, sizeof(double));
+  c.work = malloc(mb_model_worksize(m) + 16);
+  c.ls = mb_solver_new("dense", m);
+  SUNContext ctx = NULL;
+  N_Vector yy = NULL, yp = NULL, id = NULL;
+  SUNMatrix A = NULL;
+  SUNLinearSolver LS = NULL;
+  void *mem = NULL;
+  int st = MB_OK, stop = 0, flag = 0;
+  double t = 0, *y, *d, *idv;
+  long nout = (long)floor(s->end_time / s->output_step + 1e-9);
+  long nsteps = 0, nres = 0, nlres = 0, netf = 0, ncf = 0, nni = 0, nset = 0, nje = 0;
+
+  if (!c.Kx || !c.rhs || !c.phi || !c.nu || !c.x || !c.Kxv || !c.qd || !c.qn || !c.work || !c.ls) {
+    st = MB_ERR_NOMEM;
+    goto done;
+  }
+  m->init(m, c.Kx);
+  if (SUNContext_Create(NULL, &ctx)) { ctx = NULL; st = MB_ERR_NOMEM; goto done; }
+  yy = N_VNew_Serial(N, ctx);
+  yp = N_VNew_Serial(N, ctx);
+  id = N_VNew_Serial(N, ctx);
+  if (!yy || !yp || !id) { st = MB_ERR_NOMEM; goto done; }
+
+  /* consistent initial values: q0, v0 and one solve of K for vdot, lambda */
+  y = N_VGetArrayPointer(yy);
+  d = N_VGetArrayPointer(yp);
+  idv = N_VGetArrayPointer(id);
+  memcpy(y, m->q0, sizeof(double) * (size_t)nq);
+  memcpy(y + nq, m->v0, sizeof(double) * (size_t)nv);
+  if ((st = accel(&c, 0, y, y + nq))) goto done;
+  memcpy(y + nq + nv, c.x + nv, sizeof(double) * (size_t)nc);
+  mb_model_qdot(m, y, y + nq, d);
+  memcpy(d + nq, c.x, sizeof(double) * (size_t)nv);
+  for (int i = 0; i < nc; i++) d[nq + nv + i] = 0;
+  for (int i = 0; i < N; i++) idv[i] = i < nq + nv ? 1.0 : 0.0;
+
+  mem = IDACreate(ctx);
+  if (!mem) { st = MB_ERR_NOMEM; goto done; }
+  flag = IDASetErrHandlerFn(mem, silent, NULL);
+  if (!flag) flag = IDAInit(mem, residual, 0.0, yy, yp);
+  if (!flag) flag = IDASStolerances(mem, s->rtol, s->atol);
+  if (!flag) flag = IDASetUserData(mem, &c);
+  if (!flag) flag = IDASetId(mem, id);
+  if (!flag) flag = IDASetMaxNumSteps(mem, 10000000L);
+  if (!flag && s->max_step > 0) flag = IDASetMaxStep(mem, s->max_step);
+  if (!flag && s->min_step > 0) flag = IDASetMinStep(mem, s->min_step);
+  if (!flag) flag = IDASetStopTime(mem, (double)nout * s->output_step);
+  if (flag) { st = map_flag(flag); goto done; }
+  A = SUNDenseMatrix(N, N, ctx);
+  LS = A ? SUNLinSol_Dense(yy, A, ctx) : NULL;
+  if (!A || !LS) { st = MB_ERR_NOMEM; goto done; }
+  if ((flag = IDASetLinearSolver(mem, LS, A))) { st = map_flag(flag); goto done; }
+
+  if ((st = emit(&c, 0, y, out, user, &stop)) || stop) goto done;
+  for (long k = 1; k <= nout; k++) {
+    double tout = (double)k * s->output_step, tret = t;
+    flag = IDASolve(mem, tout, &tret, yy, yp, IDA_NORMAL);
+    if (flag < 0) {
+      IDAGetCurrentTime(mem, &t);
+      st = map_flag(flag);
+      goto done;
+    }
+    t = tout;
+    y = N_VGetArrayPointer(yy);
+    if ((st = emit(&c, tout, y, out, user, &stop)) || stop) goto done;
+  }
+
+done:
+  if (mem) {
+    IDAGetNumSteps(mem, &nsteps);
+    IDAGetNumResEvals(mem, &nres);
+    IDAGetNumLinResEvals(mem, &nlres);
+    IDAGetNumErrTestFails(mem, &netf);
+    IDAGetNumNonlinSolvConvFails(mem, &ncf);
+    IDAGetNumNonlinSolvIters(mem, &nni);
+    IDAGetNumLinSolvSetups(mem, &nset);
+    IDAGetNumJacEvals(mem, &nje);
+  }
+  if (stats) {
+    stats->steps = nsteps;
+    stats->rejected = netf + ncf;
+    stats->evals = nres + nlres;
+    stats->solves = nni;
+    stats->factorizations = nset;
+    stats->full_factorizations = nje;
+    stats->t_assembly = c.t_eval;
+  }
+  if (st && fail_time) *fail_time = t;
+  IDAFree(&mem);
+  if (LS) SUNLinSolFree(LS);
+  if (A) SUNMatDestroy(A);
+  if (yy) N_VDestroy(yy);
+  if (yp) N_VDestroy(yp);
+  if (id) N_VDestroy(id);
+  if (ctx) SUNContext_Free(&ctx);
+  if (c.ls) c.ls->destroy(c.ls);
+  free(c.Kx); free(c.rhs); free(c.phi); free(c.nu); free(c.x); free(c.Kxv); free(c.qd);
+  free(c.qn); free(c.work);
+  if (stats) stats->t_total = now() - wall0;
+  return st;
+}

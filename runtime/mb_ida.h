@@ -1,0 +1,35 @@
+/* mb_ida.h: a compiled model's equations of motion integrated as a DAE by
+ * SUNDIALS IDA (variable-order BDF), the general-purpose DAE solver that
+ * `mbcc bench` times the specialized paths against.  Hosted runtime: needs
+ * -lsundials_ida -lsundials_nvecserial (SUNDIALS 6.x). */
+#ifndef MB_IDA_H
+#define MB_IDA_H
+
+#include "mb_sim.h"
+
+/* Simulate from the model's q0, v0 to s->end_time with IDA.
+ * Unknowns y = [q; v; lambda] (nq + nv + nc); residual
+ *   F = [qdot - G(q) v;  M vdot + D^T lambda - f;  D vdot - gamma]
+ * (index 1: the constraints at acceleration level; lambda algebraic).  The
+ * linear solver is IDA's dense LU with its difference-quotient Jacobian.
+ * Tolerances s->rtol, s->atol (on every unknown, lambda included); steps at
+ * most s->max_step (if > 0) and at least s->min_step.  Positions drift from
+ * the position and velocity constraints by the integration error: nothing
+ * projects them, and Euler parameters are normalized only in what 'out'
+ * receives.  'out' (may be NULL) is called at t = 0 and at every output
+ * time k * s->output_step <= end_time with the interpolated state and the
+ * accelerations and multipliers from K [vdot; lambda] = [f; gamma] solved
+ * there.  'stats' (may be NULL) receives steps, rejected (error-test and
+ * convergence failures), evals (residual evaluations, the difference-
+ * quotient Jacobian's included), solves (Newton iterations), factorizations
+ * (linear solver setups), full_factorizations (Jacobian evaluations),
+ * t_assembly (time in the model's eval) and t_total.  On failure returns an
+ * MB_ERR_* status and stores the time reached in *fail_time (if not NULL).
+ * Never prints. */
+int mb_ida_simulate(const mb_model *m, const mb_settings *s, mb_output_fn out, void *user,
+                    mb_stats *stats, double *fail_time);
+
+/* the DAE's dimension nq + nv + nc */
+int mb_ida_size(const mb_model *m);
+
+#endif
