@@ -6,15 +6,15 @@ STD     := -std=c11
 ROOT    := $(CURDIR)
 LIBS    := -lyaml -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig -llapack -lblas -lm
 
-RT_SRC  := runtime/model_generic.c runtime/solver_klu.c runtime/solver_dense.c \
-           runtime/integrate.c runtime/driver.c
+RT_SRC  := runtime/model_generic.c runtime/solver_klu.c runtime/solver_dense.c runtime/solver_generic.c runtime/solver_ldl.c \
+           runtime/integrate.c runtime/driver.c runtime/ida.c runtime/bench.c
 RT_HDR  := $(wildcard runtime/*.h)
 CC_SRC  := compiler/main.c compiler/reader.c compiler/diag.c compiler/lower.c compiler/fe.c compiler/flex.c \
-           compiler/assemble.c compiler/emit.c
+           compiler/assemble.c compiler/emit.c compiler/order.c compiler/emit_ldl.c
 CC_HDR  := $(wildcard compiler/*.h)
 B       ?= build
 
-.PHONY: all test demo clean sanitize docs
+.PHONY: all test demo clean sanitize docs bench
 all: $(B)/mbcc $(B)/libmbrt.a
 
 $(B)/rt/%.o: runtime/%.c $(RT_HDR)
@@ -27,10 +27,14 @@ $(B)/libmbrt.a: $(patsubst runtime/%.c,$(B)/rt/%.o,$(RT_SRC))
 $(B)/mbcc: $(CC_SRC) $(CC_HDR) $(B)/libmbrt.a
 	$(CC) $(STD) $(WARN) $(CFLAGS) -Icompiler -Iruntime -DMBCC_ROOT='"$(ROOT)"' \
 	  -DMBCC_RTLIB='"$(ROOT)/$(B)/libmbrt.a"' -DMBCC_GEN_CFLAGS='"$(CFLAGS)"' \
-	  $(CC_SRC) $(B)/libmbrt.a $(LIBS) -o $@
+	  $(CC_SRC) $(B)/libmbrt.a $(LIBS) -lcamd -o $@
 
 demo: all
 	$(B)/mbcc run models/slider_crank.yaml
+
+# the timing comparison of every path (scripts/bench.sh): writes docs/benchmarks.md
+bench: all
+	MBCC=$(B)/mbcc sh scripts/bench.sh
 
 include tests/tests.mk
 include docs/results.mk

@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "diag.h"
+#include "emit_ldl.h"
 #include "flex.h"
 #include "lower.h"
 
@@ -539,6 +540,7 @@ static void emit_header(FILE *f, const lmodel *L, const char *nm) {
   fprintf(f, "extern const mb_model %s_model;\n", nm);
   fprintf(f, "void %s_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,\n"
              "    mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *phid, void *work);\n", nm);
+  emit_ldl_header(f, L, nm);
   fprintf(f, "void %s_init(const mb_model *m, mb_real *Kx);\n\n#endif\n", nm);
 }
 
@@ -562,6 +564,7 @@ static void emit_source(FILE *f, const lmodel *L, const char *nm) {
   emit_tables(f, L);
   emit_init(f, L, nm);
   emit_eval(f, L, nm);
+  int ldl = emit_ldl(f, L, nm);
   fprintf(f, "\nconst mb_model %s_model = {\n", nm);
   fprintf(f, "  .name = \"%s\",\n  .nbody = %d, .nmarker = %d, .nrow = %d, .nforce = %d,\n"
              "  .nprofile = %d, .noutput = %d, .njoint = %d,\n"
@@ -576,6 +579,7 @@ static void emit_source(FILE *f, const lmodel *L, const char *nm) {
   vec(f, m->gravity, 3);
   fprintf(f, ",\n  .Kp = Kp, .Ki = %s, .q0 = %s, .v0 = %s, .modal_slot = %s,\n", m->nnz ? "Ki" : "0",
           m->nq ? "q0" : "0", m->nv ? "v0" : "0", L->nmodal_slot ? "modal_slot" : "0");
+  emit_ldl_fields(f, nm, ldl);
   fprintf(f, "  .ncols = %s_NCOLS, .col_name = %s,\n  .eval = %s_eval, .init = %s_init,\n};\n", U,
           m->ncols ? "col_names" : "0", nm, nm);
 }

@@ -104,8 +104,23 @@ static int add_marker(lmodel *L, int b, int node, const double P[3], const doubl
   for (int j = 0; j < 3; j++) rel[j] = P[j] - q[j];
   mb_mul3t(A, rel, d->s);
   if (node >= 0 && L->body[b].kind == MB_BODY_FLEXIBLE) {
+    const fe_modes *fm = &L->modes[b];
     d->node = node;
-    memcpy(d->s, L->modes[b].x + 3 * node, sizeof(double) * 3);
+    if (node >= fm->nnodes) {
+      diag_error(L->ir->path, (ir_loc){0, 0}, "%s: body '%s' has no node %d (it has %d)", desc,
+                 L->body[b].name, node, fm->nnodes);
+      L->bad = 1;
+      return k;
+    }
+    /* the point given must be the node's (checked here for modal data files) */
+    double off = 0;
+    for (int j = 0; j < 3; j++) off += (d->s[j] - fm->x[3 * node + j]) * (d->s[j] - fm->x[3 * node + j]);
+    if (sqrt(off) > 1e-6 * (1 + sqrt(mb_dot3(d->s, d->s)))) {
+      diag_error(L->ir->path, (ir_loc){0, 0}, "%s: the point is %g from node %d of body '%s'", desc,
+                 sqrt(off), node, L->body[b].name);
+      L->bad = 1;
+    }
+    memcpy(d->s, fm->x + 3 * node, sizeof(double) * 3);
   }
   /* C = A^T Cg */
   for (int i = 0; i < 3; i++)
@@ -379,6 +394,7 @@ lmodel *lower_model(const ir_model *ir) {
   }
   m->nq = nq;
   m->nv = nv;
+  if (L->bad) { free(jm0); free(jm1); lower_free(L); return NULL; }
   for (int d = 0; d < ir->ndrivers; d++) {
     const ir_driver *D = &ir->drivers[d];
     if (!D->active || !ir->joints[D->joint].active) continue;

@@ -40,6 +40,7 @@ typedef struct {
   int nvirtual;              /* virtual bodies inserted for joints on flexible nodes */
   char **body_name;          /* owned names of inserted bodies */
   char *name;                /* model name, with the scene's appended: <model>_<scene> */
+  int bad;                   /* an error was reported while lowering */
   int nredundant;            /* rows removed at assembly */
   int dof;
 } lmodel;

@@ -1,4 +1,4 @@
-/* main.c: the mbcc command line: check, compile, run, plot. */
+/* main.c: the mbcc command line: check, compile, run, bench, modes, plot. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <math.h>
@@ -14,6 +14,7 @@
 #include "flex.h"
 #include "lower.h"
 #include "mb_driver.h"
+#include "order.h"
 
 #ifndef MBCC_ROOT
 #define MBCC_ROOT "."
@@ -38,12 +39,15 @@ static void usage(void) {
           "                [--integrator rk4|dopri5] [-o results.csv] [--plot out.png|none]\n"
           "                [--end T] [--output-step H] [--step H] [--rtol R] [--atol A]\n"
           "                [--stabilization projection|baumgarte|none] [--quiet]\n"
+          "       mbcc bench M.yaml [--scene S] [--csv FILE] [--reps N] [--paths a,b,...]\n"
+          "                [--integrator rk4|dopri5] [--end T] [--rtol R] [--atol A] [--quiet]\n"
           "       mbcc modes M.yaml --body NAME [--scene S] [--shapes shapes.csv]\n"
+          "                [--write-modal body.modal.yaml]\n"
           "       mbcc plot results.csv [-o out.png] [--columns a,b,...]\n");
 }
 
 typedef struct {
-  const char *model, *scene, *outdir, *csv, *plot, *path, *body, *shapes;
+  const char *model, *scene, *outdir, *csv, *plot, *path, *body, *shapes, *modal_out;
   const char *sim_args[32];
   int nsim;
   int quiet;
@@ -65,12 +69,14 @@ static int parse_options(int argc, char **argv, options *o) {
     if (!strcmp(a, "--scene")) o->scene = v;
     else if (!strcmp(a, "--body")) o->body = v;
     else if (!strcmp(a, "--shapes")) o->shapes = v;
+    else if (!strcmp(a, "--write-modal")) o->modal_out = v;
     else if (!strcmp(a, "-o")) { o->outdir = v; o->csv = v; }
     else if (!strcmp(a, "--plot")) o->plot = v;
     else if (!strcmp(a, "--path")) o->path = v;
     else if (!strcmp(a, "--solver") || !strcmp(a, "--integrator") || !strcmp(a, "--end") ||
              !strcmp(a, "--output-step") || !strcmp(a, "--step") || !strcmp(a, "--rtol") ||
-             !strcmp(a, "--atol") || !strcmp(a, "--stabilization") || !strcmp(a, "--columns")) {
+             !strcmp(a, "--atol") || !strcmp(a, "--stabilization") || !strcmp(a, "--columns") ||
+             !strcmp(a, "--csv") || !strcmp(a, "--reps") || !strcmp(a, "--paths")) {
       if (o->nsim + 2 > 30) { fprintf(stderr, "mbcc: error: too many options\n"); return 2; }
       o->sim_args[o->nsim++] = a;
       o->sim_args[o->nsim++] = v;
@@ -129,6 +135,7 @@ static int cmd_check(const options *o) {
   printf("  degrees of freedom %d\n", L->dof);
   printf("  system dimension  %d (K = [M D^T; D 0])\n", m->n);
   printf("  nnz(K)            %d (%.2f%% dense)\n", m->nnz, m->n ? 100.0 * m->nnz / ((double)m->n * m->n) : 0.0);
+  ldl_plan_report(L, stdout);
   if (L->nvirtual) printf("  virtual bodies    %d inserted for joints on flexible nodes\n", L->nvirtual);
   for (int b = 0; b < m->nbody; b++) {
     if (m->body[b].kind != MB_BODY_FLEXIBLE) continue;
@@ -200,6 +207,16 @@ static int cmd_modes(const options *o) {
       }
       if (fclose(f) || rename(tmp, o->shapes)) { remove(tmp); st = 2; }
       else printf("wrote %s\n", o->shapes);
+    }
+  }
+  if (!st && o->modal_out) {
+    char err[512], desc[600];
+    snprintf(desc, sizeof desc, "modes of body '%s' of %s", o->body, o->model);
+    if (fe_modes_write(&fm, o->modal_out, desc, err, sizeof err)) {
+      fprintf(stderr, "mbcc: error: %s\n", err);
+      st = 2;
+    } else {
+      printf("wrote %s\n", o->modal_out);
     }
   }
   fe_modes_free(&fm);
@@ -285,6 +302,49 @@ static int plot_csv(const char *csv, const char *png, const char *columns) {
   return 0;
 }
 
+/* the runtime settings of the model's simulation block */
+static void settings_from_ir(const ir_sim *s, mb_settings *set) {
+  mb_settings_default(set);
+  set->integrator = s->integrator == INTEGRATOR_RK4 ? MB_RK4 : MB_DOPRI5;
+  set->end_time = s->end_time; set->output_step = s->output_step; set->step = s->step;
+  set->rtol = s->rtol; set->atol = s->atol; set->min_step = s->min_step; set->max_step = s->max_step;
+  set->stabilization = (int)s->stabilization;
+  set->alpha = s->baumgarte_alpha; set->beta = s->baumgarte_beta;
+}
+
+/* cc the generated model DIR/NAME.c and the main program 'main_src' against the
+ * runtime library into 'exe'; 'extra' are more libraries (NULL-terminated) */
+static int compile_generated(const char *dir, const char *name, const char *main_src,
+                             const char *exe, char *const extra[], int quiet) {
+  char src_c[8400], inc[8400], lib[8400];
+  snprintf(src_c, sizeof src_c, "%s/%s.c", dir, name);
+  snprintf(inc, sizeof inc, "-I%s/runtime", root_dir());
+  const char *rtlib = getenv("MBCC_RTLIB");
+  snprintf(lib, sizeof lib, "%s", rtlib && *rtlib ? rtlib : MBCC_RTLIB);
+  const char *cc = getenv("CC");
+  /* the C flags mbcc itself was built with (e.g. sanitizers), split on spaces */
+  static char flags[1024];
+  snprintf(flags, sizeof flags, "%s", MBCC_GEN_CFLAGS);
+  char *ccargs[80];
+  int nc = 0;
+  ccargs[nc++] = (char *)(cc && *cc ? cc : "cc");
+  ccargs[nc++] = "-std=c99";
+  for (char *tok = strtok(flags, " "); tok && nc < 40; tok = strtok(NULL, " ")) ccargs[nc++] = tok;
+  char *rest[] = {inc, "-o", (char *)exe, src_c, (char *)main_src, lib, NULL};
+  for (int i = 0; rest[i]; i++) ccargs[nc++] = rest[i];
+  for (int i = 0; extra && extra[i] && nc < 60; i++) ccargs[nc++] = extra[i];
+  char *libs[] = {"-lklu", "-lamd", "-lcolamd", "-lbtf", "-lsuitesparseconfig", "-llapack",
+                  "-lblas", "-lm", NULL};
+  for (int i = 0; libs[i]; i++) ccargs[nc++] = libs[i];
+  ccargs[nc] = NULL;
+  if (!quiet) fprintf(stderr, "mbcc: compiling %s\n", src_c);
+  if (run_command(ccargs)) {
+    fprintf(stderr, "mbcc: error: the C compiler failed on %s\n", src_c);
+    return 2;
+  }
+  return 0;
+}
+
 static int cmd_run(const options *o) {
   char dir[4096];
   lmodel *L = NULL;
@@ -306,12 +366,7 @@ static int cmd_run(const options *o) {
     }
     const ir_sim *s = &ir->sim;
     mb_settings set;
-    mb_settings_default(&set);
-    set.integrator = s->integrator == INTEGRATOR_RK4 ? MB_RK4 : MB_DOPRI5;
-    set.end_time = s->end_time; set.output_step = s->output_step; set.step = s->step;
-    set.rtol = s->rtol; set.atol = s->atol; set.min_step = s->min_step; set.max_step = s->max_step;
-    set.stabilization = (int)s->stabilization;
-    set.alpha = s->baumgarte_alpha; set.beta = s->baumgarte_beta;
+    settings_from_ir(s, &set);
     char *args[40];
     int na = 0;
     args[na++] = "mbcc-generic";
@@ -333,29 +388,10 @@ static int cmd_run(const options *o) {
       snprintf(csv, sizeof csv, "results/%s.csv", L->m.name);
     }
     /* compile the generated code against the runtime library */
-    char exe[8400], src_c[8400], src_main[8400], inc[8400], lib[8400];
+    char exe[8400], src_main[8400];
     snprintf(exe, sizeof exe, "%s/%s_sim", dir, L->m.name);
-    snprintf(src_c, sizeof src_c, "%s/%s.c", dir, L->m.name);
     snprintf(src_main, sizeof src_main, "%s/main.c", dir);
-    snprintf(inc, sizeof inc, "-I%s/runtime", root_dir());
-    const char *rtlib = getenv("MBCC_RTLIB");
-    snprintf(lib, sizeof lib, "%s", rtlib && *rtlib ? rtlib : MBCC_RTLIB);
-    const char *cc = getenv("CC");
-    /* the C flags mbcc itself was built with (e.g. sanitizers), split on spaces */
-    static char flags[1024];
-    snprintf(flags, sizeof flags, "%s", MBCC_GEN_CFLAGS);
-    char *ccargs[64];
-    int nc = 0;
-    ccargs[nc++] = (char *)(cc && *cc ? cc : "cc");
-    ccargs[nc++] = "-std=c99";
-    for (char *tok = strtok(flags, " "); tok && nc < 40; tok = strtok(NULL, " ")) ccargs[nc++] = tok;
-    char *rest[] = {inc, "-o", exe, src_c, src_main, lib, "-lklu", "-lamd", "-lcolamd", "-lbtf",
-                    "-lsuitesparseconfig", "-llapack", "-lblas", "-lm", NULL};
-    for (int i = 0; rest[i]; i++) ccargs[nc++] = rest[i];
-    ccargs[nc] = NULL;
-    if (!o->quiet) fprintf(stderr, "mbcc: compiling %s\n", src_c);
-    if (run_command(ccargs)) {
-      fprintf(stderr, "mbcc: error: the C compiler failed on %s\n", src_c);
+    if (compile_generated(dir, L->m.name, src_main, exe, NULL, o->quiet)) {
       lower_free(L);
       ir_free(ir);
       return 2;
@@ -392,6 +428,61 @@ static int cmd_run(const options *o) {
   return 0;
 }
 
+/* DIR/bench_main.c: the model's default settings, then mb_bench_main */
+static int write_bench_main(const char *dir, const char *name, const mb_settings *s) {
+  char path[4200], tmp[4300];
+  snprintf(path, sizeof path, "%s/bench_main.c", dir);
+  snprintf(tmp, sizeof tmp, "%s.part", path);
+  FILE *f = fopen(tmp, "w");
+  if (!f) { fprintf(stderr, "mbcc: error: cannot write '%s'\n", tmp); return 2; }
+  static const char *stab[] = {"MB_STAB_PROJECTION", "MB_STAB_BAUMGARTE", "MB_STAB_NONE"};
+  fprintf(f, "/* bench_main.c: generated by mbcc bench: the timing comparison for model %s. Do not edit. */\n", name);
+  fprintf(f, "#include \"mb_bench.h\"\n#include \"%s.h\"\n\n", name);
+  fprintf(f, "int main(int argc, char **argv) {\n  mb_settings s;\n  mb_settings_default(&s);\n");
+  fprintf(f, "  s.integrator = %s;\n", s->integrator == MB_RK4 ? "MB_RK4" : "MB_DOPRI5");
+  fprintf(f, "  s.end_time = %.17g;\n  s.output_step = %.17g;\n  s.step = %.17g;\n", s->end_time,
+          s->output_step, s->step);
+  fprintf(f, "  s.rtol = %.17g;\n  s.atol = %.17g;\n  s.min_step = %.17g;\n  s.max_step = %.17g;\n",
+          s->rtol, s->atol, s->min_step, s->max_step);
+  fprintf(f, "  s.stabilization = %s;\n  s.alpha = %.17g;\n  s.beta = %.17g;\n",
+          stab[s->stabilization >= 0 && s->stabilization <= 2 ? s->stabilization : 0], s->alpha, s->beta);
+  fprintf(f, "  return mb_bench_main(argc, argv, &%s_model, &s);\n}\n", name);
+  if (fclose(f) || rename(tmp, path)) {
+    remove(tmp);
+    fprintf(stderr, "mbcc: error: cannot write '%s'\n", path);
+    return 2;
+  }
+  return 0;
+}
+
+/* mbcc bench: generate, compile a bench executable (with SUNDIALS IDA), run it */
+static int cmd_bench(const options *o) {
+  char dir[4096];
+  lmodel *L = NULL;
+  ir_model *ir = NULL;
+  options o2 = *o;
+  o2.outdir = NULL;
+  int rc = cmd_compile(&o2, dir, sizeof dir, &L, &ir);
+  if (rc) return rc;
+  mb_settings set;
+  settings_from_ir(&ir->sim, &set);
+  char exe[8400], src_main[8400];
+  snprintf(exe, sizeof exe, "%s/%s_bench", dir, L->m.name);
+  snprintf(src_main, sizeof src_main, "%s/bench_main.c", dir);
+  char *ida_libs[] = {"-lsundials_ida", "-lsundials_nvecserial", NULL};
+  rc = write_bench_main(dir, L->m.name, &set);
+  if (!rc) rc = compile_generated(dir, L->m.name, src_main, exe, ida_libs, o->quiet);
+  lower_free(L);
+  ir_free(ir);
+  if (rc) return rc;
+  char *args[40];
+  int na = 0;
+  args[na++] = exe;
+  for (int i = 0; i < o->nsim; i++) args[na++] = (char *)o->sim_args[i];
+  args[na] = NULL;
+  return run_command(args);
+}
+
 int main(int argc, char **argv) {
   if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
     usage();
@@ -416,7 +507,8 @@ int main(int argc, char **argv) {
     if (!st) printf("wrote %s\n", png);
     return st;
   }
-  if (strcmp(cmd, "check") && strcmp(cmd, "compile") && strcmp(cmd, "run") && strcmp(cmd, "modes")) {
+  if (strcmp(cmd, "check") && strcmp(cmd, "compile") && strcmp(cmd, "run") && strcmp(cmd, "modes") &&
+      strcmp(cmd, "bench")) {
     fprintf(stderr, "mbcc: error: unknown command '%s'\n", cmd);
     usage();
     return 2;
@@ -425,5 +517,6 @@ int main(int argc, char **argv) {
   if (!strcmp(cmd, "check")) return cmd_check(&o);
   if (!strcmp(cmd, "modes")) return cmd_modes(&o);
   if (!strcmp(cmd, "compile")) return cmd_compile(&o, NULL, 0, NULL, NULL);
+  if (!strcmp(cmd, "bench")) return cmd_bench(&o);
   return cmd_run(&o);
 }

@@ -935,7 +935,12 @@ static void node_global(const ir_body *b, int k, double out[3]);
 /* whether the element is given on FE nodes (true also when the nodes given
  * were wrong: that was reported, and the point is then not required) */
 static bool fe_nodes_given(mapping *m, const int body[2], int node[2]) {
-  return get_fe_nodes(m, body, node) || map_has(m, "node") || map_has(m, "nodes");
+  bool given = get_fe_nodes(m, body, node) || map_has(m, "node") || map_has(m, "nodes");
+  /* a body from a modal data file: its node positions are read later, so the
+     point must be given (it is checked against the node when the file is read) */
+  for (int s = 0; s < 2; s++)
+    if (node[s] >= 0 && !m->r->model->bodies[body[s]].flex->nodes) return false;
+  return given;
 }
 
 /* the point of side s: the node's position when a node is given (a point

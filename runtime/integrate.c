@@ -59,6 +59,7 @@ int mb_sim_init(mb_sim *s, const mb_model *m, mb_solver *ls, const mb_settings *
     return MB_ERR_NOMEM;
   for (int i = 0; i < 7; i++)
     if (!s->k[i]) return MB_ERR_NOMEM;
+  if (ls->bind) ls->bind(ls, s->work);
   memcpy(s->q, m->q0, sizeof(double) * (size_t)m->nq);
   memcpy(s->v, m->v0, sizeof(double) * (size_t)m->nv);
   m->init(m, s->Kx);

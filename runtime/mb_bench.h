@@ -6,7 +6,7 @@
 
 #include "mb_sim.h"
 
-/* Options: [--reps N] [--csv FILE] [--paths a,b,...] [--nnz-l N] [--quiet]
+/* Options: [--reps N] [--csv FILE] [--paths a,b,...] [--quiet]
  *          [--integrator rk4|dopri5] [--stabilization projection|baumgarte|none]
  *          [--end T] [--output-step H] [--step H] [--rtol R] [--atol A]
  * 'defaults' are the model's simulation settings.  Prints the table on stdout

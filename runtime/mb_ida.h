@@ -12,7 +12,9 @@
  *   F = [qdot - G(q) v;  M vdot + D^T lambda - f;  D vdot - gamma]
  * (index 1: the constraints at acceleration level; lambda algebraic).  The
  * linear solver is IDA's dense LU with its difference-quotient Jacobian.
- * Tolerances s->rtol, s->atol (on every unknown, lambda included); steps at
+ * Tolerances s->rtol, s->atol on q and v (lambda, algebraic, is left out of
+ * the error test: it follows from q and v; vanishing multipliers would carry
+ * only the round-off of the large ones and fail any tolerance); steps at
  * most s->max_step (if > 0) and at least s->min_step.  Positions drift from
  * the position and velocity constraints by the integration error: nothing
  * projects them, and Euler parameters are normalized only in what 'out'

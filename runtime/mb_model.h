@@ -117,13 +117,41 @@ typedef struct mb_model {
   const char *const *col_name; /* their names */
   mb_eval_fn eval;
   void (*init)(const struct mb_model *m, mb_real *Kx); /* the constant entries of K */
+  /* the emitted LDL^T of K (solver "ldl", compiler/emit_ldl.c); NULL / 0 when the
+   * model has none (the generic path).  factor: 0, or 1 + the unknown whose pivot
+   * is zero or tiny; solve: K x = b in place with refinement on the exact system,
+   * *residual = ||b - K x||_inf / (||K||_inf ||x||_inf + ||b||_inf) */
+  int (*ldl_factor)(const struct mb_model *m, const mb_real *Kx, mb_real *work);
+  int (*ldl_solve)(const struct mb_model *m, const mb_real *Kx, mb_real *work, mb_real *b,
+                   mb_real *residual);
+  size_t ldl_worksize;         /* mb_real elements of 'work' */
+  long ldl_nnzL;               /* nonzeros of L (strictly lower) */
+  double ldl_flops;            /* flops of one numeric factorization */
+  int ldl_straight;            /* 1: straight-line code, 0: loops over static tables */
 } mb_model;
+
+/* triplets (row, column, value) of K from the general generic path */
+typedef struct {
+  int n;
+  int *i, *j;
+  mb_real *x;
+} mb_triplets;
 
 /* generic (table-walking) implementations; freestanding: no allocation, no I/O */
 size_t mb_model_worksize(const mb_model *m);
 void mb_generic_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
                      mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *phid, void *work);
 void mb_generic_init(const mb_model *m, mb_real *Kx);
+/* The general generic path (the baseline `mbcc bench` times the generated
+ * code against): the same element kernels, but every entry of every element
+ * block goes into triplets (in 'work', see mb_generic_triplets), with no use of
+ * the compile-time pattern; a general sparse solver assembles them each step.
+ * Kx is left alone. */
+void mb_generic_triplet_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
+                             mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *phid,
+                             void *work);
+void mb_generic_triplet_init(const mb_model *m, mb_real *Kx);
+mb_triplets *mb_generic_triplets(const mb_model *m, void *work);
 
 /* qd = G(q) v: position-coordinate rates */
 void mb_model_qdot(const mb_model *m, const mb_real *q, const mb_real *v, mb_real *qd);

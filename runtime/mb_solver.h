@@ -13,6 +13,14 @@ typedef struct mb_solver {
   int (*factor)(struct mb_solver *s, const mb_real *Kx); /* MB_OK or MB_ERR_SINGULAR */
   int (*solve)(struct mb_solver *s, mb_real *b);         /* in place */
   void (*destroy)(struct mb_solver *s);
+  /* optional: told the simulation's workspace (the general generic path
+     reads its triplets there) */
+  void (*bind)(struct mb_solver *s, void *work);
+  /* ldl: relative residual ||b - K x||_inf / (||K||_inf ||x||_inf + ||b||_inf) of the
+   * last solve after refinement and the largest so far; the unknown whose pivot
+   * failed in the last factorization, or -1 (other solvers leave these 0) */
+  double residual, residual_max;
+  int bad_pivot;
 } mb_solver;
 
 /* SuiteSparse KLU: analyze once, refactor per step, factor again (new pivots)
@@ -20,6 +28,14 @@ typedef struct mb_solver {
 mb_solver *mb_solver_klu(const mb_model *m);
 /* LAPACK dgetrf/dgetrs on the full n x n matrix */
 mb_solver *mb_solver_dense(const mb_model *m);
+/* The general generic path's solvers (model eval = mb_generic_triplet_eval):
+ * each factorization assembles K from the triplets into CSC (sorting and
+ * summing duplicates), then KLU (symbolic analysis reused while the assembled
+ * pattern does not change) or LAPACK dense LU. */
+mb_solver *mb_solver_generic(const mb_model *m, int dense);
+/* the LDL^T emitted with the model (m->ldl_factor, compiler/emit_ldl.c); NULL
+ * when the model has none */
+mb_solver *mb_solver_ldl(const mb_model *m);
 /* by name: "klu" or "dense"; NULL if unknown or out of memory */
 mb_solver *mb_solver_new(const char *name, const mb_model *m);
 

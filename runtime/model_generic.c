@@ -16,8 +16,48 @@ const char *mb_status_text(int status) {
   }
 }
 
+/* most triplets one evaluation of the generic path can produce */
+static size_t max_triplets(const mb_model *m) {
+  size_t n = 0;
+  for (int b = 0; b < m->nbody; b++) n += (size_t)(6 + m->body[b].nm) * (size_t)(6 + m->body[b].nm);
+  for (int r = 0; r < m->nrow; r++)
+    for (int s = 0; s < 2; s++) {
+      int k = s ? m->row[r].m1 : m->row[r].m0;
+      if (m->marker[k].body >= 0) n += 2 * (size_t)(6 + m->body[m->marker[k].body].nm);
+    }
+  return n;
+}
+
+static size_t frames_size(const mb_model *m) {
+  size_t z = (size_t)m->nbody * sizeof(mb_frame) + (size_t)m->nmarker * sizeof(mb_marker);
+  return (z + sizeof(double) - 1) / sizeof(double) * sizeof(double);
+}
+
 size_t mb_model_worksize(const mb_model *m) {
-  return (size_t)m->nbody * sizeof(mb_frame) + (size_t)m->nmarker * sizeof(mb_marker);
+  return frames_size(m) + sizeof(mb_triplets) +
+         max_triplets(m) * (2 * sizeof(int) + sizeof(mb_real)) + sizeof(double);
+}
+
+mb_triplets *mb_generic_triplets(const mb_model *m, void *work) {
+  return (mb_triplets *)((char *)work + frames_size(m));
+}
+
+/* where an entry of K goes: a slot of the fixed pattern, or a triplet */
+typedef struct {
+  mb_real *Kx;
+  mb_triplets *T;
+} sink;
+
+static inline void put(sink *k, int slot, int row, int col, mb_real x) {
+  if (k->T) {
+    mb_triplets *T = k->T;
+    T->i[T->n] = row;
+    T->j[T->n] = col;
+    T->x[T->n] = x;
+    T->n++;
+  } else if (slot >= 0) {
+    k->Kx[slot] = x;
+  }
 }
 
 /* body frames and markers at (q, v) */
@@ -163,8 +203,11 @@ void mb_generic_init(const mb_model *m, mb_real *Kx) {
   }
 }
 
-void mb_generic_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
-                     mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *phid, void *work) {
+/* The evaluation of both generic variants: entries of K go to the fixed
+ * pattern's slots (K written by the caller's init for constants), or, on
+ * the general path, every entry of every element block goes to triplets. */
+static void generic_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
+                         sink *K, mb_real *rhs, mb_real *phi, mb_real *phid, void *work) {
   mb_frame *F = (mb_frame *)work;
   mb_marker *MK = (mb_marker *)(F + m->nbody);
   frames_and_markers(m, q, v, F, MK);
@@ -178,8 +221,12 @@ void mb_generic_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_re
       int nb = 6 + B->nm;
       mb_flex_body(B->flex, &F[b], q + B->qadr + 7, v + B->vadr + 6, m->gravity, Mb, f);
       for (int i = 0; i < nb * nb; i++)
-        if (B->mslotf[i] >= 0) Kx[B->mslotf[i]] = Mb[i];
+        if (K->T || B->mslotf[i] >= 0) put(K, B->mslotf[i], B->vadr + i / nb, B->vadr + i % nb, Mb[i]);
       continue;
+    }
+    if (K->T && B->kind == MB_BODY_RIGID) { /* the general path assembles M too */
+      for (int j = 0; j < 3; j++) put(K, -1, B->vadr + j, B->vadr + j, B->mass);
+      for (int j = 0; j < 9; j++) put(K, -1, B->vadr + 3 + j / 3, B->vadr + 3 + j % 3, B->J[j]);
     }
     for (int j = 0; j < 3; j++) f[j] = B->mass * m->gravity[j];
     mb_rigid_gyro(B->J, F[b].wl, s);
@@ -200,19 +247,53 @@ void mb_generic_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_re
       if (m->marker[k].body < 0) continue;
       mb_real c[6 + MB_MAX_MODES];
       int nc = marker_cols(m, F, MK, k, q, row.dV[s], row.dW[s], c);
+      int col0 = m->body[m->marker[k].body].vadr, rowi = m->nv + r;
+      if (K->T) { /* every column of the body: no compile-time structure */
+        for (int j = 0; j < nc; j++) {
+          put(K, -1, rowi, col0 + j, c[j]);
+          put(K, -1, col0 + j, rowi, c[j]);
+        }
+        continue;
+      }
       for (int j = 0; j < 6; j++)
         if (rd->slot[s][j] >= 0 && !rd->constant[s][j]) {
-          Kx[rd->slot[s][j]] = c[j];
-          Kx[rd->slotT[s][j]] = c[j];
+          put(K, rd->slot[s][j], rowi, col0 + j, c[j]);
+          put(K, rd->slotT[s][j], col0 + j, rowi, c[j]);
         }
       if (rd->mslot[s] >= 0) {
         const int *ms = m->modal_slot + rd->mslot[s];
         int nm = nc - 6;
-        for (int j = 0; j < nm; j++)
-          if (ms[j] >= 0) Kx[ms[j]] = Kx[ms[nm + j]] = c[6 + j];
+        for (int j = 0; j < nm; j++) {
+          put(K, ms[j], rowi, col0 + 6 + j, c[6 + j]);
+          put(K, ms[nm + j], col0 + 6 + j, rowi, c[6 + j]);
+        }
       }
     }
   }
+}
+
+void mb_generic_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
+                     mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *phid, void *work) {
+  sink K = {Kx, 0};
+  generic_eval(m, t, q, v, &K, rhs, phi, phid, work);
+}
+
+void mb_generic_triplet_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
+                             mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *phid,
+                             void *work) {
+  mb_triplets *T = mb_generic_triplets(m, work);
+  size_t cap = max_triplets(m);
+  T->i = (int *)(T + 1);
+  T->j = T->i + cap;
+  T->x = (mb_real *)(void *)(T->j + cap);
+  T->n = 0;
+  sink K = {Kx, T};
+  generic_eval(m, t, q, v, &K, rhs, phi, phid, work);
+}
+
+void mb_generic_triplet_init(const mb_model *m, mb_real *Kx) {
+  (void)m;
+  (void)Kx; /* the general path assembles everything in every evaluation */
 }
 
 void mb_model_qdot(const mb_model *m, const mb_real *q, const mb_real *v, mb_real *qd) {

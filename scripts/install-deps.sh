@@ -33,6 +33,7 @@ present() {
     liblapack-dev)      links lapack ;;
     libblas-dev)        links blas ;;
     libcmocka-dev)      [ -e /usr/include/cmocka.h ] && links cmocka ;;
+    libsundials-dev)    [ -e /usr/include/ida/ida.h ] && links sundials_ida && links sundials_nvecserial ;;
     gnuplot-nox)        gnuplot -e 'set terminal pngcairo' ;;
     clang)              command -v clang ;;
     *)                  false ;;
@@ -41,7 +42,7 @@ present() {
 
 # gnuplot-nox has the pngcairo terminal on Debian 12 (checked: 5.4.4)
 packages=(build-essential libyaml-dev libsuitesparse-dev liblapack-dev libblas-dev
-          libcmocka-dev gnuplot-nox clang)
+          libcmocka-dev libsundials-dev gnuplot-nox clang)
 missing=()
 for p in "${packages[@]}"; do
   present "$p" || missing+=("$p")

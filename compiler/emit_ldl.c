@@ -1,0 +1,465 @@
+/* emit_ldl.c: writes the emitted LDL^T of K (solver "ldl") into the
+ * generated <model>.c: the pattern, the ordering and every index fixed at
+ * compile time (order.c), no library, no allocation.
+ *
+ *   int <m>_ldl_factor(const mb_real *Kx, mb_real *work)
+ *     forms K_aug = [M + D^T W D, D^T; D, 0] from Kx in the CAMD order and
+ *     factorizes it up-looking into L D L^T; returns 0, or 1 + the original
+ *     unknown whose pivot is zero, tiny (|d| <= 1e-14 of the magnitudes that
+ *     formed it) or not finite.
+ *   int <m>_ldl_solve(const mb_real *Kx, mb_real *work, mb_real *b, mb_real *res)
+ *     solves K x = b in place: x from the factors of K_aug with right side
+ *     [b_top + D^T W b_bot; b_bot], then iterative refinement on the exact
+ *     system (r = b - K x with the original Kx, correction from the same
+ *     factors): one step, a second when ||r||_inf / (||K||_inf ||x||_inf +
+ *     ||b||_inf) is still above 1e-12; *res gets that relative residual.
+ *     Returns MB_OK or MB_ERR_NONFINITE.
+ *
+ * Below the flop budget every operation is emitted with constant indices
+ * (straight-line); above it the same operations run as loops over static
+ * const index arrays, so that the C compiler's time stays bounded.
+ *
+ * The workspace (<M>_LDL_WORK mb_real) holds Lx (nnz(L)), 1/d (n),
+ * ||K||_inf (1), then x, r, t and the best x of the refinement (n each). */
+#include <ctype.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "emit_ldl.h"
+#include "order.h"
+
+static void upper(char *dst, const char *src, size_t n) {
+  size_t i = 0;
+  for (; src[i] && i + 1 < n; i++) dst[i] = (char)toupper((unsigned char)src[i]);
+  dst[i] = 0;
+}
+
+static void num(FILE *f, double x) {
+  if (x == 0) x = 0;
+  fprintf(f, "%.17g", x);
+}
+
+static void int_array(FILE *f, const char *name, const int *x, long n) {
+  fprintf(f, "static const int %s[%ld] = {", name, n > 0 ? n : 1);
+  if (n <= 0) fputs("0", f);
+  for (long i = 0; i < n; i++) fprintf(f, "%s%d", i % 16 ? ", " : (i ? ",\n  " : "\n  "), x[i]);
+  fprintf(f, "\n};\n");
+}
+
+static void real_array(FILE *f, const char *name, const double *x, long n) {
+  fprintf(f, "static const mb_real %s[%ld] = {", name, n > 0 ? n : 1);
+  if (n <= 0) fputs("0", f);
+  for (long i = 0; i < n; i++) {
+    fputs(i % 4 ? ", " : (i ? ",\n  " : "\n  "), f);
+    num(f, x[i]);
+  }
+  fprintf(f, "\n};\n");
+}
+
+static long work_size(const ldl_plan *p) { return p->nnzL + 5L * p->n + 1; }
+
+void emit_ldl_header(FILE *f, const lmodel *L, const char *nm) {
+  ldl_plan p;
+  if (ldl_plan_build(L, &p)) return;
+  char U[256];
+  upper(U, nm, sizeof U);
+  fprintf(f, "/* emitted LDL^T of K (solver \"ldl\"), see %s.c */\n", nm);
+  fprintf(f, "#define %s_LDL_NNZL %ld      /* nonzeros of L (strictly lower) */\n", U, p.nnzL);
+  fprintf(f, "#define %s_LDL_FLOPS %.0f.0  /* flops of one numeric factorization */\n", U, p.flops);
+  fprintf(f, "#define %s_LDL_STRAIGHT %d   /* 1: straight-line code, 0: loops over tables */\n", U,
+          p.straight);
+  fprintf(f, "#define %s_LDL_WORK %ld      /* mb_real elements of the workspace */\n", U, work_size(&p));
+  fprintf(f, "int %s_ldl_factor(const mb_real *Kx, mb_real *work);\n", nm);
+  fprintf(f, "int %s_ldl_solve(const mb_real *Kx, mb_real *work, mb_real *b, mb_real *residual);\n", nm);
+  ldl_plan_free(&p);
+}
+
+void emit_ldl_fields(FILE *f, const char *nm, int emitted) {
+  if (!emitted) return;
+  char U[256];
+  upper(U, nm, sizeof U);
+  fprintf(f, "  .ldl_factor = ldl_factor_m, .ldl_solve = ldl_solve_m, .ldl_worksize = %s_LDL_WORK,\n"
+             "  .ldl_nnzL = %s_LDL_NNZL, .ldl_flops = %s_LDL_FLOPS, .ldl_straight = %s_LDL_STRAIGHT,\n",
+          U, U, U, U);
+}
+
+/* ---------------------------------------------------------------- helpers */
+
+/* the value of K_aug entry e (upper triangle, permuted) as a C expression */
+static void aug_value(FILE *f, const ldl_plan *p, int e) {
+  int any = 0;
+  if (p->Us[e] >= 0) { fprintf(f, "Kx[%d]", p->Us[e]); any = 1; }
+  for (int t = p->Tp[e]; t < p->Tp[e + 1]; t++) {
+    fputs(any ? " + " : "", f);
+    num(f, p->w[p->Tw[t]]);
+    fprintf(f, " * Kx[%d] * Kx[%d]", p->Ta[t], p->Tb[t]);
+    any = 1;
+  }
+  if (!any) fputs("0", f);
+}
+
+/* row sums of |K| (the same straight-line / looped choice as the factorization) */
+static void emit_knorm(FILE *f, const lmodel *L, const ldl_plan *p) {
+  const mb_model *m = &L->m;
+  fputs("  /* ||K||_inf: the largest row sum of |K| (for the relative residual) */\n", f);
+  if (!p->straight) {
+    fputs("  {\n    mb_real *rs = work + LDL_R, a = 0;\n", f);
+    fputs("    for (int i = 0; i < LDL_N; i++) rs[i] = 0;\n", f);
+    fputs("    for (int j = 0; j < LDL_N; j++)\n"
+          "      for (int q = ldl_Kp[j]; q < ldl_Kp[j + 1]; q++) rs[ldl_Ki[q]] += fabs(Kx[q]);\n", f);
+    fputs("    for (int i = 0; i < LDL_N; i++) if (rs[i] > a) a = rs[i];\n", f);
+    fputs("    work[LDL_KNORM] = a;\n  }\n", f);
+    return;
+  }
+  /* rows of K: the entries (i, j) sit in column j */
+  int n = m->n;
+  int *cnt = calloc((size_t)n + 1, sizeof(int)), *rp = calloc((size_t)n + 1, sizeof(int));
+  int *rs = malloc(sizeof(int) * (size_t)(m->nnz + 1));
+  if (!cnt || !rp || !rs) { free(cnt); free(rp); free(rs); return; }
+  fputs("  {\n    mb_real a = 0, c;\n", f);
+  for (int q = 0; q < m->nnz; q++) rp[m->Ki[q] + 1]++;
+  for (int i = 0; i < n; i++) rp[i + 1] += rp[i];
+  for (int j = 0; j < n; j++)
+    for (int q = m->Kp[j]; q < m->Kp[j + 1]; q++) rs[rp[m->Ki[q]] + cnt[m->Ki[q]]++] = q;
+  for (int i = 0; i < n; i++) {
+    if (rp[i] == rp[i + 1]) continue;
+    fputs("    c = ", f);
+    for (int q = rp[i]; q < rp[i + 1]; q++) fprintf(f, "%sfabs(Kx[%d])", q > rp[i] ? " + " : "", rs[q]);
+    fputs(";\n    if (c > a) a = c;\n", f);
+  }
+  fputs("    work[LDL_KNORM] = a;\n  }\n", f);
+  free(cnt); free(rp); free(rs);
+}
+
+/* --------------------------------------------------------- factorization */
+
+/* straight-line code is split into functions of about this many flops (kept
+ * out of line): the C compiler's register allocation and store-to-load
+ * forwarding then work on small functions, and its time stays linear */
+#define LDL_CHUNK_FLOPS 600
+
+static void emit_factor_straight(FILE *f, const lmodel *L, const ldl_plan *p, const char *nm) {
+  int n = p->n;
+  char name[512];
+  /* has the L slot been written in this factorization yet (else: fill, first
+   * update becomes an assignment) */
+  char *written = calloc((size_t)p->nnzL + 1, 1);
+  int *slot_of = malloc(sizeof(int) * (size_t)(n + 1)); /* row k: column j -> Lx position */
+  if (!written || !slot_of) { free(written); free(slot_of); return; }
+  for (int j = 0; j < n; j++) slot_of[j] = -1;
+  int nchunk = 0;
+  double chunk_flops = 0;
+  for (int k = 0; k < n; k++) {
+    if (k == 0 || chunk_flops > LDL_CHUNK_FLOPS) {
+      if (k) fputs("  (void)t;\n  (void)l;\n  return 0;\n}\n\n", f);
+      fprintf(f, "static LDL_NOINLINE int ldl_factor_part%d(const mb_real *Kx, mb_real *Lx, mb_real *Dinv) {\n",
+              nchunk++);
+      fputs("  mb_real d, s, t = 0, l = 0;\n  (void)Kx;\n  (void)Lx;\n", f);
+      chunk_flops = 0;
+    }
+    int u = p->perm[k];
+    ldl_unknown_name(L, u, name, sizeof name);
+    fprintf(f, "  /* pivot %d: unknown %d, %s; row %d of L: %d entries */\n", k, u, name, k,
+            p->Rp[k + 1] - p->Rp[k]);
+    for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) slot_of[p->Rj[r]] = p->Rpos[r];
+    /* column k of the upper triangle of K_aug into row k of L (then y) */
+    int diag = -1;
+    for (int e = p->Up[k]; e < p->Up[k + 1]; e++) {
+      int i = p->Ui[e];
+      if (i == k) { diag = e; continue; }
+      fprintf(f, "  Lx[%d] = ", slot_of[i]);
+      aug_value(f, p, e);
+      fputs(";\n", f);
+      written[slot_of[i]] = 1;
+    }
+    fputs("  d = ", f);
+    if (diag >= 0) aug_value(f, p, diag);
+    else fputs("0", f);
+    fputs(";\n  s = fabs(d);\n", f);
+    /* y_j for j ascending: update the later entries of the row, scale, pivot */
+    for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) {
+      int j = p->Rj[r], pkj = p->Rpos[r];
+      fprintf(f, "  t = Lx[%d];", pkj);
+      for (int q = p->Lp[j]; q < pkj; q++) {
+        int i = p->Li[q], pki = slot_of[i];
+        if (written[pki]) fprintf(f, " Lx[%d] -= Lx[%d] * t;", pki, q);
+        else { fprintf(f, " Lx[%d] = -(Lx[%d] * t);", pki, q); written[pki] = 1; }
+      }
+      fprintf(f, " l = Lx[%d] = t * Dinv[%d]; d -= l * t; s += fabs(l * t);\n", pkj, j);
+      chunk_flops += 2.0 * (pkj - p->Lp[j]) + 3;
+    }
+    fprintf(f, "  if (!(fabs(d) > LDL_PIVTOL * s) || !isfinite(s)) return %d;\n", u + 1);
+    fprintf(f, "  Dinv[%d] = 1 / d;\n", k);
+    chunk_flops += 1 + (p->Up[k + 1] - p->Up[k]);
+    for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) slot_of[p->Rj[r]] = -1;
+  }
+  if (n) fputs("  (void)t;\n  (void)l;\n  return 0;\n}\n\n", f);
+  fprintf(f, "int %s_ldl_factor(const mb_real *Kx, mb_real *work) {\n", nm);
+  fputs("  mb_real *Lx = work, *Dinv = work + LDL_DINV;\n  int rc;\n", f);
+  emit_knorm(f, L, p);
+  fputs("  /* the pivots in order, in parts */\n", f);
+  for (int c = 0; c < nchunk; c++)
+    fprintf(f, "  if ((rc = ldl_factor_part%d(Kx, Lx, Dinv)) != 0) return rc;\n", c);
+  fputs("  (void)Lx;\n  (void)Dinv;\n  (void)rc;\n  return 0;\n}\n\n", f);
+  free(written);
+  free(slot_of);
+}
+
+static void emit_factor_looped(FILE *f, const lmodel *L, const ldl_plan *p, const char *nm) {
+  fprintf(f, "int %s_ldl_factor(const mb_real *Kx, mb_real *work) {\n", nm);
+  fputs("  mb_real *Lx = work, *Dinv = work + LDL_DINV, *y = work + LDL_T;\n", f);
+  emit_knorm(f, L, p);
+  fputs("  for (int i = 0; i < LDL_N; i++) y[i] = 0;\n", f);
+  fputs("  for (int k = 0; k < LDL_N; k++) {\n", f);
+  fputs("    /* column k of the upper triangle of K_aug, scattered into y */\n", f);
+  fputs("    for (int e = ldl_Up[k]; e < ldl_Up[k + 1]; e++) {\n", f);
+  fputs("      mb_real v = ldl_Us[e] >= 0 ? Kx[ldl_Us[e]] : 0;\n", f);
+  if (p->Tp[p->nnzA] > 0)
+    fputs("      for (int q = ldl_Tp[e]; q < ldl_Tp[e + 1]; q++) v += ldl_Tw[q] * Kx[ldl_Ta[q]] * Kx[ldl_Tb[q]];\n",
+          f);
+  fputs("      y[ldl_Ui[e]] = v;\n    }\n", f);
+  fputs("    mb_real d = y[k], s = fabs(d);\n    y[k] = 0;\n", f);
+  fputs("    /* row k of L: a sparse triangular solve along the etree, columns ascending */\n", f);
+  fputs("    for (int r = ldl_Rp[k]; r < ldl_Rp[k + 1]; r++) {\n", f);
+  fputs("      int j = ldl_Rj[r], pkj = ldl_Rpos[r];\n", f);
+  fputs("      mb_real t = y[j], l;\n      y[j] = 0;\n", f);
+  fputs("      for (int q = ldl_Lp[j]; q < pkj; q++) y[ldl_Li[q]] -= Lx[q] * t;\n", f);
+  fputs("      l = Lx[pkj] = t * Dinv[j];\n      d -= l * t;\n      s += fabs(l * t);\n    }\n", f);
+  fputs("    if (!(fabs(d) > LDL_PIVTOL * s) || !isfinite(s)) return 1 + ldl_perm[k];\n", f);
+  fputs("    Dinv[k] = 1 / d;\n  }\n  return 0;\n}\n\n", f);
+}
+
+/* ------------------------------------------------------------------ solve */
+
+static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan *p) {
+  const mb_model *m = &L->m;
+  int n = p->n, nv = p->nv;
+  /* t = P [r_top + D^T W r_bot; r_bot] */
+  fputs("/* t = P [r_top + D^T W r_bot; r_bot]: the right side of K_aug, permuted */\n", f);
+  fputs("static void ldl_aug(const mb_real *Kx, const mb_real *r, mb_real *t) {\n", f);
+  for (int k = 0; k < n; k++) {
+    int u = p->perm[k];
+    fprintf(f, "  t[%d] = r[%d]", k, u);
+    if (u < nv)
+      for (int w = 0; w < p->nw; w++)
+        for (int q = p->Dp[w]; q < p->Dp[w + 1]; q++)
+          if (p->Dj[q] == u) {
+            fputs(" + ", f);
+            num(f, p->w[w]);
+            fprintf(f, " * Kx[%d] * r[%d]", p->Ds[q], nv + p->wrow[w]);
+          }
+    fputs(";\n", f);
+  }
+  if (p->nw == 0) fputs("  (void)Kx;\n", f);
+  fputs("}\n\n", f);
+
+  fputs("/* t <- (L D L^T)^-1 t */\n", f);
+  fputs("static void ldl_lsolve(const mb_real *Lx, const mb_real *Dinv, mb_real *t) {\n", f);
+  fputs("  /* forward: L y = t */\n", f);
+  for (int j = 0; j < n; j++)
+    for (int q = p->Lp[j]; q < p->Lp[j + 1]; q++)
+      fprintf(f, "  t[%d] -= Lx[%d] * t[%d];\n", p->Li[q], q, j);
+  fputs("  /* diagonal: z = D^-1 y */\n", f);
+  for (int k = 0; k < n; k++) fprintf(f, "  t[%d] *= Dinv[%d];\n", k, k);
+  fputs("  /* backward: L^T x = z */\n", f);
+  for (int j = n - 1; j >= 0; j--) {
+    if (p->Lp[j] == p->Lp[j + 1]) continue;
+    fprintf(f, "  t[%d] -= ", j);
+    for (int q = p->Lp[j]; q < p->Lp[j + 1]; q++)
+      fprintf(f, "%sLx[%d] * t[%d]", q > p->Lp[j] ? " + " : "", q, p->Li[q]);
+    fputs(";\n", f);
+  }
+  if (p->nnzL == 0) fputs("  (void)Lx;\n", f);
+  fputs("}\n\n", f);
+
+  fputs("/* x += P^T t */\n", f);
+  fputs("static void ldl_scatter_add(const mb_real *t, mb_real *x) {\n", f);
+  for (int k = 0; k < n; k++) fprintf(f, "  x[%d] += t[%d];\n", p->perm[k], k);
+  fputs("}\n\n", f);
+
+  /* r = b - K x by rows */
+  fputs("/* r = b - K x (the exact system, original Kx) */\n", f);
+  fputs("static void ldl_residual(const mb_real *Kx, const mb_real *x, const mb_real *b, mb_real *r) {\n", f);
+  int *cnt = calloc((size_t)n + 1, sizeof(int)), *rp = calloc((size_t)n + 1, sizeof(int));
+  int *rs = malloc(sizeof(int) * (size_t)(m->nnz + 1)), *rc = malloc(sizeof(int) * (size_t)(m->nnz + 1));
+  if (cnt && rp && rs && rc) {
+    for (int q = 0; q < m->nnz; q++) rp[m->Ki[q] + 1]++;
+    for (int i = 0; i < n; i++) rp[i + 1] += rp[i];
+    for (int j = 0; j < n; j++)
+      for (int q = m->Kp[j]; q < m->Kp[j + 1]; q++) {
+        int i = m->Ki[q], s = rp[i] + cnt[i]++;
+        rs[s] = q;
+        rc[s] = j;
+      }
+    for (int i = 0; i < n; i++) {
+      fprintf(f, "  r[%d] = b[%d]", i, i);
+      for (int s = rp[i]; s < rp[i + 1]; s++) fprintf(f, " - Kx[%d] * x[%d]", rs[s], rc[s]);
+      fputs(";\n", f);
+    }
+  }
+  free(cnt); free(rp); free(rs); free(rc);
+  fputs("}\n\n", f);
+}
+
+static void emit_solve_helpers_looped(FILE *f, const ldl_plan *p) {
+  fputs("/* t = P [r_top + D^T W r_bot; r_bot]: the right side of K_aug, permuted */\n", f);
+  fputs("static void ldl_aug(const mb_real *Kx, const mb_real *r, mb_real *t) {\n", f);
+  fputs("  for (int k = 0; k < LDL_N; k++) t[k] = r[ldl_perm[k]];\n", f);
+  if (p->nw)
+    fputs("  for (int q = 0; q < LDL_ND; q++) t[ldl_Dt[q]] += ldl_Dw[q] * Kx[ldl_Ds[q]] * r[ldl_Dr[q]];\n", f);
+  else
+    fputs("  (void)Kx;\n", f);
+  fputs("}\n\n", f);
+  fputs("/* t <- (L D L^T)^-1 t */\n", f);
+  fputs("static void ldl_lsolve(const mb_real *Lx, const mb_real *Dinv, mb_real *t) {\n", f);
+  fputs("  for (int j = 0; j < LDL_N; j++) { /* forward: L y = t */\n"
+        "    mb_real tj = t[j];\n"
+        "    for (int q = ldl_Lp[j]; q < ldl_Lp[j + 1]; q++) t[ldl_Li[q]] -= Lx[q] * tj;\n  }\n", f);
+  fputs("  for (int k = 0; k < LDL_N; k++) t[k] *= Dinv[k]; /* diagonal */\n", f);
+  fputs("  for (int j = LDL_N - 1; j >= 0; j--) { /* backward: L^T x = z */\n"
+        "    mb_real s = t[j];\n"
+        "    for (int q = ldl_Lp[j]; q < ldl_Lp[j + 1]; q++) s -= Lx[q] * t[ldl_Li[q]];\n"
+        "    t[j] = s;\n  }\n}\n\n", f);
+  fputs("/* x += P^T t */\n", f);
+  fputs("static void ldl_scatter_add(const mb_real *t, mb_real *x) {\n"
+        "  for (int k = 0; k < LDL_N; k++) x[ldl_perm[k]] += t[k];\n}\n\n", f);
+  fputs("/* r = b - K x (the exact system, original Kx) */\n", f);
+  fputs("static void ldl_residual(const mb_real *Kx, const mb_real *x, const mb_real *b, mb_real *r) {\n"
+        "  for (int i = 0; i < LDL_N; i++) r[i] = b[i];\n"
+        "  for (int j = 0; j < LDL_N; j++) {\n"
+        "    mb_real xj = x[j];\n"
+        "    for (int q = ldl_Kp[j]; q < ldl_Kp[j + 1]; q++) r[ldl_Ki[q]] -= Kx[q] * xj;\n  }\n}\n\n", f);
+}
+
+static void emit_solve(FILE *f, const char *nm) {
+  fprintf(f, "int %s_ldl_solve(const mb_real *Kx, mb_real *work, mb_real *b, mb_real *residual) {\n", nm);
+  fputs("  const mb_real *Lx = work, *Dinv = work + LDL_DINV;\n"
+        "  mb_real *x = work + LDL_X, *r = work + LDL_R, *t = work + LDL_T, *xb = work + LDL_XB;\n"
+        "  mb_real knorm = work[LDL_KNORM], bn = 0, best = 0;\n"
+        "  for (int i = 0; i < LDL_N; i++) {\n"
+        "    x[i] = 0;\n    r[i] = b[i];\n    if (fabs(b[i]) > bn) bn = fabs(b[i]);\n  }\n"
+        "  /* pass 0: the solve; pass 1: refinement; pass 2: a second one if still above 1e-12 */\n"
+        "  for (int it = 0; it < 3; it++) {\n"
+        "    mb_real rn = 0, xn = 0, den, rel;\n"
+        "    ldl_aug(Kx, r, t);\n"
+        "    ldl_lsolve(Lx, Dinv, t);\n"
+        "    ldl_scatter_add(t, x);\n"
+        "    ldl_residual(Kx, x, b, r);\n"
+        "    for (int i = 0; i < LDL_N; i++) {\n"
+        "      if (!(fabs(r[i]) <= rn)) rn = fabs(r[i]);\n"
+        "      if (!(fabs(x[i]) <= xn)) xn = fabs(x[i]);\n    }\n"
+        "    den = knorm * xn + bn;\n"
+        "    rel = den > 0 ? rn / den : rn;\n"
+        "    if (it > 0 && !(rel < best)) break; /* no longer improving: keep the best */\n"
+        "    best = rel;\n"
+        "    for (int i = 0; i < LDL_N; i++) xb[i] = x[i];\n"
+        "    if (it > 0 && rel <= 1e-12) break;\n  }\n"
+        "  for (int i = 0; i < LDL_N; i++) b[i] = xb[i];\n"
+        "  if (residual) *residual = best;\n"
+        "  return isfinite(best) ? MB_OK : MB_ERR_NONFINITE;\n}\n\n", f);
+}
+
+int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
+  ldl_plan p;
+  if (ldl_plan_build(L, &p)) {
+    fputs("/* --- emitted LDL^T: not available (the ordering failed) --- */\n\n", f);
+    return 0;
+  }
+  char U[256], name[512];
+  upper(U, nm, sizeof U);
+  int n = p.n;
+  char ordering[160];
+  if (p.tree)
+    snprintf(ordering, sizeof ordering, "CAMD with %d constraint sets from the spanning tree: each body\n"
+             " * before the rows joining it to its parent, loop rows last", p.nsets);
+  else
+    snprintf(ordering, sizeof ordering, "CAMD, the %d body unknowns before the %d constraint rows", p.nv, p.nc);
+  fprintf(f, "/* --- emitted LDL^T of K (solver \"ldl\") ---\n"
+             " * K_aug = [M + D^T W D, D^T; D, 0], right side [f + D^T W g; g]: the\n"
+             " * solution of K x = b; every leading block of the order is nonsingular with\n"
+             " * positive pivots for body unknowns, negative for rows.  Ordering:\n"
+             " * %s.  nnz(L) = %ld,\n"
+             " * %.0f flops per factorization, %.0f per solve; %s.\n",
+          ordering, p.nnzL, p.flops, p.flops_solve,
+          p.straight ? "straight-line code" : "loops over static tables (above the flop budget)");
+  fprintf(f, " * %d massless velocity unknowns; weighted rows (constraint row: w):", p.nmassless);
+  if (!p.nw) fputs(" none", f);
+  for (int k = 0; k < p.nw; k++) {
+    fputs(k % 4 ? ", " : "\n *  ", f);
+    fprintf(f, "%d: %.6g", p.wrow[k], p.w[k]);
+  }
+  fputs("\n * Workspace: Lx, 1/d, ||K||_inf, x, r, t, best x. */\n", f);
+  fprintf(f, "#define LDL_N %d\n#define LDL_DINV %s_LDL_NNZL\n#define LDL_KNORM (LDL_DINV + LDL_N)\n"
+             "#define LDL_X (LDL_KNORM + 1)\n#define LDL_R (LDL_X + LDL_N)\n#define LDL_T (LDL_R + LDL_N)\n"
+             "#define LDL_XB (LDL_T + LDL_N)\n#define LDL_PIVTOL 1e-14\n"
+             "#if defined(__GNUC__)\n#define LDL_NOINLINE __attribute__((noinline))\n#else\n#define LDL_NOINLINE\n#endif\n",
+          n, U);
+  /* pivot order as a comment (straight) or a table (looped) */
+  if (p.straight) {
+    fputs("/* pivot order: ", f);
+    for (int k = 0; k < n; k++) fprintf(f, "%s%d", k ? (k % 20 ? " " : "\n *   ") : "", p.perm[k]);
+    fputs(" */\n\n", f);
+  } else {
+    const mb_model *m = &L->m;
+    fputs("/* pivot order (original unknowns) */\n", f);
+    int_array(f, "ldl_perm", p.perm, n);
+    fputs("/* K_aug, upper triangle of the permuted matrix: rows, Kx slots (-1: none), and the\n"
+          " * products w_r D_ri D_rj of the weighted rows (weights, Kx slots) */\n", f);
+    int_array(f, "ldl_Up", p.Up, n + 1);
+    int_array(f, "ldl_Ui", p.Ui, p.nnzA);
+    int_array(f, "ldl_Us", p.Us, p.nnzA);
+    int nt = p.Tp[p.nnzA];
+    if (nt > 0) {
+      double *tw = malloc(sizeof(double) * (size_t)(nt + 1));
+      if (!tw) { ldl_plan_free(&p); return 0; }
+      for (int t = 0; t < nt; t++) tw[t] = p.w[p.Tw[t]];
+      int_array(f, "ldl_Tp", p.Tp, p.nnzA + 1);
+      real_array(f, "ldl_Tw", tw, nt);
+      int_array(f, "ldl_Ta", p.Ta, nt);
+      int_array(f, "ldl_Tb", p.Tb, nt);
+      free(tw);
+    }
+    fputs("/* L: columns (strictly lower, rows ascending) and rows (columns ascending, positions) */\n", f);
+    int_array(f, "ldl_Lp", p.Lp, n + 1);
+    int_array(f, "ldl_Li", p.Li, p.nnzL);
+    int_array(f, "ldl_Rp", p.Rp, n + 1);
+    int_array(f, "ldl_Rj", p.Rj, p.nnzL);
+    int_array(f, "ldl_Rpos", p.Rpos, p.nnzL);
+    fputs("/* D entries of the weighted rows: target (permuted), weight, Kx slot, row in b */\n", f);
+    if (p.nw) {
+      int nd = p.Dp[p.nw];
+      int *dt = malloc(sizeof(int) * (size_t)(nd + 1)), *dr = malloc(sizeof(int) * (size_t)(nd + 1));
+      double *dw = malloc(sizeof(double) * (size_t)(nd + 1));
+      if (!dt || !dr || !dw) { free(dt); free(dr); free(dw); ldl_plan_free(&p); return 0; }
+      for (int k = 0; k < p.nw; k++)
+        for (int q = p.Dp[k]; q < p.Dp[k + 1]; q++) {
+          dt[q] = p.iperm[p.Dj[q]];
+          dr[q] = p.nv + p.wrow[k];
+          dw[q] = p.w[k];
+        }
+      fprintf(f, "#define LDL_ND %d\n", nd);
+      int_array(f, "ldl_Dt", dt, nd);
+      real_array(f, "ldl_Dw", dw, nd);
+      int_array(f, "ldl_Ds", p.Ds, nd);
+      int_array(f, "ldl_Dr", dr, nd);
+      free(dt); free(dr); free(dw);
+    }
+    fputs("/* the pattern of K (for the residual and ||K||) */\n", f);
+    int_array(f, "ldl_Kp", m->Kp, n + 1);
+    int_array(f, "ldl_Ki", m->Ki, m->nnz);
+    fputc('\n', f);
+  }
+  if (p.straight) emit_factor_straight(f, L, &p, nm);
+  else emit_factor_looped(f, L, &p, nm);
+  if (p.straight) emit_solve_helpers_straight(f, L, &p);
+  else emit_solve_helpers_looped(f, &p);
+  emit_solve(f, nm);
+  fputs("static int ldl_factor_m(const mb_model *m, const mb_real *Kx, mb_real *work) {\n", f);
+  fprintf(f, "  (void)m;\n  return %s_ldl_factor(Kx, work);\n}\n", nm);
+  fputs("static int ldl_solve_m(const mb_model *m, const mb_real *Kx, mb_real *work, mb_real *b,\n"
+        "                       mb_real *residual) {\n", f);
+  fprintf(f, "  (void)m;\n  return %s_ldl_solve(Kx, work, b, residual);\n}\n\n", nm);
+  (void)name;
+  ldl_plan_free(&p);
+  return 1;
+}

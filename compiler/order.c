@@ -1,0 +1,560 @@
+/* order.c: the compile-time part of the emitted LDL^T (see order.h):
+ * weights for the rows that touch massless unknowns, the pattern of
+ * K_aug = [M + D^T W D, D^T; D, 0], the CAMD ordering (body unknowns before
+ * constraint rows), the elimination tree, column counts, the pattern of L and
+ * the flop count of the numeric factorization that emit_ldl.c emits.
+ *
+ * The numeric factorization (emit_ldl.c) is up-looking: row k of L is the
+ * solution of a sparse triangular system whose pattern is the set of etree
+ * nodes reachable from the nonzeros of column k of the upper triangle; for
+ * each j of that row (ascending) with t = y_j:
+ *     y_i -= L(i,j) t   for the entries of column j of L above row k
+ *     L(k,j) = t / d_j,  d_k -= L(k,j) t
+ * so it costs, per entry L(k,j), 2 flops per entry of column j above row k
+ * plus 3, and one division per pivot: that is the flop count reported. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <stdio.h>
+#include <suitesparse/camd.h>
+
+#include "order.h"
+
+void ldl_plan_free(ldl_plan *p) {
+  free(p->perm); free(p->iperm);
+  free(p->wrow); free(p->w); free(p->Dp); free(p->Dj); free(p->Ds);
+  free(p->Up); free(p->Ui); free(p->Us);
+  free(p->Tp); free(p->Tw); free(p->Ta); free(p->Tb);
+  free(p->parent); free(p->Lp); free(p->Li);
+  free(p->Rp); free(p->Rj); free(p->Rpos);
+  memset(p, 0, sizeof *p);
+}
+
+/* Kx slot of K(i, j), or -1 when structurally zero */
+static int kslot(const mb_model *m, int i, int j) {
+  int lo = m->Kp[j], hi = m->Kp[j + 1] - 1;
+  while (lo <= hi) {
+    int mid = (lo + hi) / 2;
+    if (m->Ki[mid] == i) return mid;
+    if (m->Ki[mid] < i) lo = mid + 1;
+    else hi = mid - 1;
+  }
+  return -1;
+}
+
+void ldl_unknown_name(const lmodel *L, int u, char *buf, size_t n) {
+  const mb_model *m = &L->m;
+  static const char *comp[6] = {"translation x", "translation y", "translation z",
+                                "rotation x",    "rotation y",    "rotation z"};
+  if (u >= m->nv) {
+    int r = u - m->nv;
+    snprintf(buf, n, "constraint row %d: %s", r, L->row_desc && L->row_desc[r] ? L->row_desc[r] : "");
+    return;
+  }
+  for (int b = 0; b < m->nbody; b++) {
+    const mb_body *B = &m->body[b];
+    int nb = 6 + (B->kind == MB_BODY_FLEXIBLE ? B->nm : 0);
+    if (u < B->vadr || u >= B->vadr + nb) continue;
+    int c = u - B->vadr;
+    if (c < 6) snprintf(buf, n, "body '%s' %s", B->name, comp[c]);
+    else snprintf(buf, n, "body '%s' mode %d", B->name, c - 6 + 1);
+    return;
+  }
+  snprintf(buf, n, "velocity unknown %d", u);
+}
+
+typedef struct { int col, row, i, j, slot; } uentry; /* permuted (col, row), original (i, j) */
+
+static int uentry_cmp(const void *a, const void *b) {
+  const uentry *x = a, *y = b;
+  if (x->col != y->col) return x->col < y->col ? -1 : 1;
+  return x->row < y->row ? -1 : x->row > y->row;
+}
+
+static int int_cmp(const void *a, const void *b) {
+  int x = *(const int *)a, y = *(const int *)b;
+  return x < y ? -1 : x > y;
+}
+
+/* Kx at t = 0 (initial state): constant entries, then the varying ones */
+static double *kx_at_start(const mb_model *m) {
+  double *Kx = calloc((size_t)m->nnz + 1, sizeof(double));
+  double *rhs = calloc((size_t)m->n + 1, sizeof(double));
+  double *phi = calloc((size_t)m->nc + 1, sizeof(double));
+  double *nu = calloc((size_t)m->nc + 1, sizeof(double));
+  void *work = malloc(mb_model_worksize(m) + 16);
+  if (Kx && rhs && phi && nu && work) {
+    m->init(m, Kx);
+    m->eval(m, 0.0, m->q0, m->v0, Kx, rhs, phi, nu, work);
+  } else {
+    free(Kx);
+    Kx = NULL;
+  }
+  free(rhs); free(phi); free(nu); free(work);
+  return Kx;
+}
+
+/* weights: rows touching a massless column get w_r = mref / |D_r|^2 with
+ * mref the geometric mean of the nonzero M diagonals of the row's other
+ * columns (or of all of M when it has none): D_r^T w_r D_r then adds to the
+ * massless columns the scale of the masses (inertias) it couples them to. */
+static int choose_weights(const mb_model *m, const double *Kx, ldl_plan *p) {
+  int nv = m->nv, nc = m->nc;
+  char *massive = calloc((size_t)nv + 1, 1), *wmark = calloc((size_t)nc + 1, 1);
+  double *mdiag = calloc((size_t)nv + 1, sizeof(double));
+  if (!massive || !wmark || !mdiag) { free(massive); free(wmark); free(mdiag); return -1; }
+  double glog = 0;
+  int gcount = 0;
+  for (int j = 0; j < nv; j++) {
+    for (int q = m->Kp[j]; q < m->Kp[j + 1]; q++)
+      if (m->Ki[q] < nv && Kx[q] != 0) massive[j] = 1;
+    int s = kslot(m, j, j);
+    mdiag[j] = s >= 0 ? fabs(Kx[s]) : 0;
+    if (massive[j] && mdiag[j] > 0) { glog += log(mdiag[j]); gcount++; }
+  }
+  double gmean = gcount ? exp(glog / gcount) : 1.0;
+  p->nmassless = 0;
+  for (int j = 0; j < nv; j++) {
+    if (massive[j]) continue;
+    p->nmassless++;
+    for (int q = m->Kp[j]; q < m->Kp[j + 1]; q++)
+      if (m->Ki[q] >= nv) wmark[m->Ki[q] - nv] = 1;
+  }
+  p->nw = 0;
+  for (int r = 0; r < nc; r++) p->nw += wmark[r];
+  p->wrow = malloc(sizeof(int) * (size_t)(p->nw + 1));
+  p->w = malloc(sizeof(double) * (size_t)(p->nw + 1));
+  p->Dp = calloc((size_t)p->nw + 1, sizeof(int));
+  int cap = 0;
+  for (int r = 0; r < nc; r++)
+    if (wmark[r]) cap += m->Kp[nv + r + 1] - m->Kp[nv + r];
+  p->Dj = malloc(sizeof(int) * (size_t)(cap + 1));
+  p->Ds = malloc(sizeof(int) * (size_t)(cap + 1));
+  if (!p->wrow || !p->w || !p->Dp || !p->Dj || !p->Ds) {
+    free(massive); free(wmark); free(mdiag);
+    return -1;
+  }
+  int k = 0, nd = 0;
+  for (int r = 0; r < nc; r++) {
+    if (!wmark[r]) continue;
+    double norm2 = 0, mlog = 0;
+    int mcount = 0;
+    /* column nv + r holds D^T: its rows below nv are the row's velocity columns */
+    for (int q = m->Kp[nv + r]; q < m->Kp[nv + r + 1]; q++) {
+      int j = m->Ki[q];
+      if (j >= nv) continue;
+      int s = kslot(m, nv + r, j);
+      if (s < 0) continue; /* (the pattern is symmetric) */
+      p->Dj[nd] = j;
+      p->Ds[nd++] = s;
+      norm2 += Kx[s] * Kx[s];
+      if (massive[j] && mdiag[j] > 0) { mlog += log(mdiag[j]); mcount++; }
+    }
+    double mref = mcount ? exp(mlog / mcount) : gmean;
+    p->wrow[k] = r;
+    p->w[k] = norm2 > 0 ? mref / norm2 : mref;
+    p->Dp[++k] = nd;
+  }
+  free(massive); free(wmark); free(mdiag);
+  return 0;
+}
+
+/* the pattern of K_aug (original numbering, both triangles, rows sorted, with
+ * every diagonal entry): K's plus, for each weighted row, all pairs of its columns */
+static int aug_pattern(const mb_model *m, const ldl_plan *p, int **Apo, int **Aio) {
+  int n = m->n, nv = m->nv;
+  /* columns -> weighted rows containing them */
+  int *cp = calloc((size_t)nv + 1, sizeof(int)), *cw = NULL;
+  int *mark = malloc(sizeof(int) * (size_t)(n + 1)), *Ap = calloc((size_t)n + 1, sizeof(int));
+  int *Ai = NULL;
+  if (!cp || !mark || !Ap) goto fail;
+  for (int k = 0; k < p->nw; k++)
+    for (int q = p->Dp[k]; q < p->Dp[k + 1]; q++) cp[p->Dj[q] + 1]++;
+  for (int j = 0; j < nv; j++) cp[j + 1] += cp[j];
+  cw = malloc(sizeof(int) * (size_t)(cp[nv] + 1));
+  if (!cw) goto fail;
+  {
+    int *fill = calloc((size_t)nv + 1, sizeof(int));
+    if (!fill) goto fail;
+    for (int k = 0; k < p->nw; k++)
+      for (int q = p->Dp[k]; q < p->Dp[k + 1]; q++) {
+        int j = p->Dj[q];
+        cw[cp[j] + fill[j]++] = k;
+      }
+    free(fill);
+  }
+  for (int pass = 0; pass < 2; pass++) {
+    for (int i = 0; i < n; i++) mark[i] = -1;
+    int nz = 0;
+    for (int j = 0; j < n; j++) {
+      int start = nz;
+#define ADD(ii)                                   \
+  do {                                            \
+    int i_ = (ii);                                \
+    if (mark[i_] != j) {                          \
+      mark[i_] = j;                               \
+      if (pass) Ai[nz] = i_;                      \
+      nz++;                                       \
+    }                                             \
+  } while (0)
+      ADD(j);
+      for (int q = m->Kp[j]; q < m->Kp[j + 1]; q++) ADD(m->Ki[q]);
+      if (j < nv)
+        for (int c = cp[j]; c < cp[j + 1]; c++) {
+          int k = cw[c];
+          for (int q = p->Dp[k]; q < p->Dp[k + 1]; q++) ADD(p->Dj[q]);
+        }
+#undef ADD
+      if (pass) qsort(Ai + start, (size_t)(nz - start), sizeof(int), int_cmp);
+      else Ap[j + 1] = nz;
+    }
+    if (!pass) {
+      Ai = malloc(sizeof(int) * (size_t)(nz + 1));
+      if (!Ai) goto fail;
+    }
+  }
+  free(cp); free(cw); free(mark);
+  *Apo = Ap;
+  *Aio = Ai;
+  return 0;
+fail:
+  free(cp); free(cw); free(mark); free(Ap); free(Ai);
+  return -1;
+}
+
+/* terms w_k D(k,i) D(k,j) of the entry (i, j) of D^T W D (original numbering) */
+static int count_terms(const ldl_plan *p, int i, int j, int *Tw, int *Ta, int *Tb) {
+  int nt = 0;
+  for (int k = 0; k < p->nw; k++) {
+    int si = -1, sj = -1;
+    for (int q = p->Dp[k]; q < p->Dp[k + 1]; q++) {
+      if (p->Dj[q] == i) si = p->Ds[q];
+      if (p->Dj[q] == j) sj = p->Ds[q];
+    }
+    if (si < 0 || sj < 0) continue;
+    if (Tw) { Tw[nt] = k; Ta[nt] = si; Tb[nt] = sj; }
+    nt++;
+  }
+  return nt;
+}
+
+/* free the analysis part of the plan (ordering onwards) */
+static void free_analysis(ldl_plan *p) {
+  free(p->perm); free(p->iperm);
+  free(p->Up); free(p->Ui); free(p->Us);
+  free(p->Tp); free(p->Tw); free(p->Ta); free(p->Tb);
+  free(p->parent); free(p->Lp); free(p->Li);
+  free(p->Rp); free(p->Rj); free(p->Rpos);
+  p->perm = p->iperm = p->Up = p->Ui = p->Us = p->Tp = p->Tw = p->Ta = p->Tb = NULL;
+  p->parent = p->Lp = p->Li = p->Rp = p->Rj = p->Rpos = NULL;
+}
+
+/* CAMD with the constraint sets C on the pattern (Ap, Ai) of K_aug, then the
+ * permuted upper triangle with its value sources, the elimination tree, the
+ * pattern of L and the flop count.  0 or -1. */
+static int analyze(const mb_model *m, ldl_plan *p, const int *Ap, const int *Ai, const int *C) {
+  int n = m->n, nv = m->nv;
+  int *anc = NULL, *flag = NULL, *cnt = NULL;
+  uentry *U = NULL;
+  free_analysis(p);
+  p->perm = malloc(sizeof(int) * (size_t)(n + 1));
+  p->iperm = malloc(sizeof(int) * (size_t)(n + 1));
+  if (!p->perm || !p->iperm) goto fail;
+  double control[CAMD_CONTROL], info[CAMD_INFO];
+  camd_defaults(control);
+  control[CAMD_DENSE] = -1; /* no dense-row postponement: keep the sets intact */
+  if (n > 0) {
+    int st = camd_order(n, Ap, Ai, p->perm, control, info, (int *)C);
+    if (st != CAMD_OK && st != CAMD_OK_BUT_JUMBLED) goto fail;
+  }
+  for (int k = 0; k < n; k++) p->iperm[p->perm[k]] = k;
+  for (int k = 1; k < n; k++)
+    if (C[p->perm[k]] < C[p->perm[k - 1]]) goto fail; /* CAMD broke a constraint */
+
+  /* upper triangle of P K_aug P^T, with the sources of every value */
+  int nnzfull = Ap[n];
+  U = malloc(sizeof(uentry) * (size_t)(nnzfull + 1));
+  if (!U) goto fail;
+  int nu = 0;
+  for (int j = 0; j < n; j++)
+    for (int q = Ap[j]; q < Ap[j + 1]; q++) {
+      int i = Ai[q], pi = p->iperm[i], pj = p->iperm[j];
+      if (pi > pj) continue;
+      U[nu++] = (uentry){pj, pi, i, j, kslot(m, i, j)};
+    }
+  qsort(U, (size_t)nu, sizeof *U, uentry_cmp);
+  p->nnzA = nu;
+  p->Up = calloc((size_t)n + 1, sizeof(int));
+  p->Ui = malloc(sizeof(int) * (size_t)(nu + 1));
+  p->Us = malloc(sizeof(int) * (size_t)(nu + 1));
+  p->Tp = calloc((size_t)nu + 1, sizeof(int));
+  if (!p->Up || !p->Ui || !p->Us || !p->Tp) goto fail;
+  int nt = 0;
+  for (int e = 0; e < nu; e++) {
+    p->Up[U[e].col + 1]++;
+    p->Ui[e] = U[e].row;
+    p->Us[e] = U[e].slot;
+    if (U[e].i < nv && U[e].j < nv) nt += count_terms(p, U[e].i, U[e].j, NULL, NULL, NULL);
+    p->Tp[e + 1] = nt;
+  }
+  for (int k = 0; k < n; k++) p->Up[k + 1] += p->Up[k];
+  p->Tw = malloc(sizeof(int) * (size_t)(nt + 1));
+  p->Ta = malloc(sizeof(int) * (size_t)(nt + 1));
+  p->Tb = malloc(sizeof(int) * (size_t)(nt + 1));
+  if (!p->Tw || !p->Ta || !p->Tb) goto fail;
+  for (int e = 0; e < nu; e++)
+    if (U[e].i < nv && U[e].j < nv)
+      count_terms(p, U[e].i, U[e].j, p->Tw + p->Tp[e], p->Ta + p->Tp[e], p->Tb + p->Tp[e]);
+
+  /* elimination tree (Liu): walk from each i < k of column k towards its
+   * current root, compressing the path to k; a root reached becomes a child of k */
+  p->parent = malloc(sizeof(int) * (size_t)(n + 1));
+  anc = malloc(sizeof(int) * (size_t)(n + 1));
+  flag = malloc(sizeof(int) * (size_t)(n + 1));
+  cnt = calloc((size_t)n + 1, sizeof(int));
+  if (!p->parent || !anc || !flag || !cnt) goto fail;
+  for (int k = 0; k < n; k++) {
+    p->parent[k] = -1;
+    anc[k] = -1;
+    for (int e = p->Up[k]; e < p->Up[k + 1]; e++) {
+      int i = p->Ui[e];
+      while (i != -1 && i < k) {
+        int next = anc[i];
+        anc[i] = k;
+        if (next == -1) p->parent[i] = k;
+        i = next;
+      }
+    }
+  }
+  /* column counts: row k of L is the union of the etree paths from each
+   * i < k of column k up to k; every node on them gains one entry */
+  for (int pass = 0; pass < 2; pass++) {
+    for (int k = 0; k < n; k++) flag[k] = -1;
+    if (pass) memset(cnt, 0, sizeof(int) * (size_t)n);
+    for (int k = 0; k < n; k++) {
+      flag[k] = k;
+      for (int e = p->Up[k]; e < p->Up[k + 1]; e++)
+        for (int i = p->Ui[e]; flag[i] != k; i = p->parent[i]) {
+          flag[i] = k;
+          if (pass) p->Li[p->Lp[i] + cnt[i]] = k; /* k ascends: rows come sorted */
+          cnt[i]++;
+        }
+    }
+    if (!pass) {
+      p->Lp = calloc((size_t)n + 1, sizeof(int));
+      if (!p->Lp) goto fail;
+      for (int k = 0; k < n; k++) p->Lp[k + 1] = p->Lp[k] + cnt[k];
+      p->nnzL = p->Lp[n];
+      p->Li = malloc(sizeof(int) * (size_t)(p->nnzL + 1));
+      if (!p->Li) goto fail;
+    }
+  }
+  /* the same entries by rows (the transpose), columns ascending */
+  p->Rp = calloc((size_t)n + 1, sizeof(int));
+  p->Rj = malloc(sizeof(int) * (size_t)(p->nnzL + 1));
+  p->Rpos = malloc(sizeof(int) * (size_t)(p->nnzL + 1));
+  if (!p->Rp || !p->Rj || !p->Rpos) goto fail;
+  for (long q = 0; q < p->nnzL; q++) p->Rp[p->Li[q] + 1]++;
+  for (int k = 0; k < n; k++) p->Rp[k + 1] += p->Rp[k];
+  memset(cnt, 0, sizeof(int) * (size_t)n);
+  for (int j = 0; j < n; j++)
+    for (int q = p->Lp[j]; q < p->Lp[j + 1]; q++) {
+      int k = p->Li[q], r = p->Rp[k] + cnt[k]++;
+      p->Rj[r] = j;
+      p->Rpos[r] = q;
+    }
+  /* flops of the up-looking factorization (header comment) and of a solve */
+  double fl = n;
+  for (int k = 0; k < n; k++)
+    for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) fl += 2.0 * (p->Rpos[r] - p->Lp[p->Rj[r]]) + 3;
+  p->flops = fl;
+  p->flops_solve = 4.0 * (double)p->nnzL + n;
+  free(U); free(anc); free(flag); free(cnt);
+  return 0;
+fail:
+  free(U); free(anc); free(flag); free(cnt);
+  free_analysis(p);
+  return -1;
+}
+
+/* Constraint sets from the mechanism's spanning tree (rooted at the ground).
+ * Each body b reached from its parent body (or the ground) p is assigned the
+ * rows between p and b whose restriction to b's columns is independent at
+ * t = 0 (Gram-Schmidt, a generous threshold); the other rows close loops.
+ * Sets: body b at 2 h(b), its assigned rows at 2 h(b) + 1 (h: height in the
+ * tree, leaves 0), loop rows after everything.  Every leading block of the
+ * order then holds rows with a block-triangular, full-row-rank restriction
+ * to the leading bodies, and those bodies' block of M + D^T W D is positive
+ * definite: each leading principal block of K_aug is nonsingular with one
+ * positive eigenvalue per body unknown and one negative per row, so the
+ * static pivots are nonzero and their signs fixed -- as with all bodies
+ * first, but without coupling every pair of rows that share a body (no fill
+ * at all for a tree).  Returns the number of sets, or -1. */
+static int tree_sets(const mb_model *m, const double *Kx, int *C) {
+  int nb = m->nbody, nv = m->nv, nc = m->nc, n = m->n;
+  int *par = malloc(sizeof(int) * (size_t)(nb + 1)), *queue = malloc(sizeof(int) * (size_t)(nb + 1));
+  int *height = calloc((size_t)nb + 1, sizeof(int)), *assigned = malloc(sizeof(int) * (size_t)(nc + 1));
+  int *rb0 = malloc(sizeof(int) * (size_t)(nc + 1)), *rb1 = malloc(sizeof(int) * (size_t)(nc + 1));
+  int *bodyof = malloc(sizeof(int) * (size_t)(nv + 1));
+  double *basis = NULL, *vec = NULL;
+  int nsets = -1, maxw = 6;
+  if (!par || !queue || !height || !assigned || !rb0 || !rb1 || !bodyof) goto done;
+  for (int b = 0; b < nb; b++) {
+    int w = 6 + (m->body[b].kind == MB_BODY_FLEXIBLE ? m->body[b].nm : 0);
+    if (w > maxw) maxw = w;
+    for (int j = 0; j < w; j++)
+      if (m->body[b].vadr + j < nv) bodyof[m->body[b].vadr + j] = b;
+  }
+  basis = malloc(sizeof(double) * (size_t)maxw * (size_t)(maxw + 1));
+  vec = malloc(sizeof(double) * (size_t)(maxw + 1));
+  if (!basis || !vec) goto done;
+  for (int r = 0; r < nc; r++) {
+    rb0[r] = m->marker[m->row[r].m0].body;
+    rb1[r] = m->marker[m->row[r].m1].body;
+    assigned[r] = -1;
+  }
+  /* breadth-first from the ground, then from any body not connected to it */
+  for (int b = 0; b < nb; b++) par[b] = -2; /* -2: not reached, -1: ground or root */
+  int head = 0, tail = 0;
+  for (int r = 0; r < nc; r++) {
+    int b = rb0[r] < 0 ? rb1[r] : rb1[r] < 0 ? rb0[r] : -1;
+    if (b >= 0 && par[b] == -2) { par[b] = -1; queue[tail++] = b; }
+  }
+  for (int root = 0;; root++) {
+    while (head < tail) {
+      int b = queue[head++];
+      for (int r = 0; r < nc; r++) {
+        int o = rb0[r] == b ? rb1[r] : rb1[r] == b ? rb0[r] : -2;
+        if (o >= 0 && par[o] == -2) { par[o] = b; queue[tail++] = o; }
+      }
+    }
+    while (root < nb && par[root] != -2) root++;
+    if (root >= nb) break;
+    par[root] = -1;
+    queue[tail++] = root;
+  }
+  /* rows between each body and its parent, kept while independent on the body */
+  for (int b = 0; b < nb; b++) {
+    int w = 6 + (m->body[b].kind == MB_BODY_FLEXIBLE ? m->body[b].nm : 0), rank = 0;
+    for (int r = 0; r < nc && rank < w; r++) {
+      int other = rb0[r] == b ? rb1[r] : rb1[r] == b ? rb0[r] : -2;
+      if (other == -2 || other != par[b] || rb0[r] == rb1[r]) continue;
+      double norm = 0;
+      for (int j = 0; j < w; j++) {
+        int s = kslot(m, nv + r, m->body[b].vadr + j);
+        vec[j] = s >= 0 ? Kx[s] : 0;
+        norm += vec[j] * vec[j];
+      }
+      norm = sqrt(norm);
+      if (!(norm > 0)) continue;
+      for (int pass = 0; pass < 2; pass++)
+        for (int k = 0; k < rank; k++) {
+          double d = 0;
+          for (int j = 0; j < w; j++) d += basis[k * maxw + j] * vec[j];
+          for (int j = 0; j < w; j++) vec[j] -= d * basis[k * maxw + j];
+        }
+      double rest = 0;
+      for (int j = 0; j < w; j++) rest += vec[j] * vec[j];
+      rest = sqrt(rest);
+      if (rest < 1e-3 * norm) continue; /* (nearly) dependent on b: a loop row */
+      for (int j = 0; j < w; j++) basis[rank * maxw + j] = vec[j] / rest;
+      rank++;
+      assigned[r] = b;
+    }
+  }
+  /* heights: children before parents (reverse breadth-first order) */
+  int hmax = 0;
+  for (int k = tail - 1; k >= 0; k--) {
+    int b = queue[k];
+    if (par[b] >= 0 && height[par[b]] < height[b] + 1) height[par[b]] = height[b] + 1;
+    if (height[b] > hmax) hmax = height[b];
+  }
+  for (int i = 0; i < nv; i++) C[i] = 2 * height[bodyof[i]];
+  for (int r = 0; r < nc; r++) C[nv + r] = assigned[r] >= 0 ? 2 * height[assigned[r]] + 1 : 2 * hmax + 2;
+  nsets = 2 * hmax + 3;
+  /* CAMD wants every set from 0 to max non-empty: renumber the sets used */
+  {
+    int *used = calloc((size_t)nsets + 1, sizeof(int));
+    if (!used) { nsets = -1; goto done; }
+    for (int i = 0; i < n; i++) used[C[i]] = 1;
+    int k = 0;
+    for (int c = 0; c < nsets; c++) used[c] = used[c] ? k++ : -1;
+    for (int i = 0; i < n; i++) C[i] = used[C[i]];
+    nsets = k;
+    free(used);
+  }
+done:
+  free(par); free(queue); free(height); free(assigned); free(rb0); free(rb1); free(bodyof);
+  free(basis); free(vec);
+  return nsets;
+}
+
+int ldl_plan_build(const lmodel *L, ldl_plan *p) {
+  const mb_model *m = &L->m;
+  memset(p, 0, sizeof *p);
+  int n = m->n, nv = m->nv;
+  p->n = n;
+  p->nv = nv;
+  p->nc = m->nc;
+  const char *env = getenv("MBCC_LDL_BUDGET");
+  p->budget = env && *env ? atof(env) : LDL_FLOP_BUDGET;
+  const char *ord = getenv("MBCC_LDL_ORDER"); /* "bodies-first" or "tree": force one */
+  int *Ap = NULL, *Ai = NULL, *C2 = NULL, *Ct = NULL;
+  double *Kx = kx_at_start(m);
+  if (!Kx) goto fail;
+  if (choose_weights(m, Kx, p)) goto fail;
+  if (aug_pattern(m, p, &Ap, &Ai)) goto fail;
+  C2 = malloc(sizeof(int) * (size_t)(n + 1));
+  Ct = malloc(sizeof(int) * (size_t)(n + 1));
+  if (!C2 || !Ct) goto fail;
+  /* all body unknowns before all constraint rows (always valid) */
+  for (int i = 0; i < n; i++) C2[i] = i >= nv;
+  int nt = tree_sets(m, Kx, Ct);
+  double f2 = INFINITY;
+  if (!(ord && !strcmp(ord, "tree"))) {
+    if (analyze(m, p, Ap, Ai, C2)) goto fail;
+    f2 = p->flops;
+    p->nsets = 2;
+  }
+  if (nt > 0 && !(ord && !strcmp(ord, "bodies-first"))) {
+    ldl_plan t = *p; /* same weights; a second analysis */
+    t.perm = t.iperm = t.Up = t.Ui = t.Us = t.Tp = t.Tw = t.Ta = t.Tb = NULL;
+    t.parent = t.Lp = t.Li = t.Rp = t.Rj = t.Rpos = NULL;
+    if (!analyze(m, &t, Ap, Ai, Ct) && t.flops < f2) {
+      free_analysis(p);
+      *p = t;
+      p->nsets = nt;
+      p->tree = 1;
+    } else {
+      free_analysis(&t);
+    }
+  }
+  if (!p->perm) goto fail;
+  p->straight = p->flops <= p->budget;
+  free(Kx); free(Ap); free(Ai); free(C2); free(Ct);
+  return 0;
+fail:
+  free(Kx); free(Ap); free(Ai); free(C2); free(Ct);
+  ldl_plan_free(p);
+  return -1;
+}
+
+void ldl_plan_report(const lmodel *L, FILE *out) {
+  ldl_plan p;
+  if (ldl_plan_build(L, &p)) {
+    fprintf(out, "  LDL^T             not available (ordering failed)\n");
+    return;
+  }
+  if (p.tree)
+    fprintf(out, "  ordering          CAMD, %d sets from the spanning tree (bodies before their joints' rows)\n",
+            p.nsets);
+  else
+    fprintf(out, "  ordering          CAMD, %d body unknowns before %d constraint rows\n", p.nv, p.nc);
+  if (p.nmassless)
+    fprintf(out, "  zero mass         %d massless unknowns: %d rows weighted (K_aug = [M + D^T W D, D^T; D, 0])\n",
+            p.nmassless, p.nw);
+  fprintf(out, "  nnz(L)            %ld (strictly lower; L + D + L^T has %ld)\n", p.nnzL, 2 * p.nnzL + p.n);
+  fprintf(out, "  LDL^T flops       %.0f per factorization, %.0f per solve\n", p.flops, p.flops_solve);
+  fprintf(out, "  LDL^T code        %s (flop budget %.0f)\n", p.straight ? "straight-line" : "looped", p.budget);
+  ldl_plan_free(&p);
+}

@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# test_bench.sh: `mbcc bench` end to end (exit 0 = pass), on a short run of
+# the slider-crank (0.01 s, one repetition):
+#   - the CSV has the columns path,n,nnz_K,nnz_L,step_median_s,run_s,ratio,
+#     steps,max_rel_diff (then step_ratio,status) and one row per path;
+#   - every path that ran (ldl may be absent: "skipped") reports steps and
+#     times, the fastest run has ratio 1, the paths with the same integrator
+#     agree to 1e-9 of each output's range and IDA to 1e-5;
+#   - --paths selects paths; bad options exit with status 2.
+# Runs mbcc from a scratch directory, so that nothing lands in the source tree.
+# Environment: MBCC (set by tests/run_tests.sh; default build/mbcc).
+set -u
+cd "$(dirname "$0")/.."
+root=$(pwd)
+MBCC=${MBCC:-build/mbcc}
+case $MBCC in /*) ;; *) MBCC="$root/$MBCC" ;; esac
+[ -x "$MBCC" ] || { echo "no mbcc at $MBCC"; exit 1; }
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+cd "$tmp" || exit 1
+fail=0
+err() { echo "FAIL: $*"; fail=1; }
+
+model="$root/models/slider_crank.yaml"
+if "$MBCC" bench "$model" --end 0.01 --reps 1 --csv b.csv --quiet > bench.txt 2> bench.log; then
+  head -1 b.csv | grep -q '^path,n,nnz_K,nnz_L,step_median_s,run_s,ratio,steps,max_rel_diff' ||
+    err "CSV header: $(head -1 b.csv)"
+  rows=$(($(wc -l < b.csv) - 1))
+  [ "$rows" = 6 ] || err "CSV has $rows rows, expected 6"
+  for p in generated+ldl generated+klu generated+dense generic+klu generic+dense ida; do
+    grep -q "^$p," b.csv || err "no row for path $p"
+  done
+  awk -F, 'NR > 1 {
+      if ($11 == "skipped") { if ($1 != "generated+ldl") { print "path " $1 " skipped"; bad = 1 } next }
+      if ($11 != "ok") { print "path " $1 ": " $11; bad = 1; next }
+      if (!($8 > 0) || !($5 > 0) || !($6 > 0)) { print "path " $1 ": no steps or times"; bad = 1 }
+      if ($7 < 0.999) { print "path " $1 ": ratio " $7 " below 1"; bad = 1 }
+      if ($7 < 1.0001) one = 1
+      tol = ($1 == "ida") ? 1e-5 : 1e-9
+      if (!($9 <= tol)) { print "path " $1 ": max_rel_diff " $9 " above " tol; bad = 1 }
+      if ($2 != (($1 == "ida") ? 57 : 36)) { print "path " $1 ": n = " $2; bad = 1 }
+    }
+    END { if (!one) { print "no path with ratio 1"; bad = 1 } exit bad }' b.csv > check.log ||
+    err "$(cat check.log)"
+  grep -q '^generated+klu ' bench.txt || err "no table on stdout: $(head -5 bench.txt)"
+else
+  err "mbcc bench failed: $(tail -5 bench.log)"
+fi
+
+# --paths
+if "$MBCC" bench "$model" --end 0.005 --reps 1 --paths generated+klu,ida --csv p.csv --quiet > /dev/null 2>&1; then
+  [ "$(cut -d, -f1 p.csv | tr '\n' ' ')" = "path generated+klu ida " ] || err "--paths: $(cut -d, -f1 p.csv | tr '\n' ' ')"
+else
+  err "mbcc bench --paths failed"
+fi
+
+# bad options
+"$MBCC" bench "$model" --reps 0 --quiet > /dev/null 2>&1
+[ $? = 2 ] || err "--reps 0 did not exit with status 2"
+"$MBCC" bench "$model" --paths generated+foo --quiet > /dev/null 2>&1
+[ $? = 2 ] || err "--paths generated+foo did not exit with status 2"
+exit $fail
