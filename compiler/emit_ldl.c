@@ -365,10 +365,10 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
     fputs("/* --- emitted LDL^T: not available (the ordering failed) --- */\n\n", f);
     return 0;
   }
-  char U[256], name[512];
+  char U[256];
   upper(U, nm, sizeof U);
   int n = p.n;
-  char ordering[160];
+  char ordering[256];
   if (p.tree)
     snprintf(ordering, sizeof ordering, "CAMD with %d constraint sets from the spanning tree: each body\n"
              " * before the rows joining it to its parent, loop rows last", p.nsets);
@@ -459,7 +459,6 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
   fputs("static int ldl_solve_m(const mb_model *m, const mb_real *Kx, mb_real *work, mb_real *b,\n"
         "                       mb_real *residual) {\n", f);
   fprintf(f, "  (void)m;\n  return %s_ldl_solve(Kx, work, b, residual);\n}\n\n", nm);
-  (void)name;
   ldl_plan_free(&p);
   return 1;
 }
