@@ -61,5 +61,8 @@ int assemble_model(lmodel *L, int verbose);
 
 /* Emit generated/<name>/ (emit.c).  Returns 0 or reports and returns 2. */
 int emit_model(const lmodel *L, const char *dir);
+/* Fill templates/<name> (model name, simulation settings, solver) into the
+ * file 'out' (emit.c).  Returns 0 or reports and returns 2. */
+int emit_template(const lmodel *L, const char *name, const char *out);
 
 #endif

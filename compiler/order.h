@@ -7,7 +7,11 @@
  *  - fill-reducing ordering of K_aug with SuiteSparse CAMD, all body unknowns
  *    (0..nv-1) constrained before all constraint rows (nv..n-1): then the body
  *    block is symmetric positive definite and the Schur complement
- *    -D (M + D^T W D)^-1 D^T negative definite, so a static pivot order works;
+ *    -D (M + D^T W D)^-1 D^T negative definite, so a static pivot order works.
+ *    A second candidate uses constraint sets from the mechanism's spanning
+ *    tree (each body before the rows joining it to its parent, loop rows
+ *    last; order.c proves it as safe); the one with fewer flops is kept
+ *    (MBCC_LDL_ORDER=bodies-first or tree forces one);
  *  - elimination tree, column counts, the pattern of L (strictly lower, CSC,
  *    rows sorted), nnz(L) and the flop count of the numeric factorization.
  * Everything here is in the numbering of the permuted matrix P K_aug P^T
