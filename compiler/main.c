@@ -37,7 +37,7 @@ static void usage(void) {
           "       mbcc compile M.yaml [--scene S] [-o DIR]\n"
           "       mbcc run M.yaml [--scene S] [--path generated|generic] [--solver ldl|klu|dense]\n"
           "                [--integrator rk4|dopri5] [-o results.csv] [--plot out.png|none]\n"
-          "                [--end T] [--output-step H] [--step H] [--rtol R] [--atol A]\n"
+          "                [--end T] [--output-step H] [--step H] [--max-step H] [--rtol R] [--atol A]\n"
           "                [--stabilization projection|baumgarte|none] [--quiet]\n"
           "       mbcc bench M.yaml [--scene S] [--csv FILE] [--reps N] [--paths a,b,...]\n"
           "                [--integrator rk4|dopri5] [--end T] [--rtol R] [--atol A] [--quiet]\n"
@@ -74,7 +74,7 @@ static int parse_options(int argc, char **argv, options *o) {
     else if (!strcmp(a, "--plot")) o->plot = v;
     else if (!strcmp(a, "--path")) o->path = v;
     else if (!strcmp(a, "--solver") || !strcmp(a, "--integrator") || !strcmp(a, "--end") ||
-             !strcmp(a, "--output-step") || !strcmp(a, "--step") || !strcmp(a, "--rtol") ||
+             !strcmp(a, "--output-step") || !strcmp(a, "--step") || !strcmp(a, "--max-step") || !strcmp(a, "--rtol") ||
              !strcmp(a, "--atol") || !strcmp(a, "--stabilization") || !strcmp(a, "--columns") ||
              !strcmp(a, "--csv") || !strcmp(a, "--reps") || !strcmp(a, "--paths")) {
       if (o->nsim + 2 > 30) { fprintf(stderr, "mbcc: error: too many options\n"); return 2; }

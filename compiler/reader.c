@@ -2079,12 +2079,10 @@ static bool to_matrix6(reader *r, yaml_node_t *n, const char *label, double out[
   return ok;
 }
 
-/* field: a general 6x6 stiffness and damping between two bodies (seed 001 3.2.6) */
-static void parse_field(mapping *m, ir_force *f) {
+/* 'bodies' and one 'point' for both sides, or the point of the node given
+ * ('node' / 'nodes'): a bushing's or a field's */
+static void parse_pair_at_point(mapping *m, ir_force *f) {
   reader *r = m->r;
-  static const char *const keys[] = {"type", "bodies", "point", "stiffness", "damping",
-                                     "preload", "axes", "node", "nodes", NULL};
-  map_check_keys(m, keys);
   bool on_nodes = get_body_pair(m, f->body, f->body_loc) && fe_nodes_given(m, f->body, f->node);
   bool given = get_vector(m, "point", 3, !on_nodes, f->point[0]);
   if (given)
@@ -2094,6 +2092,15 @@ static void parse_field(mapping *m, ir_force *f) {
     if (!given)
       memcpy(f->point[f->node[0] >= 0 ? 1 : 0], f->point[f->node[0] >= 0 ? 0 : 1], sizeof f->point[0]);
   }
+}
+
+/* field: a general 6x6 stiffness and damping between two bodies (seed 001 3.2.6) */
+static void parse_field(mapping *m, ir_force *f) {
+  reader *r = m->r;
+  static const char *const keys[] = {"type", "bodies", "point", "stiffness", "damping",
+                                     "preload", "axes", "node", "nodes", NULL};
+  map_check_keys(m, keys);
+  parse_pair_at_point(m, f);
   yaml_node_t *k = map_require(m, "stiffness", true, "a 6x6 matrix");
   if (k != NULL && to_matrix6(r, k, "'stiffness'", f->K))
     for (int i = 0; i < 6; i++)
@@ -2154,19 +2161,10 @@ static void parse_beam_force(mapping *m, ir_force *f) {
 }
 
 static void parse_bushing(mapping *m, ir_force *f) {
-  reader *r = m->r;
   static const char *const keys[] = {"type",    "bodies",  "point", "stiffness",
                                      "damping", "preload", "axes",  "node", "nodes", NULL};
   map_check_keys(m, keys);
-  bool on_nodes = get_body_pair(m, f->body, f->body_loc) && fe_nodes_given(m, f->body, f->node);
-  bool given = get_vector(m, "point", 3, !on_nodes, f->point[0]);
-  if (given)
-    memcpy(f->point[1], f->point[0], sizeof f->point[0]);
-  if (on_nodes) {
-    check_node_point(r, r->model, m->loc, f->body, f->node, given, &f->point[0][0]);
-    if (!given)
-      memcpy(f->point[f->node[0] >= 0 ? 1 : 0], f->point[f->node[0] >= 0 ? 0 : 1], sizeof f->point[0]);
-  }
+  parse_pair_at_point(m, f);
   get_six(m, "stiffness", true, true, f->k6);
   get_six(m, "damping", false, true, f->c6);
   get_six(m, "preload", false, false, f->preload6);

@@ -9,6 +9,7 @@
 #include <time.h>
 
 #include "mb_bench.h"
+#include "mb_driver.h"
 #include "mb_ida.h"
 
 static double now(void) {
@@ -199,31 +200,18 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
         if (!e) break;
         s = e + 1;
       }
-    } else if (!strcmp(a, "--integrator")) {
-      if (!strcmp(val, "rk4")) set.integrator = MB_RK4;
-      else if (!strcmp(val, "dopri5")) set.integrator = MB_DOPRI5;
-      else { fprintf(stderr, "%s: error: unknown integrator '%s' (expected rk4 or dopri5)\n", argv[0], val); return 2; }
-    } else if (!strcmp(a, "--stabilization")) {
-      if (!strcmp(val, "projection")) set.stabilization = MB_STAB_PROJECTION;
-      else if (!strcmp(val, "baumgarte")) set.stabilization = MB_STAB_BAUMGARTE;
-      else if (!strcmp(val, "none")) set.stabilization = MB_STAB_NONE;
-      else { fprintf(stderr, "%s: error: unknown stabilization '%s'\n", argv[0], val); return 2; }
-    } else {
+    } else if (!strcmp(a, "--reps")) {
       char *end;
       double x = strtod(val, &end);
-      if (*end || !(x > 0) || !isfinite(x)) {
-        fprintf(stderr, "%s: error: '%s' needs a positive number, got '%s'\n", argv[0], a, val);
+      if (*end || !(x >= 1) || x != floor(x) || x > 1000) {
+        fprintf(stderr, "%s: error: '--reps' needs a whole number from 1 to 1000\n", argv[0]);
         return 2;
       }
-      if (!strcmp(a, "--reps")) {
-        if (x != floor(x) || x > 1000) { fprintf(stderr, "%s: error: '--reps' needs a whole number from 1 to 1000\n", argv[0]); return 2; }
-        reps = (int)x;
-      } else if (!strcmp(a, "--end")) set.end_time = x;
-      else if (!strcmp(a, "--output-step")) set.output_step = x;
-      else if (!strcmp(a, "--step")) set.step = x;
-      else if (!strcmp(a, "--rtol")) set.rtol = x;
-      else if (!strcmp(a, "--atol")) set.atol = x;
-      else { fprintf(stderr, "%s: error: unknown option '%s'\n", argv[0], a); usage(argv[0]); return 2; }
+      reps = (int)x;
+    } else {
+      int k = mb_settings_option(&set, a, val, argv[0]);
+      if (k < 0) return 2;
+      if (k == 0) { fprintf(stderr, "%s: error: unknown option '%s'\n", argv[0], a); usage(argv[0]); return 2; }
     }
   }
   if (set.output_step > set.end_time) set.output_step = set.end_time;

@@ -44,10 +44,40 @@ static int write_row(void *user, double t, const double *q, const double *v, con
   return 0;
 }
 
+int mb_settings_option(mb_settings *set, const char *opt, const char *val, const char *prog) {
+  if (!strcmp(opt, "--integrator")) {
+    if (!strcmp(val, "rk4")) set->integrator = MB_RK4;
+    else if (!strcmp(val, "dopri5")) set->integrator = MB_DOPRI5;
+    else { fprintf(stderr, "%s: error: unknown integrator '%s' (expected rk4 or dopri5)\n", prog, val); return -1; }
+    return 1;
+  }
+  if (!strcmp(opt, "--stabilization")) {
+    if (!strcmp(val, "projection")) set->stabilization = MB_STAB_PROJECTION;
+    else if (!strcmp(val, "baumgarte")) set->stabilization = MB_STAB_BAUMGARTE;
+    else if (!strcmp(val, "none")) set->stabilization = MB_STAB_NONE;
+    else { fprintf(stderr, "%s: error: unknown stabilization '%s' (expected projection, baumgarte or none)\n", prog, val); return -1; }
+    return 1;
+  }
+  static const char *const names[] = {"--end", "--output-step", "--step", "--rtol", "--atol", "--max-step"};
+  double *fields[] = {&set->end_time, &set->output_step, &set->step, &set->rtol, &set->atol, &set->max_step};
+  for (int k = 0; k < 6; k++) {
+    if (strcmp(opt, names[k])) continue;
+    char *end;
+    double x = strtod(val, &end);
+    if (*end || !(x > 0) || !isfinite(x)) {
+      fprintf(stderr, "%s: error: '%s' needs a positive number, got '%s'\n", prog, opt, val);
+      return -1;
+    }
+    *fields[k] = x;
+    return 1;
+  }
+  return 0;
+}
+
 static void usage(const char *prog) {
   fprintf(stderr,
           "usage: %s [-o results.csv] [--solver klu|dense] [--integrator rk4|dopri5]\n"
-          "          [--end T] [--output-step H] [--step H] [--rtol R] [--atol A]\n"
+          "          [--end T] [--output-step H] [--step H] [--max-step H] [--rtol R] [--atol A]\n"
           "          [--stabilization projection|baumgarte|none] [--quiet]\n",
           prog);
 }
@@ -56,6 +86,7 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
             const char *solver) {
   mb_settings set = *defaults;
   const char *csv_path = "results.csv";
+  int output_given = 0, max_given = 0;
   int quiet = 0;
   for (int i = 1; i < argc; i++) {
     const char *a = argv[i], *val = (i + 1 < argc) ? argv[i + 1] : NULL;
@@ -64,29 +95,19 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
     else if (!val) { usage(argv[0]); return 2; }
     else if (!strcmp(a, "-o")) csv_path = val;
     else if (!strcmp(a, "--solver")) solver = val;
-    else if (!strcmp(a, "--integrator")) {
-      if (!strcmp(val, "rk4")) set.integrator = MB_RK4;
-      else if (!strcmp(val, "dopri5")) set.integrator = MB_DOPRI5;
-      else { fprintf(stderr, "%s: error: unknown integrator '%s' (expected rk4 or dopri5)\n", argv[0], val); return 2; }
-    } else if (!strcmp(a, "--stabilization")) {
-      if (!strcmp(val, "projection")) set.stabilization = MB_STAB_PROJECTION;
-      else if (!strcmp(val, "baumgarte")) set.stabilization = MB_STAB_BAUMGARTE;
-      else if (!strcmp(val, "none")) set.stabilization = MB_STAB_NONE;
-      else { fprintf(stderr, "%s: error: unknown stabilization '%s'\n", argv[0], val); return 2; }
-    } else {
-      char *end;
-      double x = strtod(val, &end);
-      if (*end || !(x > 0) || !isfinite(x)) { fprintf(stderr, "%s: error: '%s' needs a positive number, got '%s'\n", argv[0], a, val); return 2; }
-      if (!strcmp(a, "--end")) set.end_time = x;
-      else if (!strcmp(a, "--output-step")) set.output_step = x;
-      else if (!strcmp(a, "--step")) set.step = x;
-      else if (!strcmp(a, "--rtol")) set.rtol = x;
-      else if (!strcmp(a, "--atol")) set.atol = x;
-      else { usage(argv[0]); return 2; }
+    else {
+      int k = mb_settings_option(&set, a, val, argv[0]);
+      if (k < 0) return 2;
+      if (k == 0) { usage(argv[0]); return 2; }
+      if (!strcmp(a, "--output-step")) output_given = 1;
+      if (!strcmp(a, "--max-step")) max_given = 1;
     }
     i += takes;
   }
   if (set.output_step > set.end_time) set.output_step = set.end_time;
+  /* the model's largest step is its output step unless said otherwise: a new
+     output step given on the command line carries it along */
+  if (output_given && !max_given) set.max_step = set.output_step;
   if (set.max_step > set.output_step) set.max_step = set.output_step;
 
   mb_solver *ls = mb_solver_new(solver, m);

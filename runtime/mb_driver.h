@@ -10,4 +10,9 @@
 int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *defaults,
             const char *solver);
 
+/* One simulation-settings option of the command line (--integrator,
+ * --stabilization, --end, --output-step, --step, --max-step, --rtol, --atol):
+ * 1 if applied, 0 if opt is not one of them, -1 after printing an error. */
+int mb_settings_option(mb_settings *set, const char *opt, const char *val, const char *prog);
+
 #endif
