@@ -1,5 +1,6 @@
 /* support.c: test helpers (see support.h). */
 #define _POSIX_C_SOURCE 200809L
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -104,4 +105,26 @@ double urand(double a, double b) {
   rng_state ^= rng_state >> 7;
   rng_state ^= rng_state << 17;
   return a + (b - a) * (double)(rng_state >> 11) / 9007199254740992.0;
+}
+
+double max_rel_diff(const mb_model *m, const trajectory *a, const trajectory *b,
+                    const char **worst_col) {
+  assert_int_equal(a->nrows, b->nrows);
+  double worst = 0;
+  if (worst_col) *worst_col = "";
+  for (int c = 0; c < m->ncols; c++) {
+    double lo = INFINITY, hi = -INFINITY, d = 0;
+    for (int k = 0; k < a->nrows; k++) {
+      lo = fmin(lo, at(a, k, c));
+      hi = fmax(hi, at(a, k, c));
+      d = fmax(d, fabs(at(a, k, c) - at(b, k, c)));
+    }
+    double r = d / fmax(hi - lo, 1e-3);
+    if (!(r <= worst)) {
+      worst = r;
+      if (worst_col) *worst_col = m->col_name[c];
+    }
+  }
+  for (int k = 0; k < a->nrows; k++) assert_true(a->t[k] == b->t[k]);
+  return worst;
 }

@@ -41,6 +41,14 @@ int column(const mb_model *m, const char *name);
 /* value of column c at row k */
 static inline double at(const trajectory *tr, int k, int c) { return tr->y[(size_t)k * (size_t)tr->ncols + (size_t)c]; }
 
+/* Largest difference between two runs of model m over every column and row,
+ * relative to the column's range over run a; a column that hardly moves
+ * (range below 1e-3 in its units, e.g. a coordinate that stays 0, or a
+ * conserved energy) is compared against 1e-3.  Names the worst column in
+ * *worst_col when not NULL.  The runs must share their output times. */
+double max_rel_diff(const mb_model *m, const trajectory *a, const trajectory *b,
+                    const char **worst_col);
+
 /* run a shell command; capture stdout+stderr (truncated to n-1 chars); returns exit status */
 int run_capture(const char *cmd, char *out, size_t n);
 

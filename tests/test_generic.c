@@ -11,22 +11,6 @@
 #include "slider_crank_flexible_virtual2.h"
 #include "fd_all.h"
 
-static double compare(const trajectory *a, const trajectory *b) {
-  double worst = 0;
-  for (int c = 0; c < a->ncols; c++) {
-    double lo = INFINITY, hi = -INFINITY;
-    for (int k = 0; k < a->nrows; k++) { lo = fmin(lo, at(a, k, c)); hi = fmax(hi, at(a, k, c)); }
-    /* relative to the column's range, or to its size when it hardly varies (energy) */
-    double range = fmax(hi - lo, 1e-3 * fmax(fabs(hi), fabs(lo)));
-    if (range == 0) range = 1;
-    for (int k = 0; k < a->nrows; k++) {
-      double d = fabs(at(a, k, c) - at(b, k, c)) / range;
-      worst = fmax(worst, d);
-    }
-  }
-  return worst;
-}
-
 static void check(const mb_model *m, double end, double step) {
   mb_settings s;
   test_settings(&s, end, step);
@@ -39,7 +23,7 @@ static void check(const mb_model *m, double end, double step) {
   for (int dense = 0; dense < 2; dense++) {
     trajectory *out = dense ? &gd : &gk;
     assert_int_equal(simulate(&g, &s, dense ? "generic-dense" : "generic-klu", out), MB_OK);
-    double d = compare(&ref, out);
+    double d = max_rel_diff(m, &ref, out, NULL);
     print_message("  %s: generic+%s vs generated+klu: max difference %.2e of the range\n", m->name,
                   dense ? "dense" : "klu", d);
     assert_true(d < 1e-9);

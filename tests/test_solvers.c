@@ -25,29 +25,6 @@ static mb_settings model_settings(const mb_model *m) {
   return s;
 }
 
-/* Largest difference between two runs over every column and row, relative to
- * the column's range over run a; a column that does not move (range below
- * 1e-3 in its units, e.g. an out-of-plane coordinate that stays 0) is compared
- * against 1e-3, i.e. absolutely to ~1e-12 for a 1e-9 tolerance. */
-static double max_rel_diff(const mb_model *m, const trajectory *a, const trajectory *b,
-                           const char **worst_col) {
-  assert_int_equal(a->nrows, b->nrows);
-  double worst = 0;
-  *worst_col = "";
-  for (int c = 0; c < m->ncols; c++) {
-    double lo = INFINITY, hi = -INFINITY, d = 0;
-    for (int k = 0; k < a->nrows; k++) {
-      lo = fmin(lo, at(a, k, c));
-      hi = fmax(hi, at(a, k, c));
-      d = fmax(d, fabs(at(a, k, c) - at(b, k, c)));
-    }
-    double r = d / fmax(hi - lo, 1e-3);
-    if (!(r <= worst)) { worst = r; *worst_col = m->col_name[c]; }
-  }
-  for (int k = 0; k < a->nrows; k++) assert_true(a->t[k] == b->t[k]);
-  return worst;
-}
-
 /* KLU and dense: the same K, factored by two codes; every difference is
  * round-off (~1e-16) carried through the integration (error-controlled
  * steps react smoothly to it).  1e-9 of the range leaves room for its growth
