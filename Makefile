@@ -6,7 +6,7 @@ STD     := -std=c11
 ROOT    := $(CURDIR)
 LIBS    := -lyaml -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig -llapack -lblas -lm
 
-RT_SRC  := runtime/model_generic.c runtime/solver_klu.c runtime/solver_dense.c runtime/solver_generic.c runtime/solver_ldl.c \
+RT_SRC  := runtime/model_generic.c runtime/solver_select.c runtime/genalpha.c runtime/solver_klu.c runtime/solver_dense.c runtime/solver_generic.c runtime/solver_ldl.c \
            runtime/integrate.c runtime/driver.c runtime/ida.c runtime/bench.c
 RT_HDR  := $(wildcard runtime/*.h)
 CC_SRC  := compiler/main.c compiler/reader.c compiler/diag.c compiler/lower.c compiler/fe.c compiler/flex.c \
@@ -15,13 +15,24 @@ CC_HDR  := $(wildcard compiler/*.h)
 B       ?= build
 
 .PHONY: all test demo clean sanitize docs bench
-all: $(B)/mbcc $(B)/libmbrt.a
+all: $(B)/mbcc $(B)/libmbrt.a $(B)/libmbrt_float.a
 
 $(B)/rt/%.o: runtime/%.c $(RT_HDR)
 	@mkdir -p $(B)/rt
 	$(CC) $(STD) $(WARN) $(CFLAGS) -Iruntime -c $< -o $@
 
 $(B)/libmbrt.a: $(patsubst runtime/%.c,$(B)/rt/%.o,$(RT_SRC))
+	rm -f $@ && ar rcs $@ $^
+
+# the single-precision runtime (mbcc compile --real float): the emitted LDL^T
+# only, since KLU, LAPACK and SUNDIALS work in double
+RT_FLOAT_SRC := runtime/model_generic.c runtime/solver_select.c runtime/solver_ldl.c \
+                runtime/integrate.c runtime/genalpha.c runtime/driver.c
+$(B)/rt-float/%.o: runtime/%.c $(RT_HDR)
+	@mkdir -p $(B)/rt-float
+	$(CC) $(STD) $(WARN) $(CFLAGS) -DMB_REAL_FLOAT -Iruntime -c $< -o $@
+
+$(B)/libmbrt_float.a: $(patsubst runtime/%.c,$(B)/rt-float/%.o,$(RT_FLOAT_SRC))
 	rm -f $@ && ar rcs $@ $^
 
 $(B)/mbcc: $(CC_SRC) $(CC_HDR) $(B)/libmbrt.a

@@ -238,7 +238,8 @@ typedef struct {
 } ir_output;
 
 /* --- simulation settings --------------------------------------------------------------- */
-typedef enum { INTEGRATOR_RK4, INTEGRATOR_DOPRI5 } ir_integrator;
+/* the same numbers as the runtime's MB_RK4, MB_DOPRI5, MB_GENALPHA, MB_AUTO */
+typedef enum { INTEGRATOR_RK4, INTEGRATOR_DOPRI5, INTEGRATOR_GENALPHA, INTEGRATOR_AUTO } ir_integrator;
 typedef enum { SOLVER_KLU, SOLVER_DENSE } ir_solver;
 typedef enum { STAB_PROJECTION, STAB_BAUMGARTE, STAB_NONE } ir_stab;
 typedef enum { JOF_DIRECT, JOF_VIRTUAL, JOF_LIST } ir_jof;
@@ -253,6 +254,7 @@ typedef struct {
   ir_solver solver;          /* default klu */
   ir_stab stabilization;     /* default projection */
   double baumgarte_alpha, baumgarte_beta; /* defaults 10, 10 */
+  double rho_inf;            /* generalized-alpha; default 0.8 */
   ir_jof joints_on_flexible; /* default direct */
 } ir_sim;
 

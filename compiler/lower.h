@@ -43,6 +43,7 @@ typedef struct {
   int bad;                   /* an error was reported while lowering */
   int nredundant;            /* rows removed at assembly */
   int dof;
+  int real_float;            /* emit for single precision (mbcc compile --real float) */
 } lmodel;
 
 /* Build the tables and pattern from the IR (positions as given).  Returns

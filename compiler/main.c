@@ -34,11 +34,12 @@ static const char *root_dir(void) {
 static void usage(void) {
   fprintf(stderr,
           "usage: mbcc check M.yaml [--scene S]\n"
-          "       mbcc compile M.yaml [--scene S] [-o DIR]\n"
+          "       mbcc compile M.yaml [--scene S] [-o DIR] [--real float|double]\n"
           "       mbcc run M.yaml [--scene S] [--path generated|generic] [--solver ldl|klu|dense]\n"
-          "                [--integrator rk4|dopri5] [-o results.csv] [--plot out.png|none]\n"
+          "                [--real float|double]\n"
+          "                [--integrator rk4|dopri5|genalpha|auto] [-o results.csv] [--plot out.png|none]\n"
           "                [--end T] [--output-step H] [--step H] [--max-step H] [--rtol R] [--atol A]\n"
-          "                [--stabilization projection|baumgarte|none] [--quiet]\n"
+          "                [--stabilization projection|baumgarte|none] [--rho-inf R] [--quiet]\n"
           "       mbcc bench M.yaml [--scene S] [--csv FILE] [--reps N] [--paths a,b,...]\n"
           "                [--integrator rk4|dopri5] [--end T] [--rtol R] [--atol A] [--quiet]\n"
           "       mbcc modes M.yaml --body NAME [--scene S] [--shapes shapes.csv]\n"
@@ -48,6 +49,7 @@ static void usage(void) {
 
 typedef struct {
   const char *model, *scene, *outdir, *csv, *plot, *path, *body, *shapes, *modal_out;
+  int real_float;   /* --real float: single-precision generated code and runtime */
   const char *sim_args[32];
   int nsim;
   int quiet;
@@ -73,10 +75,15 @@ static int parse_options(int argc, char **argv, options *o) {
     else if (!strcmp(a, "-o")) { o->outdir = v; o->csv = v; }
     else if (!strcmp(a, "--plot")) o->plot = v;
     else if (!strcmp(a, "--path")) o->path = v;
+    else if (!strcmp(a, "--real")) {
+      if (!strcmp(v, "float")) o->real_float = 1;
+      else if (!strcmp(v, "double")) o->real_float = 0;
+      else { fprintf(stderr, "mbcc: error: '--real' must be float or double, got '%s'\n", v); return 2; }
+    }
     else if (!strcmp(a, "--solver") || !strcmp(a, "--integrator") || !strcmp(a, "--end") ||
              !strcmp(a, "--output-step") || !strcmp(a, "--step") || !strcmp(a, "--max-step") || !strcmp(a, "--rtol") ||
              !strcmp(a, "--atol") || !strcmp(a, "--stabilization") || !strcmp(a, "--columns") ||
-             !strcmp(a, "--csv") || !strcmp(a, "--reps") || !strcmp(a, "--paths")) {
+             !strcmp(a, "--csv") || !strcmp(a, "--reps") || !strcmp(a, "--paths") || !strcmp(a, "--rho-inf")) {
       if (o->nsim + 2 > 30) { fprintf(stderr, "mbcc: error: too many options\n"); return 2; }
       o->sim_args[o->nsim++] = a;
       o->sim_args[o->nsim++] = v;
@@ -233,6 +240,7 @@ static int cmd_compile(const options *o, char *dir_out, size_t n, lmodel **Lp, i
   ir_model *ir;
   lmodel *L = build(o, &ir, 0);
   if (!L) return 2;
+  L->real_float = o->real_float;
   char dir[4096];
   if (o->outdir && !dir_out) snprintf(dir, sizeof dir, "%s", o->outdir);
   else default_dir(L, ir, dir, sizeof dir);
@@ -305,7 +313,8 @@ static int plot_csv(const char *csv, const char *png, const char *columns) {
 /* the runtime settings of the model's simulation block */
 static void settings_from_ir(const ir_sim *s, mb_settings *set) {
   mb_settings_default(set);
-  set->integrator = s->integrator == INTEGRATOR_RK4 ? MB_RK4 : MB_DOPRI5;
+  set->integrator = (int)s->integrator; /* ir_integrator numbers the runtime's */
+  set->rho_inf = s->rho_inf;
   set->end_time = s->end_time; set->output_step = s->output_step; set->step = s->step;
   set->rtol = s->rtol; set->atol = s->atol; set->min_step = s->min_step; set->max_step = s->max_step;
   set->stabilization = (int)s->stabilization;
@@ -315,12 +324,17 @@ static void settings_from_ir(const ir_sim *s, mb_settings *set) {
 /* cc the generated model DIR/NAME.c and the main program 'main_src' against the
  * runtime library into 'exe'; 'extra' are more libraries (NULL-terminated) */
 static int compile_generated(const char *dir, const char *name, const char *main_src,
-                             const char *exe, char *const extra[], int quiet) {
+                             const char *exe, char *const extra[], int quiet, int real_float) {
   char src_c[8400], inc[8400], lib[8400];
   snprintf(src_c, sizeof src_c, "%s/%s.c", dir, name);
   snprintf(inc, sizeof inc, "-I%s/runtime", root_dir());
   const char *rtlib = getenv("MBCC_RTLIB");
   snprintf(lib, sizeof lib, "%s", rtlib && *rtlib ? rtlib : MBCC_RTLIB);
+  if (real_float) {
+    /* the single-precision runtime sits beside the double one: libmbrt_float.a */
+    char *dot = strstr(lib, ".a");
+    if (dot && !dot[2]) snprintf(dot, sizeof lib - (size_t)(dot - lib), "_float.a");
+  }
   const char *cc = getenv("CC");
   /* the C flags mbcc itself was built with (e.g. sanitizers), split on spaces */
   static char flags[1024];
@@ -329,6 +343,7 @@ static int compile_generated(const char *dir, const char *name, const char *main
   int nc = 0;
   ccargs[nc++] = (char *)(cc && *cc ? cc : "cc");
   ccargs[nc++] = "-std=c99";
+  if (real_float) ccargs[nc++] = "-DMB_REAL_FLOAT";
   for (char *tok = strtok(flags, " "); tok && nc < 40; tok = strtok(NULL, " ")) ccargs[nc++] = tok;
   char *rest[] = {inc, "-o", (char *)exe, src_c, (char *)main_src, lib, NULL};
   for (int i = 0; rest[i]; i++) ccargs[nc++] = rest[i];
@@ -391,7 +406,7 @@ static int cmd_run(const options *o) {
     char exe[8400], src_main[8400];
     snprintf(exe, sizeof exe, "%s/%s_sim", dir, L->m.name);
     snprintf(src_main, sizeof src_main, "%s/main.c", dir);
-    if (compile_generated(dir, L->m.name, src_main, exe, NULL, o->quiet)) {
+    if (compile_generated(dir, L->m.name, src_main, exe, NULL, o->quiet, o->real_float)) {
       lower_free(L);
       ir_free(ir);
       return 2;
@@ -443,7 +458,11 @@ static int cmd_bench(const options *o) {
   snprintf(src_main, sizeof src_main, "%s/bench_main.c", dir);
   char *ida_libs[] = {"-lsundials_ida", "-lsundials_nvecserial", NULL};
   rc = emit_template(L, "bench_main.c.in", src_main);
-  if (!rc) rc = compile_generated(dir, L->m.name, src_main, exe, ida_libs, o->quiet);
+  if (!rc && o->real_float) {
+    fprintf(stderr, "mbcc: error: bench runs double-precision paths only (drop '--real float')\n");
+    rc = 2;
+  }
+  if (!rc) rc = compile_generated(dir, L->m.name, src_main, exe, ida_libs, o->quiet, 0);
   lower_free(L);
   ir_free(ir);
   if (rc) return rc;

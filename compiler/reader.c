@@ -2370,6 +2370,7 @@ enum {
   SIM_MAX_STEP,
   SIM_ALPHA,
   SIM_BETA,
+  SIM_RHO_INF,
   SIM_INTEGRATOR,
   SIM_SOLVER,
   SIM_STABILIZATION,
@@ -2390,10 +2391,10 @@ typedef struct {
 
 static const char *const sim_keys[SIM_FIELDS] = {
     "end_time", "output_step", "step",       "rtol",          "atol",
-    "min_step", "max_step",    "alpha",      "beta",          "integrator",
+    "min_step", "max_step",    "alpha",      "beta",          "rho_inf",   "integrator",
     "solver",   "stabilization", "joints_on_flexible"};
 
-static const char *const integrator_names[] = {"rk4", "dopri5", NULL};
+static const char *const integrator_names[] = {"rk4", "dopri5", "genalpha", "auto", NULL};
 static const char *const solver_names[] = {"klu", "dense", NULL};
 static const char *const stabilization_names[] = {"projection", "baumgarte", "none", NULL};
 static const char *const jof_names[] = {"direct", "virtual", NULL};
@@ -2406,6 +2407,7 @@ static void sim_defaults(sim_settings *s) {
   s->value[SIM_MIN_STEP] = 1e-12;
   s->value[SIM_ALPHA] = 10;
   s->value[SIM_BETA] = 10;
+  s->value[SIM_RHO_INF] = 0.8;
   s->value[SIM_INTEGRATOR] = INTEGRATOR_DOPRI5;
   s->value[SIM_SOLVER] = SOLVER_KLU;
   s->value[SIM_STABILIZATION] = STAB_PROJECTION;
@@ -2428,12 +2430,20 @@ static void parse_sim(reader *r, yaml_node_t *n, const char *what, sim_source so
                                      "rtol",      "atol",        "min_step",
                                      "max_step",  "integrator",  "solver",
                                      "stabilization", "baumgarte", "joints_on_flexible",
-                                     NULL};
+                                     "rho_inf", NULL};
   map_check_keys(&m, keys);
   for (int field = SIM_END_TIME; field <= SIM_MAX_STEP; field++) {
     double value;
     if (get_positive(&m, sim_keys[field], false, &value))
       sim_set(s, field, value, source, m.last_loc);
+  }
+  double rho_inf;
+  if (get_nonnegative(&m, "rho_inf", false, &rho_inf)) {
+    if (rho_inf > 1)
+      error_at(r, m.last_loc, "'rho_inf' of %s must be from 0 to 1 (the spectral radius of the "
+               "generalized-alpha method at an infinite step), got %g", what, rho_inf);
+    else
+      sim_set(s, SIM_RHO_INF, rho_inf, source, m.last_loc);
   }
   yaml_node_t *baumgarte = map_get(&m, "baumgarte");
   if (baumgarte != NULL) {
@@ -2505,6 +2515,7 @@ static bool sim_finish(reader *r, sim_settings *s, bool is_scene, ir_sim *out) {
   out->max_step = v[SIM_MAX_STEP];
   out->baumgarte_alpha = v[SIM_ALPHA];
   out->baumgarte_beta = v[SIM_BETA];
+  out->rho_inf = v[SIM_RHO_INF];
   out->integrator = (ir_integrator)(int)v[SIM_INTEGRATOR];
   out->solver = (ir_solver)(int)v[SIM_SOLVER];
   out->stabilization = (ir_stab)(int)v[SIM_STABILIZATION];

@@ -11,7 +11,7 @@
 typedef struct {
   const mb_model *m;
   FILE *csv;
-  double *out, *prev;
+  mb_real *out, *prev;
   int have_prev;
   void *work;
   double end_time, last_report, wall0;
@@ -24,8 +24,8 @@ static double wall(void) {
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static int write_row(void *user, double t, const double *q, const double *v, const double *vd,
-                     const double *lambda) {
+static int write_row(void *user, double t, const mb_real *q, const mb_real *v, const mb_real *vd,
+                     const mb_real *lambda) {
   writer *w = user;
   const mb_model *m = w->m;
   mb_model_outputs(m, t, q, v, vd, lambda, w->have_prev ? w->prev : NULL, w->out, w->work);
@@ -34,7 +34,7 @@ static int write_row(void *user, double t, const double *q, const double *v, con
   fprintf(w->csv, "%.10g", t);
   for (int j = 0; j < m->ncols; j++) fprintf(w->csv, ",%.12g", w->out[j]);
   fputc('\n', w->csv);
-  memcpy(w->prev, w->out, sizeof(double) * (size_t)m->ncols);
+  memcpy(w->prev, w->out, sizeof(mb_real) * (size_t)m->ncols);
   w->have_prev = 1;
   double now = wall();
   if (w->progress && now - w->wall0 > 1.0 && now - w->last_report > 0.5) {
@@ -48,7 +48,9 @@ int mb_settings_option(mb_settings *set, const char *opt, const char *val, const
   if (!strcmp(opt, "--integrator")) {
     if (!strcmp(val, "rk4")) set->integrator = MB_RK4;
     else if (!strcmp(val, "dopri5")) set->integrator = MB_DOPRI5;
-    else { fprintf(stderr, "%s: error: unknown integrator '%s' (expected rk4 or dopri5)\n", prog, val); return -1; }
+    else if (!strcmp(val, "genalpha")) set->integrator = MB_GENALPHA;
+    else if (!strcmp(val, "auto")) set->integrator = MB_AUTO;
+    else { fprintf(stderr, "%s: error: unknown integrator '%s' (expected rk4, dopri5, genalpha or auto)\n", prog, val); return -1; }
     return 1;
   }
   if (!strcmp(opt, "--stabilization")) {
@@ -58,12 +60,17 @@ int mb_settings_option(mb_settings *set, const char *opt, const char *val, const
     else { fprintf(stderr, "%s: error: unknown stabilization '%s' (expected projection, baumgarte or none)\n", prog, val); return -1; }
     return 1;
   }
-  static const char *const names[] = {"--end", "--output-step", "--step", "--rtol", "--atol", "--max-step"};
-  double *fields[] = {&set->end_time, &set->output_step, &set->step, &set->rtol, &set->atol, &set->max_step};
-  for (int k = 0; k < 6; k++) {
+  static const char *const names[] = {"--end", "--output-step", "--step", "--rtol", "--atol", "--max-step", "--rho-inf"};
+  double *fields[] = {&set->end_time, &set->output_step, &set->step, &set->rtol, &set->atol, &set->max_step, &set->rho_inf};
+  for (int k = 0; k < 7; k++) {
     if (strcmp(opt, names[k])) continue;
     char *end;
     double x = strtod(val, &end);
+    if (k == 6 && !*end && x >= 0 && x <= 1) { *fields[k] = x; return 1; }
+    if (k == 6) {
+      fprintf(stderr, "%s: error: '--rho-inf' needs a number from 0 to 1, got '%s'\n", prog, val);
+      return -1;
+    }
     if (*end || !(x > 0) || !isfinite(x)) {
       fprintf(stderr, "%s: error: '%s' needs a positive number, got '%s'\n", prog, opt, val);
       return -1;
@@ -76,8 +83,9 @@ int mb_settings_option(mb_settings *set, const char *opt, const char *val, const
 
 static void usage(const char *prog) {
   fprintf(stderr,
-          "usage: %s [-o results.csv] [--solver klu|dense] [--integrator rk4|dopri5]\n"
+          "usage: %s [-o results.csv] [--solver ldl|klu|dense] [--integrator rk4|dopri5|genalpha|auto]\n"
           "          [--end T] [--output-step H] [--step H] [--max-step H] [--rtol R] [--atol A]\n"
+          "          [--rho-inf R]\n"
           "          [--stabilization projection|baumgarte|none] [--quiet]\n",
           prog);
 }
@@ -104,6 +112,29 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
     }
     i += takes;
   }
+#ifdef MB_REAL_FLOAT
+  /* single precision resolves about 1e-7: a tighter tolerance only makes the
+     step control chase round-off */
+  if (set.rtol < 1e-5) {
+    if (!quiet)
+      fprintf(stderr, "%s: warning: rtol %g is below what single precision resolves; using 1e-5\n",
+              argv[0], set.rtol);
+    set.rtol = 1e-5;
+  }
+  /* ... and positions to about 4 ulp of the model's size: an absolute tolerance
+     below that (it also bounds the modal amplitudes, which the constraints tie
+     to the positions) cannot be met */
+  double size = 1;
+  for (int b = 0; b < m->nbody; b++)
+    for (int j = 0; j < 3; j++) size = fmax(size, fabs((double)m->q0[m->body[b].qadr + j]));
+  double atol_min = 4 * 1.1920929e-7 * size;
+  if (set.atol < atol_min) {
+    if (!quiet)
+      fprintf(stderr, "%s: warning: atol %g is below what single precision resolves for this model; "
+              "using %.2g\n", argv[0], set.atol, atol_min);
+    set.atol = atol_min;
+  }
+#endif
   if (set.output_step > set.end_time) set.output_step = set.end_time;
   /* the model's largest step is its output step unless said otherwise: a new
      output step given on the command line carries it along */
@@ -111,7 +142,7 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
   if (set.max_step > set.output_step) set.max_step = set.output_step;
 
   mb_solver *ls = mb_solver_new(solver, m);
-  if (!ls) { fprintf(stderr, "%s: error: unknown solver '%s' (expected klu or dense)\n", argv[0], solver); return 2; }
+  if (!ls) { fprintf(stderr, "%s: error: unknown solver '%s' (expected ldl, klu or dense)\n", argv[0], solver); return 2; }
   /* write to a temporary file, renamed on success: nothing half-written */
   char tmp[4096];
   snprintf(tmp, sizeof tmp, "%s.part", csv_path);
@@ -119,8 +150,8 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
   w.m = m;
   w.csv = fopen(tmp, "w");
   if (!w.csv) { fprintf(stderr, "%s: error: cannot write '%s'\n", argv[0], tmp); ls->destroy(ls); return 2; }
-  w.out = calloc((size_t)m->ncols + 1, sizeof(double));
-  w.prev = calloc((size_t)m->ncols + 1, sizeof(double));
+  w.out = calloc((size_t)m->ncols + 1, sizeof(mb_real));
+  w.prev = calloc((size_t)m->ncols + 1, sizeof(mb_real));
   w.work = malloc(mb_model_worksize(m) + 16);
   w.end_time = set.end_time;
   w.wall0 = wall();
@@ -129,6 +160,11 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
   for (int j = 0; j < m->ncols; j++) fprintf(w.csv, ",%s", m->col_name[j]);
   fputc('\n', w.csv);
 
+  if (set.integrator == MB_AUTO) {
+    char why[320];
+    set.integrator = mb_integrator_auto(m, &set, why, sizeof why);
+    if (!quiet) fprintf(stderr, "%s: integrator auto: %s\n", argv[0], why);
+  }
   mb_sim sim;
   int st = mb_sim_init(&sim, m, ls, &set);
   if (!st) st = mb_sim_run(&sim, write_row, &w);
@@ -153,7 +189,7 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
     printf("model %s: %d bodies, %d coordinates (q), %d velocities, %d constraint rows, n = %d, nnz(K) = %d\n",
            m->name, m->nbody, m->nq, m->nv, m->nc, m->n, m->nnz);
     printf("integrator %s, solver %s, stabilization %s, t = 0 .. %g\n",
-           set.integrator == MB_RK4 ? "rk4" : "dopri5", ls->name,
+           mb_integrator_name(set.integrator), ls->name,
            set.stabilization == MB_STAB_PROJECTION ? "projection"
            : set.stabilization == MB_STAB_BAUMGARTE ? "baumgarte" : "none", set.end_time);
     printf("steps %ld (rejected %ld), evaluations %ld, factorizations %ld (full %ld), solves %ld, projections %ld\n",
@@ -161,6 +197,10 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
            s->projections);
     printf("time %.3f s: assembly %.3f s, factor+solve %.3f s, other %.3f s\n", s->t_total,
            s->t_assembly, s->t_solve, s->t_total - s->t_assembly - s->t_solve);
+    if (set.integrator == MB_GENALPHA)
+      printf("Newton iterations %ld (%.2f per step), Newton failures %ld, rho_inf %g\n",
+             s->newton_iterations, s->steps ? (double)s->newton_iterations / (double)s->steps : 0.0,
+             s->newton_failures, set.rho_inf);
     printf("max |phi| at outputs %.3g\n", s->max_phi);
     printf("wrote %s (%d columns)\n", csv_path, m->ncols + 1);
   }

@@ -8,7 +8,7 @@
 #include <time.h>
 #include "mb_sim.h"
 
-static double now(void) {
+double mb_sim_clock(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
@@ -26,10 +26,15 @@ void mb_settings_default(mb_settings *s) {
   s->stabilization = MB_STAB_PROJECTION;
   s->alpha = 10;
   s->beta = 10;
+#ifdef MB_REAL_FLOAT
+  s->projection_tol = 1e-5; /* single precision: about 100 ulp of unit coordinates */
+#else
   s->projection_tol = 1e-10;
+#endif
+  s->rho_inf = 0.8;
 }
 
-static int fail(mb_sim *s, double t, int status, const char *what) {
+int mb_sim_fail(mb_sim *s, double t, int status, const char *what) {
   s->fail_time = t;
   snprintf(s->fail_detail, sizeof s->fail_detail, "%s: %s", what, mb_status_text(status));
   return status;
@@ -40,19 +45,20 @@ int mb_sim_init(mb_sim *s, const mb_model *m, mb_solver *ls, const mb_settings *
   s->m = m;
   s->ls = ls;
   s->set = *set;
+  if (s->set.integrator == MB_AUTO) s->set.integrator = mb_integrator_auto(m, set, NULL, 0);
   size_t ny = (size_t)(m->nq + m->nv);
-  s->q = calloc((size_t)m->nq + 1, sizeof(double));
-  s->v = calloc((size_t)m->nv + 1, sizeof(double));
-  s->Kx = calloc((size_t)m->nnz + 1, sizeof(double));
-  s->rhs = calloc((size_t)m->n + 1, sizeof(double));
-  s->x = calloc((size_t)m->n + 1, sizeof(double));
-  s->phi = calloc((size_t)m->nc + 1, sizeof(double));
-  s->nu = calloc((size_t)m->nc + 1, sizeof(double));
-  s->y = calloc(ny + 1, sizeof(double));
-  s->ytmp = calloc(ny + 1, sizeof(double));
-  for (int i = 0; i < 7; i++) s->k[i] = calloc(ny + 1, sizeof(double));
-  s->qsave = calloc((size_t)m->nq + 1, sizeof(double));
-  s->dv = calloc((size_t)m->n + 1, sizeof(double));
+  s->q = calloc((size_t)m->nq + 1, sizeof(mb_real));
+  s->v = calloc((size_t)m->nv + 1, sizeof(mb_real));
+  s->Kx = calloc((size_t)m->nnz + 1, sizeof(mb_real));
+  s->rhs = calloc((size_t)m->n + 1, sizeof(mb_real));
+  s->x = calloc((size_t)m->n + 1, sizeof(mb_real));
+  s->phi = calloc((size_t)m->nc + 1, sizeof(mb_real));
+  s->nu = calloc((size_t)m->nc + 1, sizeof(mb_real));
+  s->y = calloc(ny + 1, sizeof(mb_real));
+  s->ytmp = calloc(ny + 1, sizeof(mb_real));
+  for (int i = 0; i < 7; i++) s->k[i] = calloc(ny + 1, sizeof(mb_real));
+  s->qsave = calloc((size_t)m->nq + 1, sizeof(mb_real));
+  s->dv = calloc((size_t)m->n + 1, sizeof(mb_real));
   s->work = malloc(mb_model_worksize(m) + 16);
   if (!s->q || !s->v || !s->Kx || !s->rhs || !s->x || !s->phi || !s->nu || !s->y || !s->ytmp ||
       !s->qsave || !s->dv || !s->work)
@@ -60,8 +66,8 @@ int mb_sim_init(mb_sim *s, const mb_model *m, mb_solver *ls, const mb_settings *
   for (int i = 0; i < 7; i++)
     if (!s->k[i]) return MB_ERR_NOMEM;
   if (ls->bind) ls->bind(ls, s->work);
-  memcpy(s->q, m->q0, sizeof(double) * (size_t)m->nq);
-  memcpy(s->v, m->v0, sizeof(double) * (size_t)m->nv);
+  memcpy(s->q, m->q0, sizeof(mb_real) * (size_t)m->nq);
+  memcpy(s->v, m->v0, sizeof(mb_real) * (size_t)m->nv);
   m->init(m, s->Kx);
   if (set->end_time <= 0 || set->output_step <= 0 || set->step <= 0) return MB_ERR_INVALID;
   return MB_OK;
@@ -76,58 +82,58 @@ void mb_sim_free(mb_sim *s) {
 
 /* evaluate K and the right side at (t, q, v); factor unless q is the one
  * already factored (K depends on q only) */
-static int assemble_factor(mb_sim *s, double t, const double *q, const double *v) {
+static int assemble_factor(mb_sim *s, double t, const mb_real *q, const mb_real *v) {
   const mb_model *m = s->m;
-  double t0 = now();
+  double t0 = mb_sim_clock();
   m->eval(m, t, q, v, s->Kx, s->rhs, s->phi, s->nu, s->work);
   s->stats.evals++;
-  double t1 = now();
+  double t1 = mb_sim_clock();
   s->stats.t_assembly += t1 - t0;
-  if (s->factored_valid && !memcmp(q, s->qsave, sizeof(double) * (size_t)m->nq)) return MB_OK;
+  if (s->factored_valid && !memcmp(q, s->qsave, sizeof(mb_real) * (size_t)m->nq)) return MB_OK;
   int st = s->ls->factor(s->ls, s->Kx);
-  s->stats.t_solve += now() - t1;
+  s->stats.t_solve += mb_sim_clock() - t1;
   if (st) { s->factored_valid = 0; return st; }
-  memcpy(s->qsave, q, sizeof(double) * (size_t)m->nq);
+  memcpy(s->qsave, q, sizeof(mb_real) * (size_t)m->nq);
   s->factored_valid = 1;
   return MB_OK;
 }
 
-static int solve(mb_sim *s, double *b) {
-  double t0 = now();
+static int solve(mb_sim *s, mb_real *b) {
+  double t0 = mb_sim_clock();
   int st = s->ls->solve(s->ls, b);
   s->stats.solves++;
-  s->stats.t_solve += now() - t0;
+  s->stats.t_solve += mb_sim_clock() - t0;
   for (int i = 0; i < s->m->n; i++)
     if (!isfinite(b[i])) return MB_ERR_NONFINITE;
   return st;
 }
 
-int mb_sim_accel(mb_sim *s, double t, const double *q, const double *v, double *vd,
-                 double *lambda) {
+int mb_sim_accel(mb_sim *s, double t, const mb_real *q, const mb_real *v, mb_real *vd,
+                 mb_real *lambda) {
   const mb_model *m = s->m;
   int st = assemble_factor(s, t, q, v);
-  if (st) return fail(s, t, st, "factorization of K");
+  if (st) return mb_sim_fail(s, t, st, "factorization of K");
   if (s->set.stabilization == MB_STAB_BAUMGARTE) {
     /* gamma - 2 alpha phidot - beta^2 phi */
     for (int r = 0; r < m->nc; r++)
       s->rhs[m->nv + r] -= 2 * s->set.alpha * s->nu[r] + s->set.beta * s->set.beta * s->phi[r];
   }
-  memcpy(s->x, s->rhs, sizeof(double) * (size_t)m->n);
+  memcpy(s->x, s->rhs, sizeof(mb_real) * (size_t)m->n);
   st = solve(s, s->x);
-  if (st) return fail(s, t, st, "solution for the accelerations");
-  memcpy(vd, s->x, sizeof(double) * (size_t)m->nv);
-  if (lambda) memcpy(lambda, s->x + m->nv, sizeof(double) * (size_t)m->nc);
+  if (st) return mb_sim_fail(s, t, st, "solution for the accelerations");
+  memcpy(vd, s->x, sizeof(mb_real) * (size_t)m->nv);
+  if (lambda) memcpy(lambda, s->x + m->nv, sizeof(mb_real) * (size_t)m->nc);
   return MB_OK;
 }
 
-static double max_abs(const double *a, int n) {
+static double max_abs(const mb_real *a, int n) {
   double mx = 0;
   for (int i = 0; i < n; i++)
     if (fabs(a[i]) > mx || a[i] != a[i]) mx = (a[i] != a[i]) ? INFINITY : fabs(a[i]);
   return mx;
 }
 
-int mb_sim_project(mb_sim *s, double t, double *q, double *v) {
+int mb_sim_project(mb_sim *s, double t, mb_real *q, mb_real *v) {
   const mb_model *m = s->m;
   int n = m->n, nv = m->nv;
   mb_model_normalize(m, q);
@@ -135,13 +141,13 @@ int mb_sim_project(mb_sim *s, double t, double *q, double *v) {
      K [dq; mu] = [0; -phi] */
   for (int it = 0;; it++) {
     int st = assemble_factor(s, t, q, v);
-    if (st) return fail(s, t, st, "projection");
+    if (st) return mb_sim_fail(s, t, st, "projection");
     if (max_abs(s->phi, m->nc) <= s->set.projection_tol) break;
-    if (it >= 8) return fail(s, t, MB_ERR_PROJECTION, "position projection");
+    if (it >= 8) return mb_sim_fail(s, t, MB_ERR_PROJECTION, "position projection");
     for (int i = 0; i < nv; i++) s->dv[i] = 0;
     for (int r = 0; r < m->nc; r++) s->dv[nv + r] = -s->phi[r];
     st = solve(s, s->dv);
-    if (st) return fail(s, t, st, "position projection");
+    if (st) return mb_sim_fail(s, t, st, "position projection");
     mb_model_qincrement(m, q, s->dv);
     mb_model_normalize(m, q);
     s->stats.projections++;
@@ -150,16 +156,16 @@ int mb_sim_project(mb_sim *s, double t, double *q, double *v) {
   for (int i = 0; i < nv; i++) s->dv[i] = 0;
   for (int r = 0; r < m->nc; r++) s->dv[nv + r] = -s->nu[r];
   int st = solve(s, s->dv);
-  if (st) return fail(s, t, st, "velocity projection");
+  if (st) return mb_sim_fail(s, t, st, "velocity projection");
   for (int i = 0; i < nv; i++) v[i] += s->dv[i];
   (void)n;
   return MB_OK;
 }
 
 /* dy = f(t, y): y = [q; v], dy = [G(q) v; vdot] */
-static int deriv(mb_sim *s, double t, const double *y, double *dy) {
+static int deriv(mb_sim *s, double t, const mb_real *y, mb_real *dy) {
   const mb_model *m = s->m;
-  const double *q = y, *v = y + m->nq;
+  const mb_real *q = y, *v = y + m->nq;
   int st = mb_sim_accel(s, t, q, v, dy + m->nq, NULL);
   if (st) return st;
   mb_model_qdot(m, q, v, dy);
@@ -167,7 +173,7 @@ static int deriv(mb_sim *s, double t, const double *y, double *dy) {
 }
 
 /* after a step: stabilize and check the state */
-static int finish_step(mb_sim *s, double t) {
+int mb_sim_finish_step(mb_sim *s, double t) {
   const mb_model *m = s->m;
   if (s->set.stabilization == MB_STAB_PROJECTION) {
     int st = mb_sim_project(s, t, s->q, s->v);
@@ -176,9 +182,9 @@ static int finish_step(mb_sim *s, double t) {
     mb_model_normalize(m, s->q);
   }
   for (int i = 0; i < m->nq; i++)
-    if (!isfinite(s->q[i])) return fail(s, t, MB_ERR_NONFINITE, "positions");
+    if (!isfinite(s->q[i])) return mb_sim_fail(s, t, MB_ERR_NONFINITE, "positions");
   for (int i = 0; i < m->nv; i++)
-    if (!isfinite(s->v[i])) return fail(s, t, MB_ERR_NONFINITE, "velocities");
+    if (!isfinite(s->v[i])) return mb_sim_fail(s, t, MB_ERR_NONFINITE, "velocities");
   return MB_OK;
 }
 
@@ -197,8 +203,8 @@ static const double DP_E[7] = {71.0 / 57600, 0, -71.0 / 16695, 71.0 / 1920, -172
                                22.0 / 525, -1.0 / 40};
 
 /* one explicit stage combination: ytmp = y + h sum a_j k_j */
-static void combine(int ny, const double *y, double h, const double *a, double *const *k, int nk,
-                    double *out) {
+static void combine(int ny, const mb_real *y, double h, const double *a, mb_real *const *k, int nk,
+                    mb_real *out) {
   for (int i = 0; i < ny; i++) {
     double acc = 0;
     for (int j = 0; j < nk; j++) acc += a[j] * k[j][i];
@@ -206,13 +212,61 @@ static void combine(int ny, const double *y, double h, const double *a, double *
   }
 }
 
+const char *mb_integrator_name(int integrator) {
+  switch (integrator) {
+  case MB_RK4: return "rk4";
+  case MB_DOPRI5: return "dopri5";
+  case MB_GENALPHA: return "genalpha";
+  case MB_AUTO: return "auto";
+  default: return "unknown";
+  }
+}
+
+/* The stiffness an explicit method must resolve comes from the highest modal
+ * frequency: Dormand-Prince is stable for |h lambda| up to about 3.3, so a
+ * mode of angular frequency w caps its step at 3.3 / w.  When that cap is
+ * below a tenth of the output step (the step the explicit method could
+ * otherwise take), the implicit method is cheaper. */
+int mb_integrator_auto(const mb_model *m, const mb_settings *set, char *why, size_t nwhy) {
+  double wmax = 0;
+  const char *body = NULL;
+  for (int b = 0; b < m->nbody; b++) {
+    const mb_body *B = &m->body[b];
+    if (B->kind != MB_BODY_FLEXIBLE || !B->flex) continue;
+    for (int j = 0; j < B->nm; j++)
+      if (sqrt((double)B->flex->stiffness[j]) > wmax) { wmax = sqrt((double)B->flex->stiffness[j]); body = B->name; }
+  }
+  double hstab = wmax > 0 ? 3.3 / wmax : INFINITY;
+  double hwant = fmin(set->output_step, set->max_step);
+  int implicit = hstab < 0.1 * hwant;
+  if (why && nwhy) {
+    if (!body)
+      snprintf(why, nwhy, "dopri5: the model has no flexible modes, so nothing stiff for an explicit method");
+    else
+      snprintf(why, nwhy,
+               "%s: the highest mode (%s, %.4g Hz) limits an explicit step to %.3g s for stability, "
+               "%s a tenth of the output step %.3g s",
+               implicit ? "genalpha" : "dopri5", body, wmax / (2 * MB_PI), hstab,
+               implicit ? "below" : "above", hwant);
+  }
+  return implicit ? MB_GENALPHA : MB_DOPRI5;
+}
+
 int mb_sim_run(mb_sim *s, mb_output_fn out, void *user) {
+  if (s->set.integrator == MB_GENALPHA) {
+    double t0 = mb_sim_clock();
+    int st = mb_genalpha_run(s, out, user);
+    s->stats.factorizations = s->ls->factorizations;
+    s->stats.full_factorizations = s->ls->full_factorizations;
+    s->stats.t_total = mb_sim_clock() - t0;
+    return st;
+  }
   const mb_model *m = s->m;
   const mb_settings *set = &s->set;
   int nq = m->nq, nv = m->nv, ny = nq + nv;
-  double t0w = now();
-  double *vd = malloc(sizeof(double) * (size_t)(nv + 1));
-  double *lam = malloc(sizeof(double) * (size_t)(m->nc + 1));
+  double t0w = mb_sim_clock();
+  mb_real *vd = malloc(sizeof(mb_real) * (size_t)(nv + 1));
+  mb_real *lam = malloc(sizeof(mb_real) * (size_t)(m->nc + 1));
   if (!vd || !lam) { free(vd); free(lam); return MB_ERR_NOMEM; }
   int st = MB_OK;
   s->t = 0;
@@ -224,10 +278,10 @@ int mb_sim_run(mb_sim *s, mb_output_fn out, void *user) {
   while (1) {
     double tout = (double)iout * set->output_step;
     /* the stage-1 derivative at (t, y): also gives the outputs at output times */
-    memcpy(s->y, s->q, sizeof(double) * (size_t)nq);
-    memcpy(s->y + nq, s->v, sizeof(double) * (size_t)nv);
+    memcpy(s->y, s->q, sizeof(mb_real) * (size_t)nq);
+    memcpy(s->y + nq, s->v, sizeof(mb_real) * (size_t)nv);
     if ((st = mb_sim_accel(s, s->t, s->q, s->v, vd, lam))) goto done;
-    memcpy(s->k[0] + nq, vd, sizeof(double) * (size_t)nv);
+    memcpy(s->k[0] + nq, vd, sizeof(mb_real) * (size_t)nv);
     mb_model_qdot(m, s->q, s->v, s->k[0]);
     if (fabs(s->t - tout) <= 1e-9 * set->output_step) {
       double mx = max_abs(s->phi, m->nc);
@@ -253,11 +307,11 @@ int mb_sim_run(mb_sim *s, mb_output_fn out, void *user) {
       if ((st = deriv(s, s->t + h, s->ytmp, s->k[3]))) goto done;
       static const double b[4] = {1.0 / 6, 1.0 / 3, 1.0 / 3, 1.0 / 6};
       combine(ny, s->y, h, b, s->k, 4, s->ytmp);
-      memcpy(s->q, s->ytmp, sizeof(double) * (size_t)nq);
-      memcpy(s->v, s->ytmp + nq, sizeof(double) * (size_t)nv);
+      memcpy(s->q, s->ytmp, sizeof(mb_real) * (size_t)nq);
+      memcpy(s->v, s->ytmp + nq, sizeof(mb_real) * (size_t)nv);
       s->t = (h == hmax) ? tout : s->t + h;
       s->stats.steps++;
-      if ((st = finish_step(s, s->t))) goto done;
+      if ((st = mb_sim_finish_step(s, s->t))) goto done;
     } else {
       /* adaptive Dormand-Prince 5(4); steps end on output times */
       for (;;) {
@@ -286,8 +340,8 @@ int mb_sim_run(mb_sim *s, mb_output_fn out, void *user) {
         double fac = err > 0 ? 0.9 * pow(err, -0.2) : 5;
         fac = fmin(5, fmax(0.2, fac));
         if (err <= 1) {
-          memcpy(s->q, s->ytmp, sizeof(double) * (size_t)nq);
-          memcpy(s->v, s->ytmp + nq, sizeof(double) * (size_t)nv);
+          memcpy(s->q, s->ytmp, sizeof(mb_real) * (size_t)nq);
+          memcpy(s->v, s->ytmp + nq, sizeof(mb_real) * (size_t)nv);
           s->t = (hh == hmax) ? tout : s->t + hh;
           s->stats.steps++;
           h = fmin(hh * fac, set->max_step);
@@ -298,17 +352,17 @@ int mb_sim_run(mb_sim *s, mb_output_fn out, void *user) {
         h = hh * fmax(0.2, fac);
       retry:
         if (h < set->min_step) {
-          st = fail(s, s->t, MB_ERR_STEP_TOO_SMALL, "adaptive step");
+          st = mb_sim_fail(s, s->t, MB_ERR_STEP_TOO_SMALL, "adaptive step");
           goto done;
         }
       }
-      if ((st = finish_step(s, s->t))) goto done;
+      if ((st = mb_sim_finish_step(s, s->t))) goto done;
     }
   }
 done:
   s->stats.factorizations = s->ls->factorizations;
   s->stats.full_factorizations = s->ls->full_factorizations;
-  s->stats.t_total = now() - t0w;
+  s->stats.t_total = mb_sim_clock() - t0w;
   free(vd);
   free(lam);
   return st;

@@ -1,13 +1,15 @@
-/* mb_sim.h: time integration of a compiled model: explicit RK4 (fixed step)
- * and Dormand-Prince 5(4) (adaptive), with coordinate projection or
- * Baumgarte stabilization.  Hosted runtime: workspaces are allocated once in
+/* mb_sim.h: time integration of a compiled model: explicit RK4 (fixed step),
+ * Dormand-Prince 5(4) (adaptive) and the implicit generalized-alpha method
+ * (adaptive, for stiff modal content; genalpha.c), with coordinate projection
+ * or Baumgarte stabilization.  Hosted runtime: workspaces are allocated once in
  * mb_sim_init, nothing per step. */
 #ifndef MB_SIM_H
 #define MB_SIM_H
 
 #include "mb_solver.h"
 
-enum { MB_RK4 = 0, MB_DOPRI5 = 1 };
+/* MB_AUTO is resolved by mb_sim_init (mb_integrator_auto) */
+enum { MB_RK4 = 0, MB_DOPRI5 = 1, MB_GENALPHA = 2, MB_AUTO = 3 };
 enum { MB_STAB_PROJECTION = 0, MB_STAB_BAUMGARTE = 1, MB_STAB_NONE = 2 };
 
 typedef struct {
@@ -18,18 +20,20 @@ typedef struct {
   int stabilization;
   double alpha, beta;         /* Baumgarte */
   double projection_tol;      /* max |phi| after projection */
+  double rho_inf;             /* generalized-alpha: spectral radius at infinite step, 0..1 */
 } mb_settings;
 
 typedef struct {
   long steps, rejected, evals, solves, projections;
   long factorizations, full_factorizations;
+  long newton_iterations, newton_failures; /* generalized-alpha */
   double t_assembly, t_solve, t_total; /* seconds */
   double max_phi, max_phid;            /* largest constraint violations seen at outputs */
 } mb_stats;
 
 /* called at t = 0 and every output step; return nonzero to stop */
-typedef int (*mb_output_fn)(void *user, double t, const double *q, const double *v,
-                            const double *vd, const double *lambda);
+typedef int (*mb_output_fn)(void *user, double t, const mb_real *q, const mb_real *v,
+                            const mb_real *vd, const mb_real *lambda);
 
 typedef struct {
   const mb_model *m;
@@ -37,11 +41,11 @@ typedef struct {
   mb_settings set;
   mb_stats stats;
   double t;                 /* current time */
-  double *q, *v;            /* current state (nq, nv) */
+  mb_real *q, *v;            /* current state (nq, nv) */
   double fail_time;         /* time of a failure */
   char fail_detail[160];    /* what failed */
   /* workspaces */
-  double *Kx, *rhs, *x, *phi, *nu, *y, *ytmp, *k[7], *qsave, *dv; /* nu: phid = D v - nu */
+  mb_real *Kx, *rhs, *x, *phi, *nu, *y, *ytmp, *k[7], *qsave, *dv; /* nu: phid = D v - nu */
   void *work;
   int factored_valid;       /* Kx factorization matches qsave */
 } mb_sim;
@@ -51,10 +55,21 @@ int mb_sim_init(mb_sim *s, const mb_model *m, mb_solver *ls, const mb_settings *
 /* integrate from the model's initial state to end_time */
 int mb_sim_run(mb_sim *s, mb_output_fn out, void *user);
 /* accelerations and multipliers at (t, q, v) into vd (nv) and lambda (nc) */
-int mb_sim_accel(mb_sim *s, double t, const double *q, const double *v, double *vd,
-                 double *lambda);
+int mb_sim_accel(mb_sim *s, double t, const mb_real *q, const mb_real *v, mb_real *vd,
+                 mb_real *lambda);
 /* project (q, v) onto the position and velocity constraints */
-int mb_sim_project(mb_sim *s, double t, double *q, double *v);
+int mb_sim_project(mb_sim *s, double t, mb_real *q, mb_real *v);
 void mb_sim_free(mb_sim *s);
+
+/* The integrator 'auto' picks for this model and these settings, and why
+ * (a sentence into why[0..nwhy)); never MB_AUTO. */
+int mb_integrator_auto(const mb_model *m, const mb_settings *set, char *why, size_t nwhy);
+const char *mb_integrator_name(int integrator);
+
+/* for the integrators (integrate.c, genalpha.c) */
+int mb_sim_fail(mb_sim *s, double t, int status, const char *what);
+double mb_sim_clock(void); /* monotonic seconds */
+int mb_sim_finish_step(mb_sim *s, double t);
+int mb_genalpha_run(mb_sim *s, mb_output_fn out, void *user);
 
 #endif

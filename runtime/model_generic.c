@@ -12,6 +12,7 @@ const char *mb_status_text(int status) {
   case MB_ERR_PROJECTION: return "coordinate projection did not converge";
   case MB_ERR_NOMEM: return "out of memory";
   case MB_ERR_INVALID: return "invalid settings";
+  case MB_ERR_NEWTON: return "Newton iteration did not converge";
   default: return "unknown error";
   }
 }

@@ -56,12 +56,3 @@ mb_solver *mb_solver_dense(const mb_model *m) {
   return &d->base;
 }
 
-mb_solver *mb_solver_klu(const mb_model *m);
-mb_solver *mb_solver_new(const char *name, const mb_model *m) {
-  if (!strcmp(name, "klu")) return mb_solver_klu(m);
-  if (!strcmp(name, "dense")) return mb_solver_dense(m);
-  if (!strcmp(name, "ldl")) return mb_solver_ldl(m);
-  if (!strcmp(name, "generic-klu")) return mb_solver_generic(m, 0);
-  if (!strcmp(name, "generic-dense")) return mb_solver_generic(m, 1);
-  return NULL;
-}

@@ -1,0 +1,283 @@
+/* genalpha.c: the implicit generalized-alpha method (Chung & Hulbert; on the
+ * Lie group of the body rotations as Arnold & Bruls 2007) for stiff modal
+ * content, on the index-3 equations
+ *     M(q) vd + D(q)^T lambda = f(q, v, t),   phi(q) = 0,
+ * with adaptive steps.  Newton iterates on the fixed pattern of K: scaled by
+ * 1/beta', the iteration matrix is
+ *     [ M + (gamma'/beta') C + (1/beta') K_t   D^T ]
+ *     [ D                                      0   ]
+ * which is K with the modal damping and stiffness added on the modal diagonal
+ * (the stiff part of K_t; the remaining, non-stiff tangent terms are left to
+ * the Newton iterations).  Velocities are projected onto D v = nu after each
+ * step when projection is on (index-3 positions already satisfy phi = 0). */
+#define _POSIX_C_SOURCE 199309L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "mb_sim.h"
+
+typedef struct {
+  /* method constants */
+  double am, af, gamma, beta;
+  /* state at t_n: accelerations vd and algorithmic accelerations a */
+  mb_real *vd, *a, *lam;
+  /* the iterate at t_n+1 */
+  mb_real *x;      /* [vd; lambda] */
+  mb_real *q1, *v1, *a1, *dq;
+  mb_real *Kmod, *r; /* iteration matrix, Newton right side / correction */
+  mb_real *sc;       /* error weights of the velocity-space position coordinates */
+  mb_real *vd_out, *lam_out;
+} ga_work;
+
+static void ga_free(ga_work *g) {
+  free(g->vd); free(g->a); free(g->lam); free(g->x); free(g->q1); free(g->v1); free(g->a1);
+  free(g->dq); free(g->Kmod); free(g->r); free(g->sc); free(g->vd_out); free(g->lam_out);
+}
+
+static int ga_alloc(ga_work *g, const mb_model *m) {
+  size_t nv = (size_t)m->nv + 1, n = (size_t)m->n + 1, nc = (size_t)m->nc + 1;
+  g->vd = calloc(nv, sizeof(mb_real));
+  g->a = calloc(nv, sizeof(mb_real));
+  g->lam = calloc(nc, sizeof(mb_real));
+  g->x = calloc(n, sizeof(mb_real));
+  g->q1 = calloc((size_t)m->nq + 1, sizeof(mb_real));
+  g->v1 = calloc(nv, sizeof(mb_real));
+  g->a1 = calloc(nv, sizeof(mb_real));
+  g->dq = calloc(nv, sizeof(mb_real));
+  g->Kmod = calloc((size_t)m->nnz + 1, sizeof(mb_real));
+  g->r = calloc(n, sizeof(mb_real));
+  g->sc = calloc(nv, sizeof(mb_real));
+  g->vd_out = calloc(nv, sizeof(mb_real));
+  g->lam_out = calloc(nc, sizeof(mb_real));
+  return g->vd && g->a && g->lam && g->x && g->q1 && g->v1 && g->a1 && g->dq && g->Kmod &&
+         g->r && g->sc && g->vd_out && g->lam_out;
+}
+
+/* error weights atol + rtol |size|, per velocity-space coordinate: translations
+ * by their size, rotations by 1 rad, and modal amplitudes by the body's largest
+ * modal amplitude: an error in a high mode matters against the deformation of
+ * the body, not against that mode's own (tiny) amplitude */
+static void error_weights(const mb_model *m, const mb_settings *set, const mb_real *q,
+                          const mb_real *q1, mb_real *sc) {
+  for (int b = 0; b < m->nbody; b++) {
+    const mb_body *B = &m->body[b];
+    for (int j = 0; j < 3; j++)
+      sc[B->vadr + j] = (mb_real)(set->atol + set->rtol * fmax(fabs((double)q[B->qadr + j]),
+                                                              fabs((double)q1[B->qadr + j])));
+    for (int j = 3; j < 6; j++) sc[B->vadr + j] = (mb_real)(set->atol + set->rtol);
+    double wmax = 0;
+    for (int j = 0; j < B->nm; j++)
+      wmax = fmax(wmax, fmax(fabs((double)q[B->qadr + 7 + j]), fabs((double)q1[B->qadr + 7 + j])));
+    for (int j = 0; j < B->nm; j++) sc[B->vadr + 6 + j] = (mb_real)(set->atol + set->rtol * wmax);
+  }
+}
+
+/* q1, v1, a1 from the iterate vd1 = x[0..nv) (generalized-alpha recurrences) */
+static void ga_predict(const mb_sim *s, const ga_work *g, double h) {
+  const mb_model *m = s->m;
+  for (int i = 0; i < m->nv; i++) {
+    double a1 = ((1 - g->af) * g->x[i] + g->af * g->vd[i] - g->am * g->a[i]) / (1 - g->am);
+    g->a1[i] = (mb_real)a1;
+    g->dq[i] = (mb_real)(h * s->v[i] + h * h * ((0.5 - g->beta) * g->a[i] + g->beta * a1));
+    g->v1[i] = (mb_real)(s->v[i] + h * ((1 - g->gamma) * g->a[i] + g->gamma * a1));
+  }
+  memcpy(g->q1, s->q, sizeof(mb_real) * (size_t)m->nq);
+  mb_model_qincrement(m, g->q1, g->dq);
+  mb_model_normalize(m, g->q1);
+}
+
+/* the iteration matrix: K with kfac * stiffness + cfac * damping on the modal diagonal */
+static void iteration_matrix(const mb_model *m, const mb_real *Kx, double kfac, double cfac,
+                             mb_real *Kmod) {
+  memcpy(Kmod, Kx, sizeof(mb_real) * (size_t)m->nnz);
+  for (int b = 0; b < m->nbody; b++) {
+    const mb_body *B = &m->body[b];
+    if (B->kind != MB_BODY_FLEXIBLE || !B->flex || !B->mslotf) continue;
+    int nb = 6 + B->nm;
+    for (int j = 0; j < B->nm; j++) {
+      int slot = B->mslotf[(6 + j) * nb + 6 + j];
+      if (slot >= 0) Kmod[slot] += (mb_real)(kfac * B->flex->stiffness[j] + cfac * B->flex->damping[j]);
+    }
+  }
+}
+
+/* r_top = K x - f over the dynamic rows (the constraint rows are phi) */
+static void dynamic_residual(const mb_model *m, const mb_real *Kx, const mb_real *x,
+                             const mb_real *rhs, mb_real *r) {
+  for (int i = 0; i < m->nv; i++) r[i] = -rhs[i];
+  for (int j = 0; j < m->n; j++)
+    for (int p = m->Kp[j]; p < m->Kp[j + 1]; p++)
+      if (m->Ki[p] < m->nv) r[m->Ki[p]] += Kx[p] * x[j];
+}
+
+static double weighted_rms(const mb_real *e, const mb_real *sc, int n, double scale) {
+  double sum = 0;
+  for (int i = 0; i < n; i++) {
+    double z = scale * (double)e[i] / (double)sc[i];
+    sum += z * z;
+  }
+  return n ? sqrt(sum / n) : 0;
+}
+
+enum { GA_CONVERGED = 0, GA_DIVERGED = 1, GA_FAILED = 2 };
+
+/* Newton on x = [vd1; lambda1] for a step h from s->t: GA_CONVERGED with q1, v1,
+ * a1 and x at the solution; GA_DIVERGED (retry smaller); GA_FAILED (status in *st) */
+static int ga_newton(mb_sim *s, ga_work *g, double h, int *st, double *rate_out) {
+  const mb_model *m = s->m;
+  int nv = m->nv, nc = m->nc, n = m->n;
+  double bp = (1 - g->am) / (h * h * g->beta * (1 - g->af)); /* beta' */
+  double gp = g->gamma / (h * g->beta);                      /* gamma' */
+  double eta_prev = 0;
+  int factored = 0;
+  /* predictor: the accelerations and multipliers of t_n */
+  memcpy(g->x, g->vd, sizeof(mb_real) * (size_t)nv);
+  memcpy(g->x + nv, g->lam, sizeof(mb_real) * (size_t)nc);
+  for (int it = 0; it < 12; it++) {
+    ga_predict(s, g, h);
+    double t0 = mb_sim_clock();
+    m->eval(m, (mb_real)(s->t + h), g->q1, g->v1, s->Kx, s->rhs, s->phi, s->nu, s->work);
+    s->stats.evals++;
+    double t1 = mb_sim_clock();
+    s->stats.t_assembly += t1 - t0;
+    dynamic_residual(m, s->Kx, g->x, s->rhs, g->r);
+    for (int i = 0; i < nv; i++) g->r[i] = -g->r[i];
+    for (int r = 0; r < nc; r++) g->r[nv + r] = (mb_real)(-bp * s->phi[r]);
+    for (int i = 0; i < n; i++)
+      if (!isfinite((double)g->r[i])) return GA_DIVERGED;
+    /* a fresh iteration matrix at the first iterate and whenever the
+       iterations slow down (modified Newton) */
+    if (!factored || (it >= 2 && *rate_out > 0.25)) {
+      iteration_matrix(m, s->Kx, 1 / bp, gp / bp, g->Kmod);
+      s->factored_valid = 0; /* the solver now holds the iteration matrix */
+      int fs = s->ls->factor(s->ls, g->Kmod);
+      if (fs) return GA_DIVERGED; /* singular at a wild iterate: a smaller step */
+      factored = 1;
+    }
+    int ss = s->ls->solve(s->ls, g->r);
+    s->stats.solves++;
+    s->stats.t_solve += mb_sim_clock() - t1;
+    if (ss) { *st = ss; return GA_FAILED; }
+    for (int i = 0; i < n; i++) {
+      if (!isfinite((double)g->r[i])) return GA_DIVERGED;
+      g->x[i] += g->r[i];
+    }
+    s->stats.newton_iterations++;
+    /* size of the position correction dq = d(vd) / beta' against the error weights */
+    error_weights(m, &s->set, s->q, g->q1, g->sc);
+    double eta = weighted_rms(g->r, g->sc, nv, 1 / bp);
+    if (it > 0) *rate_out = eta / fmax(eta_prev, 1e-300);
+    if (getenv("GA_DEBUG")) fprintf(stderr, "t=%g h=%g it=%d eta=%g\n", s->t, h, it, eta);
+    eta_prev = eta;
+    /* converged: the correction is far below the error tolerance, or it has
+       stopped shrinking (round-off, e.g. in single precision) while already
+       below the tolerance */
+    int stalled = it > 1 && *rate_out > 0.9;
+    if (eta <= 1e-2 || (stalled && eta <= 1)) {
+      ga_predict(s, g, h);
+      return GA_CONVERGED;
+    }
+    if (stalled) return GA_DIVERGED;
+  }
+  return GA_DIVERGED;
+}
+
+int mb_genalpha_run(mb_sim *s, mb_output_fn out, void *user) {
+  const mb_model *m = s->m;
+  const mb_settings *set = &s->set;
+  int nq = m->nq, nv = m->nv, nc = m->nc;
+  ga_work g;
+  memset(&g, 0, sizeof g);
+  if (!ga_alloc(&g, m)) { ga_free(&g); return MB_ERR_NOMEM; }
+  double rho = set->rho_inf;
+  if (!(rho >= 0 && rho <= 1)) { ga_free(&g); return MB_ERR_INVALID; }
+  g.am = (2 * rho - 1) / (rho + 1);
+  g.af = rho / (rho + 1);
+  g.gamma = 0.5 - g.am + g.af;
+  g.beta = 0.25 * (g.gamma + 0.5) * (g.gamma + 0.5);
+  int st = MB_OK;
+  s->t = 0;
+  long nout = (long)floor(set->end_time / set->output_step + 1e-9), iout = 0;
+  double h = fmin(set->step, set->max_step);
+
+  if (set->stabilization == MB_STAB_PROJECTION && (st = mb_sim_project(s, 0, s->q, s->v))) goto done;
+  /* consistent accelerations at t = 0 start the recurrence: a_0 = vd_0 */
+  if ((st = mb_sim_accel(s, 0, s->q, s->v, g.vd, g.lam))) goto done;
+  memcpy(g.a, g.vd, sizeof(mb_real) * (size_t)nv);
+  while (1) {
+    double tout = (double)iout * set->output_step;
+    if (fabs(s->t - tout) <= 1e-9 * set->output_step) {
+      /* outputs from the index-1 accelerations of the (projected) state */
+      if ((st = mb_sim_accel(s, s->t, s->q, s->v, g.vd_out, g.lam_out))) goto done;
+      double mx = 0;
+      for (int r = 0; r < nc; r++) mx = fmax(mx, fabs((double)s->phi[r]));
+      if (mx > s->stats.max_phi) s->stats.max_phi = mx;
+      if (out && out(user, s->t, s->q, s->v, g.vd_out, g.lam_out)) goto done;
+      iout++;
+      if (iout > nout) break;
+      tout = (double)iout * set->output_step;
+    }
+    double hmax = tout - s->t;
+    for (;;) {
+      double hh = fmin(h, hmax);
+      if (hmax - hh < 1e-9 * set->output_step) hh = hmax;
+      double rate = 0;
+      int ns = MB_OK;
+      int res = ga_newton(s, &g, hh, &ns, &rate);
+      if (res == GA_FAILED) { st = mb_sim_fail(s, s->t + hh, ns, "implicit step"); goto done; }
+      if (res == GA_DIVERGED) {
+        s->stats.newton_failures++;
+        s->stats.rejected++;
+        h = hh / 4;
+        if (h < set->min_step) {
+          s->fail_time = s->t;
+          snprintf(s->fail_detail, sizeof s->fail_detail,
+                   "generalized-alpha: Newton iteration did not converge even with step %.3g s "
+                   "(stiffness outside the modal coordinates, or a singular configuration)", hh);
+          st = MB_ERR_NEWTON;
+          goto done;
+        }
+        continue;
+      }
+      /* local error of the positions: h^2 (beta - 1/6) (vd1 - vd0) */
+      for (int i = 0; i < nv; i++) g.r[i] = g.x[i] - g.vd[i];
+      error_weights(m, set, s->q, g.q1, g.sc);
+      double err = weighted_rms(g.r, g.sc, nv, hh * hh * fabs(g.beta - 1.0 / 6));
+      if (!isfinite(err)) err = 1e10;
+      if (getenv("GA_DEBUG")) {
+        int worst = 0; double wv = 0;
+        for (int i = 0; i < nv; i++) { double z = fabs((double)g.r[i] / (double)g.sc[i]); if (z > wv) { wv = z; worst = i; } }
+        fprintf(stderr, "ERR t=%g h=%g err=%g worst=%d sc=%g\n", s->t, hh, err, worst, (double)g.sc[worst]);
+      }
+      double fac = err > 0 ? 0.9 * pow(err, -1.0 / 3) : 2;
+      fac = fmin(2, fmax(0.2, fac));
+      if (err <= 1) {
+        memcpy(s->q, g.q1, sizeof(mb_real) * (size_t)nq);
+        memcpy(s->v, g.v1, sizeof(mb_real) * (size_t)nv);
+        memcpy(g.vd, g.x, sizeof(mb_real) * (size_t)nv);
+        memcpy(g.lam, g.x + nv, sizeof(mb_real) * (size_t)nc);
+        memcpy(g.a, g.a1, sizeof(mb_real) * (size_t)nv);
+        s->t = (hh == hmax) ? tout : s->t + hh;
+        s->stats.steps++;
+        h = fmin(hh * fac, set->max_step);
+        if (hh == hmax && hh < h) h = fmax(h, hh);
+        break;
+      }
+      s->stats.rejected++;
+      h = hh * fac;
+      if (h < set->min_step) {
+        st = mb_sim_fail(s, s->t, MB_ERR_STEP_TOO_SMALL, "generalized-alpha error control");
+        goto done;
+      }
+    }
+    if (set->stabilization == MB_STAB_BAUMGARTE) {
+      /* index-3 positions need no Baumgarte terms: plain normalization */
+      mb_model_normalize(m, s->q);
+    }
+    if ((st = mb_sim_finish_step(s, s->t))) goto done;
+  }
+done:
+  ga_free(&g);
+  return st;
+}
