@@ -39,7 +39,7 @@ static void usage(void) {
           "                [--real float|double]\n"
           "                [--integrator rk4|dopri5|genalpha|auto] [-o results.csv] [--plot out.png|none]\n"
           "                [--end T] [--output-step H] [--step H] [--max-step H] [--rtol R] [--atol A]\n"
-          "                [--stabilization projection|baumgarte|none] [--rho-inf R] [--quiet]\n"
+          "                [--stabilization projection|baumgarte|none] [--rho-inf R] [--max-steps N] [--quiet]\n"
           "       mbcc bench M.yaml [--scene S] [--csv FILE] [--reps N] [--paths a,b,...]\n"
           "                [--integrator rk4|dopri5] [--end T] [--rtol R] [--atol A] [--quiet]\n"
           "       mbcc modes M.yaml --body NAME [--scene S] [--shapes shapes.csv]\n"
@@ -83,7 +83,8 @@ static int parse_options(int argc, char **argv, options *o) {
     else if (!strcmp(a, "--solver") || !strcmp(a, "--integrator") || !strcmp(a, "--end") ||
              !strcmp(a, "--output-step") || !strcmp(a, "--step") || !strcmp(a, "--max-step") || !strcmp(a, "--rtol") ||
              !strcmp(a, "--atol") || !strcmp(a, "--stabilization") || !strcmp(a, "--columns") ||
-             !strcmp(a, "--csv") || !strcmp(a, "--reps") || !strcmp(a, "--paths") || !strcmp(a, "--rho-inf")) {
+             !strcmp(a, "--csv") || !strcmp(a, "--reps") || !strcmp(a, "--paths") || !strcmp(a, "--rho-inf") ||
+             !strcmp(a, "--max-steps")) {
       if (o->nsim + 2 > 30) { fprintf(stderr, "mbcc: error: too many options\n"); return 2; }
       o->sim_args[o->nsim++] = a;
       o->sim_args[o->nsim++] = v;

@@ -60,9 +60,9 @@ int mb_settings_option(mb_settings *set, const char *opt, const char *val, const
     else { fprintf(stderr, "%s: error: unknown stabilization '%s' (expected projection, baumgarte or none)\n", prog, val); return -1; }
     return 1;
   }
-  static const char *const names[] = {"--end", "--output-step", "--step", "--rtol", "--atol", "--max-step", "--rho-inf"};
-  double *fields[] = {&set->end_time, &set->output_step, &set->step, &set->rtol, &set->atol, &set->max_step, &set->rho_inf};
-  for (int k = 0; k < 7; k++) {
+  static const char *const names[] = {"--end", "--output-step", "--step", "--rtol", "--atol", "--max-step", "--rho-inf", "--max-steps"};
+  double *fields[] = {&set->end_time, &set->output_step, &set->step, &set->rtol, &set->atol, &set->max_step, &set->rho_inf, &set->max_steps};
+  for (int k = 0; k < 8; k++) {
     if (strcmp(opt, names[k])) continue;
     char *end;
     double x = strtod(val, &end);
@@ -85,7 +85,7 @@ static void usage(const char *prog) {
   fprintf(stderr,
           "usage: %s [-o results.csv] [--solver ldl|klu|dense] [--integrator rk4|dopri5|genalpha|auto]\n"
           "          [--end T] [--output-step H] [--step H] [--max-step H] [--rtol R] [--atol A]\n"
-          "          [--rho-inf R]\n"
+          "          [--rho-inf R] [--max-steps N]\n"
           "          [--stabilization projection|baumgarte|none] [--quiet]\n",
           prog);
 }

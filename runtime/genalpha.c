@@ -168,7 +168,6 @@ static int ga_newton(mb_sim *s, ga_work *g, double h, int *st, double *rate_out)
     error_weights(m, &s->set, s->q, g->q1, g->sc);
     double eta = weighted_rms(g->r, g->sc, nv, 1 / bp);
     if (it > 0) *rate_out = eta / fmax(eta_prev, 1e-300);
-    if (getenv("GA_DEBUG")) fprintf(stderr, "t=%g h=%g it=%d eta=%g\n", s->t, h, it, eta);
     eta_prev = eta;
     /* converged: the correction is far below the error tolerance, or it has
        stopped shrinking (round-off, e.g. in single precision) while already
@@ -207,6 +206,14 @@ int mb_genalpha_run(mb_sim *s, mb_output_fn out, void *user) {
   memcpy(g.a, g.vd, sizeof(mb_real) * (size_t)nv);
   while (1) {
     double tout = (double)iout * set->output_step;
+    if ((double)(s->stats.steps + s->stats.rejected) >= set->max_steps) {
+      s->fail_time = s->t;
+      snprintf(s->fail_detail, sizeof s->fail_detail,
+               "%ld steps (%ld rejected) reached max_steps %.3g at t = %.6g s (last step %.3g s)",
+               s->stats.steps, s->stats.rejected, set->max_steps, s->t, h);
+      st = MB_ERR_STEP_BUDGET;
+      goto done;
+    }
     if (fabs(s->t - tout) <= 1e-9 * set->output_step) {
       /* outputs from the index-1 accelerations of the (projected) state */
       if ((st = mb_sim_accel(s, s->t, s->q, s->v, g.vd_out, g.lam_out))) goto done;
@@ -245,11 +252,6 @@ int mb_genalpha_run(mb_sim *s, mb_output_fn out, void *user) {
       error_weights(m, set, s->q, g.q1, g.sc);
       double err = weighted_rms(g.r, g.sc, nv, hh * hh * fabs(g.beta - 1.0 / 6));
       if (!isfinite(err)) err = 1e10;
-      if (getenv("GA_DEBUG")) {
-        int worst = 0; double wv = 0;
-        for (int i = 0; i < nv; i++) { double z = fabs((double)g.r[i] / (double)g.sc[i]); if (z > wv) { wv = z; worst = i; } }
-        fprintf(stderr, "ERR t=%g h=%g err=%g worst=%d sc=%g\n", s->t, hh, err, worst, (double)g.sc[worst]);
-      }
       double fac = err > 0 ? 0.9 * pow(err, -1.0 / 3) : 2;
       fac = fmin(2, fmax(0.2, fac));
       if (err <= 1) {

@@ -32,6 +32,7 @@ void mb_settings_default(mb_settings *s) {
   s->projection_tol = 1e-10;
 #endif
   s->rho_inf = 0.8;
+  s->max_steps = 1e7;
 }
 
 int mb_sim_fail(mb_sim *s, double t, int status, const char *what) {
@@ -274,9 +275,29 @@ int mb_sim_run(mb_sim *s, mb_output_fn out, void *user) {
   double h = set->integrator == MB_RK4 ? set->step : fmin(set->step, set->max_step);
   long iout = 0;
 
+  if (set->integrator == MB_RK4) {
+    /* a fixed step the run cannot afford is refused before it starts, not after hours */
+    double need = ceil(set->output_step / set->step - 1e-9) * ceil(set->end_time / set->output_step - 1e-9);
+    if (need > set->max_steps) {
+      s->fail_time = 0;
+      snprintf(s->fail_detail, sizeof s->fail_detail,
+               "RK4 with step %.3g s needs %.3g steps to reach %.3g s, more than max_steps %.3g",
+               set->step, need, set->end_time, set->max_steps);
+      st = MB_ERR_STEP_BUDGET;
+      goto done;
+    }
+  }
   if (set->stabilization == MB_STAB_PROJECTION && (st = mb_sim_project(s, 0, s->q, s->v))) goto done;
   while (1) {
     double tout = (double)iout * set->output_step;
+    if ((double)(s->stats.steps + s->stats.rejected) >= set->max_steps) {
+      s->fail_time = s->t;
+      snprintf(s->fail_detail, sizeof s->fail_detail,
+               "%ld steps (%ld rejected) reached max_steps %.3g at t = %.6g s (last step %.3g s)",
+               s->stats.steps, s->stats.rejected, set->max_steps, s->t, h);
+      st = MB_ERR_STEP_BUDGET;
+      goto done;
+    }
     /* the stage-1 derivative at (t, y): also gives the outputs at output times */
     memcpy(s->y, s->q, sizeof(mb_real) * (size_t)nq);
     memcpy(s->y + nq, s->v, sizeof(mb_real) * (size_t)nv);

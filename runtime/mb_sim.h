@@ -21,6 +21,7 @@ typedef struct {
   double alpha, beta;         /* Baumgarte */
   double projection_tol;      /* max |phi| after projection */
   double rho_inf;             /* generalized-alpha: spectral radius at infinite step, 0..1 */
+  double max_steps;           /* stop with MB_ERR_STEP_BUDGET beyond this many steps */
 } mb_settings;
 
 typedef struct {

@@ -18,7 +18,8 @@ typedef enum {
   MB_ERR_PROJECTION = 4,      /* coordinate projection did not converge */
   MB_ERR_NOMEM = 5,           /* allocation failed (hosted runtime only) */
   MB_ERR_INVALID = 6,         /* invalid settings */
-  MB_ERR_NEWTON = 7           /* the implicit integrator's Newton iteration diverged */
+  MB_ERR_NEWTON = 7,          /* the implicit integrator's Newton iteration diverged */
+  MB_ERR_STEP_BUDGET = 8      /* the run needs more steps than settings.max_steps */
 } mb_status;
 
 #define MB_PI 3.14159265358979323846

@@ -13,6 +13,7 @@ const char *mb_status_text(int status) {
   case MB_ERR_NOMEM: return "out of memory";
   case MB_ERR_INVALID: return "invalid settings";
   case MB_ERR_NEWTON: return "Newton iteration did not converge";
+  case MB_ERR_STEP_BUDGET: return "more steps than the step budget (max_steps)";
   default: return "unknown error";
   }
 }
