@@ -16,6 +16,7 @@ typedef struct {
   void *work;
   double end_time, last_report, wall0;
   int progress;
+  int nonfinite;   /* 1 + the output column that was not finite, or 0 */
 } writer;
 
 static double wall(void) {
@@ -30,7 +31,7 @@ static int write_row(void *user, double t, const mb_real *q, const mb_real *v, c
   const mb_model *m = w->m;
   mb_model_outputs(m, t, q, v, vd, lambda, w->have_prev ? w->prev : NULL, w->out, w->work);
   for (int j = 0; j < m->ncols; j++)
-    if (!isfinite(w->out[j])) return 1; /* never print NaN as data */
+    if (!isfinite(w->out[j])) { w->nonfinite = j + 1; return 1; } /* never print NaN as data */
   fprintf(w->csv, "%.10g", t);
   for (int j = 0; j < m->ncols; j++) fprintf(w->csv, ",%.12g", w->out[j]);
   fputc('\n', w->csv);
@@ -43,6 +44,44 @@ static int write_row(void *user, double t, const mb_real *q, const mb_real *v, c
   }
   return 0;
 }
+
+#ifndef MB_REAL_FLOAT
+void dgesvd_(const char *jobu, const char *jobvt, const int *m, const int *n, double *a,
+             const int *lda, double *s, double *u, const int *ldu, double *vt, const int *ldvt,
+             double *work, const int *lwork, int *info);
+
+/* After a numerical failure: is the configuration where the run stopped a
+ * singular one (dead point, change point, lock-up)?  The singular values of
+ * the constraint Jacobian D at the last accepted state tell. */
+static void diagnose_configuration(mb_sim *sim, const char *prog) {
+  const mb_model *m = sim->m;
+  int nc = m->nc, nv = m->nv;
+  if (nc == 0) return;
+  double *D = calloc((size_t)nc * (size_t)nv, sizeof(double));
+  double *sv = calloc((size_t)(nc < nv ? nc : nv) + 1, sizeof(double));
+  int lwork = 8 * (nc + nv) + 64;
+  double *work = malloc(sizeof(double) * (size_t)lwork);
+  if (!D || !sv || !work) { free(D); free(sv); free(work); return; }
+  m->eval(m, sim->t, sim->q, sim->v, sim->Kx, sim->rhs, sim->phi, sim->nu, sim->work);
+  for (int j = 0; j < nv; j++)
+    for (int p = m->Kp[j]; p < m->Kp[j + 1]; p++)
+      if (m->Ki[p] >= nv) D[(size_t)(m->Ki[p] - nv) + (size_t)nc * (size_t)j] = sim->Kx[p];
+  int info = 0, one = 1;
+  dgesvd_("N", "N", &nc, &nv, D, &nc, sv, NULL, &one, NULL, &one, work, &lwork, &info);
+  int k = nc < nv ? nc : nv;
+  if (info == 0 && sv[0] > 0) {
+    double ratio = sv[k - 1] / sv[0];
+    if (ratio < 1e-6)
+      fprintf(stderr, "%s: note: at t = %.9g the constraint Jacobian is nearly singular (smallest/largest "
+              "singular value %.2g): a singular configuration (dead point, change point or lock-up)\n",
+              prog, sim->t, ratio);
+    else
+      fprintf(stderr, "%s: note: at t = %.9g the constraint Jacobian is regular (smallest/largest singular "
+              "value %.2g)\n", prog, sim->t, ratio);
+  }
+  free(D); free(sv); free(work);
+}
+#endif
 
 int mb_settings_option(mb_settings *set, const char *opt, const char *val, const char *prog) {
   if (!strcmp(opt, "--integrator")) {
@@ -169,16 +208,21 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
   int st = mb_sim_init(&sim, m, ls, &set);
   if (!st) st = mb_sim_run(&sim, write_row, &w);
   if (w.progress && wall() - w.wall0 > 1.0) fprintf(stderr, "\n");
-  int nonfinite_output = !st && sim.t < set.end_time * (1 - 1e-9);
+  int nonfinite_output = !st && w.nonfinite;
   fclose(w.csv);
   int rc = 0;
   if (st || nonfinite_output) {
     remove(tmp);
     if (nonfinite_output)
-      fprintf(stderr, "%s: error: at t = %.9g: non-finite output value; no results written\n", argv[0], sim.t);
+      fprintf(stderr, "%s: error: at t = %.9g: output '%s' is not finite; no results written\n", argv[0],
+              sim.t, m->col_name[w.nonfinite - 1]);
     else
       fprintf(stderr, "%s: error: at t = %.9g: %s; no results written\n", argv[0], sim.fail_time,
               sim.fail_detail[0] ? sim.fail_detail : mb_status_text(st));
+#ifndef MB_REAL_FLOAT
+    if (st != MB_ERR_STEP_BUDGET && st != MB_ERR_INVALID && st != MB_ERR_NOMEM && sim.q)
+      diagnose_configuration(&sim, argv[0]);
+#endif
     rc = 1;
   } else if (rename(tmp, csv_path)) {
     fprintf(stderr, "%s: error: cannot write '%s'\n", argv[0], csv_path);
@@ -202,6 +246,12 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
              s->newton_iterations, s->steps ? (double)s->newton_iterations / (double)s->steps : 0.0,
              s->newton_failures, set.rho_inf);
     printf("max |phi| at outputs %.3g\n", s->max_phi);
+    if (s->rcond_first > 0 && s->rcond_min < 1e-6 * s->rcond_first)
+      fprintf(stderr, "%s: warning: near t = %.9g the condition estimate of K fell to %.2g (%.2g at the "
+              "start): the run passed close to a singular configuration; check the results there\n",
+              argv[0], s->rcond_min_t, s->rcond_min, s->rcond_first);
+    if (!strcmp(ls->name, "ldl"))
+      printf("ldl residual after refinement: last %.3g, largest %.3g\n", ls->residual, ls->residual_max);
     printf("wrote %s (%d columns)\n", csv_path, m->ncols + 1);
   }
   mb_sim_free(&sim);

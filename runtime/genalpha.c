@@ -28,6 +28,7 @@ typedef struct {
   mb_real *Kmod, *r; /* iteration matrix, Newton right side / correction */
   mb_real *sc;       /* error weights of the velocity-space position coordinates */
   mb_real *vd_out, *lam_out;
+  const char *why; /* why the last Newton iteration failed */
 } ga_work;
 
 static void ga_free(ga_work *g) {
@@ -145,14 +146,14 @@ static int ga_newton(mb_sim *s, ga_work *g, double h, int *st, double *rate_out)
     for (int i = 0; i < nv; i++) g->r[i] = -g->r[i];
     for (int r = 0; r < nc; r++) g->r[nv + r] = (mb_real)(-bp * s->phi[r]);
     for (int i = 0; i < n; i++)
-      if (!isfinite((double)g->r[i])) return GA_DIVERGED;
+      if (!isfinite((double)g->r[i])) { g->why = "the residual is not finite"; return GA_DIVERGED; }
     /* a fresh iteration matrix at the first iterate and whenever the
        iterations slow down (modified Newton) */
     if (!factored || (it >= 2 && *rate_out > 0.25)) {
       iteration_matrix(m, s->Kx, 1 / bp, gp / bp, g->Kmod);
       s->factored_valid = 0; /* the solver now holds the iteration matrix */
       int fs = s->ls->factor(s->ls, g->Kmod);
-      if (fs) return GA_DIVERGED; /* singular at a wild iterate: a smaller step */
+      if (fs) { g->why = "the iteration matrix is singular"; return GA_DIVERGED; } /* a smaller step may help */
       factored = 1;
     }
     int ss = s->ls->solve(s->ls, g->r);
@@ -160,7 +161,7 @@ static int ga_newton(mb_sim *s, ga_work *g, double h, int *st, double *rate_out)
     s->stats.t_solve += mb_sim_clock() - t1;
     if (ss) { *st = ss; return GA_FAILED; }
     for (int i = 0; i < n; i++) {
-      if (!isfinite((double)g->r[i])) return GA_DIVERGED;
+      if (!isfinite((double)g->r[i])) { g->why = "the Newton correction is not finite"; return GA_DIVERGED; }
       g->x[i] += g->r[i];
     }
     s->stats.newton_iterations++;
@@ -177,8 +178,9 @@ static int ga_newton(mb_sim *s, ga_work *g, double h, int *st, double *rate_out)
       ga_predict(s, g, h);
       return GA_CONVERGED;
     }
-    if (stalled) return GA_DIVERGED;
+    if (stalled) { g->why = "the Newton corrections stopped shrinking"; return GA_DIVERGED; }
   }
+  g->why = "no convergence in 12 iterations";
   return GA_DIVERGED;
 }
 
@@ -240,8 +242,8 @@ int mb_genalpha_run(mb_sim *s, mb_output_fn out, void *user) {
         if (h < set->min_step) {
           s->fail_time = s->t;
           snprintf(s->fail_detail, sizeof s->fail_detail,
-                   "generalized-alpha: Newton iteration did not converge even with step %.3g s "
-                   "(stiffness outside the modal coordinates, or a singular configuration)", hh);
+                   "generalized-alpha: Newton did not converge even with step %.3g s: %s", hh,
+                   g.why ? g.why : "unknown");
           st = MB_ERR_NEWTON;
           goto done;
         }

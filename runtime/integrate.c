@@ -94,6 +94,10 @@ static int assemble_factor(mb_sim *s, double t, const mb_real *q, const mb_real 
   int st = s->ls->factor(s->ls, s->Kx);
   s->stats.t_solve += mb_sim_clock() - t1;
   if (st) { s->factored_valid = 0; return st; }
+  if (s->ls->rcond > 0) { /* watch for near-singular configurations */
+    if (s->stats.rcond_first == 0) s->stats.rcond_first = s->stats.rcond_min = s->ls->rcond;
+    if (s->ls->rcond < s->stats.rcond_min) { s->stats.rcond_min = s->ls->rcond; s->stats.rcond_min_t = t; }
+  }
   memcpy(s->qsave, q, sizeof(mb_real) * (size_t)m->nq);
   s->factored_valid = 1;
   return MB_OK;
@@ -335,6 +339,8 @@ int mb_sim_run(mb_sim *s, mb_output_fn out, void *user) {
       if ((st = mb_sim_finish_step(s, s->t))) goto done;
     } else {
       /* adaptive Dormand-Prince 5(4); steps end on output times */
+      char stage_failure[160] = ""; /* why a stage failed in this step's attempts */
+      double stage_failure_t = 0;
       for (;;) {
         double hh = fmin(h, hmax);
         if (hmax - hh < 1e-9 * set->output_step) hh = hmax;
@@ -343,6 +349,8 @@ int mb_sim_run(mb_sim *s, mb_output_fn out, void *user) {
           if ((st = deriv(s, s->t + DP_C[j] * hh, s->ytmp, s->k[j]))) {
             /* a failed stage (e.g. a singular matrix far from the path):
                retry with a smaller step before giving up */
+            snprintf(stage_failure, sizeof stage_failure, "%s", s->fail_detail);
+            stage_failure_t = s->fail_time;
             if (hh > 4 * set->min_step) { st = MB_OK; h = hh / 4; goto retry; }
             goto done;
           }
@@ -374,6 +382,12 @@ int mb_sim_run(mb_sim *s, mb_output_fn out, void *user) {
       retry:
         if (h < set->min_step) {
           st = mb_sim_fail(s, s->t, MB_ERR_STEP_TOO_SMALL, "adaptive step");
+          if (stage_failure[0]) {
+            char detail[sizeof s->fail_detail];
+            snprintf(detail, sizeof detail, "adaptive step fell below %.3g s; a stage failed: %.80s at t = %.9g",
+                     set->min_step, stage_failure, stage_failure_t);
+            memcpy(s->fail_detail, detail, sizeof detail);
+          }
           goto done;
         }
       }

@@ -30,6 +30,7 @@ typedef struct {
   long newton_iterations, newton_failures; /* generalized-alpha */
   double t_assembly, t_solve, t_total; /* seconds */
   double max_phi, max_phid;            /* largest constraint violations seen at outputs */
+  double rcond_first, rcond_min, rcond_min_t; /* KLU's condition estimate of K: first, smallest, when */
 } mb_stats;
 
 /* called at t = 0 and every output step; return nonzero to stop */

@@ -21,6 +21,9 @@ typedef struct mb_solver {
    * failed in the last factorization, or -1 (other solvers leave these 0) */
   double residual, residual_max;
   int bad_pivot;
+  /* klu: the reciprocal condition estimate of the last factorization
+     (min |u_ii| / max |u_ii|); 0 when the solver does not estimate it */
+  double rcond;
 } mb_solver;
 
 /* SuiteSparse KLU: analyze once, refactor per step, factor again (new pivots)

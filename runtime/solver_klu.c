@@ -20,6 +20,7 @@ static int full_factor(klu_solver *k) {
   if (!k->numeric || k->common.status != KLU_OK) return MB_ERR_SINGULAR;
   klu_rcond(k->symbolic, k->numeric, &k->common);
   k->rcond_full = k->common.rcond;
+  k->base.rcond = k->common.rcond;
   k->base.full_factorizations++;
   return MB_OK;
 }
@@ -32,8 +33,10 @@ static int klu_factor_fn(mb_solver *s, const mb_real *Kx) {
   /* same pivot order: refactor, unless it fails or the pivots degrade */
   if (klu_refactor(k->Ap, k->Ai, k->Ax, k->symbolic, k->numeric, &k->common) &&
       k->common.status == KLU_OK && klu_rcond(k->symbolic, k->numeric, &k->common) &&
-      k->common.rcond > 1e-3 * k->rcond_full)
+      k->common.rcond > 1e-3 * k->rcond_full) {
+    s->rcond = k->common.rcond;
     return MB_OK;
+  }
   return full_factor(k);
 }
 
