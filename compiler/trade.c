@@ -64,7 +64,7 @@ typedef struct {
 
 typedef struct {
   const char *model, *scene, *outputs, *csv, *plot, *workdir;
-  double max_error, end, ref_rtol;
+  double max_error, end, ref_rtol, output_step;
   int have_max_error, reps, quiet;
   char integrators[512], modes[256], couplings[128], joints[64], solvers[64], reals[64];
 } trade_options;
@@ -153,7 +153,7 @@ static void trade_usage(void) {
   fprintf(stderr,
           "usage: mbcc trade M.yaml [--scene S] [--outputs a,b,...] [--max-error E]\n"
           "                [--csv FILE] [--plot FILE.png|none] [--reps N] [--end T]\n"
-          "                [--integrators rk4@H,dopri5@R,genalpha@R,...] [--solvers ldl,klu,dense]\n"
+          "                [--output-step H] [--integrators rk4@H,dopri5@R,genalpha@R,...] [--solvers ldl,klu,dense]\n"
           "                [--modes all,N,FHz,...] [--couplings full,partial,constant,rigid]\n"
           "                [--joints direct,virtual] [--reals double,float]\n"
           "                [--ref-rtol R] [--workdir DIR] [--quiet]\n");
@@ -228,6 +228,8 @@ static int parse_trade_options(int argc, char **argv, trade_options *o) {
       o->have_max_error = 1;
     } else if (!strcmp(a, "--end")) {
       if (positive_number(a, v, &o->end)) return 2;
+    } else if (!strcmp(a, "--output-step")) {
+      if (positive_number(a, v, &o->output_step)) return 2;
     } else if (!strcmp(a, "--ref-rtol")) {
       if (positive_number(a, v, &o->ref_rtol)) return 2;
       if (o->ref_rtol < 1e-13) { fprintf(stderr, "mbcc: error: --ref-rtol below 1e-13 leaves no room for the stricter run\n"); return 2; }
@@ -333,7 +335,8 @@ static void last_error_line(const char *log, char *why, size_t n) {
   while (fgets(line, sizeof line, f))
     if (strstr(line, "error")) {
       line[strcspn(line, "\r\n")] = 0;
-      textf(why, n, "%s", line);
+      const char *sim = strstr(line, "_sim: error: "); /* without the simulator's path */
+      textf(why, n, "%s", sim ? sim + 5 : line);
     }
   fclose(f);
 }
@@ -471,7 +474,8 @@ static void sim_num(sim_args *a, const char *opt, double x) {
 }
 
 /* Run the simulator reps times; CSV to csv.  0, or 1 with the reason in why. */
-static int simulate(const char *exe, const integ_setting *s, const char *solver, double end, double max_step,
+static int simulate(const char *exe, const integ_setting *s, const char *solver, double end, double output_step,
+                    double max_step,
                     int reps, const char *csv, const char *log, double *cpu_median, char *why, size_t nwhy) {
   sim_args a = {0};
   sim_arg(&a, (char *)exe);
@@ -488,6 +492,7 @@ static int simulate(const char *exe, const integ_setting *s, const char *solver,
     sim_num(&a, "--atol", s->value * 1e-2);
   }
   if (end > 0) sim_num(&a, "--end", end);
+  if (output_step > 0) sim_num(&a, "--output-step", output_step);
   if (max_step > 0) sim_num(&a, "--max-step", max_step);
   a.argv[a.n] = NULL;
   double times[100];
@@ -675,7 +680,7 @@ int cmd_trade(int argc, char **argv) {
     if (model_coupling < 0) model_coupling = (int)fx->coupling;
   }
   for (int j = 0; j < ir->njoints; j++) model_virtual |= ir->joints[j].via_virtual;
-  double output_step = ir->sim.output_step;
+  double output_step = o.output_step > 0 ? o.output_step : ir->sim.output_step;
   lower_free(L);
   ir_free(ir);
 
@@ -794,8 +799,8 @@ int cmd_trade(int argc, char **argv) {
   remove(ref_log);
   integ_setting ref_set = {"dopri5", o.ref_rtol}, strict_set = {"dopri5", o.ref_rtol * 1e-2};
   double ref_cpu = 0, strict_cpu = 0;
-  if (simulate(ref->exe, &ref_set, "klu", o.end, 0, 1, ref_csv, ref_log, &ref_cpu, why, sizeof why) ||
-      simulate(ref->exe, &strict_set, "klu", o.end, output_step / 2, 1, strict_csv, ref_log, &strict_cpu, why, sizeof why)) {
+  if (simulate(ref->exe, &ref_set, "klu", o.end, o.output_step, 0, 1, ref_csv, ref_log, &ref_cpu, why, sizeof why) ||
+      simulate(ref->exe, &strict_set, "klu", o.end, o.output_step, output_step / 2, 1, strict_csv, ref_log, &strict_cpu, why, sizeof why)) {
     fprintf(stderr, "mbcc: error: the reference run failed: %s (see %s)\n", why, ref_log);
     return 1;
   }
@@ -885,7 +890,7 @@ int cmd_trade(int argc, char **argv) {
     snprintf(run_csv, sizeof run_csv, "%s/%s/run%d.csv", workdir, v->label, k + 1);
     snprintf(run_log, sizeof run_log, "%s/%s/run%d.log", workdir, v->label, k + 1);
     remove(run_log);
-    if (simulate(v->exe, &I[r->i], r->solver, o.end, 0, o.reps, run_csv, run_log, &r->cpu, r->why, sizeof r->why) ||
+    if (simulate(v->exe, &I[r->i], r->solver, o.end, o.output_step, 0, o.reps, run_csv, run_log, &r->cpu, r->why, sizeof r->why) ||
         compare_run(run_csv, &reft, sel, nsel, refy, scale, &r->err, r->why, sizeof r->why)) {
       r->failed = 1;
       r->cpu = NAN;
