@@ -15,7 +15,7 @@ CC_SRC  := compiler/main.c compiler/reader.c compiler/diag.c compiler/lower.c co
 CC_HDR  := $(wildcard compiler/*.h)
 B       ?= build
 
-.PHONY: all test demo clean sanitize docs bench
+.PHONY: all test demo clean sanitize docs bench trade
 all: $(B)/mbcc $(B)/libmbrt.a
 
 $(B)/rt/%.o: runtime/%.c $(RT_HDR)
@@ -36,6 +36,10 @@ demo: all
 # the timing comparison of every path (scripts/bench.sh): writes docs/benchmarks.md
 bench: all
 	MBCC=$(B)/mbcc sh scripts/bench.sh
+
+# the speed/accuracy study (scripts/trade.sh): writes docs/trade.md and docs/img/trade_*.png
+trade: all
+	MBCC=$(B)/mbcc sh scripts/trade.sh
 
 include tests/tests.mk
 include docs/results.mk

@@ -64,8 +64,8 @@ typedef struct {
 
 typedef struct {
   const char *model, *scene, *outputs, *csv, *plot, *workdir;
-  double max_error, end, ref_rtol, output_step;
-  int have_max_error, reps, quiet;
+  double max_error[8], end, ref_rtol, output_step;
+  int nmax_error, reps, quiet;
   char integrators[512], modes[256], couplings[128], joints[64], solvers[64], reals[64];
 } trade_options;
 
@@ -151,7 +151,7 @@ static double *pick_columns(const table *tb, const int *sel, int nsel, int nrows
 
 static void trade_usage(void) {
   fprintf(stderr,
-          "usage: mbcc trade M.yaml [--scene S] [--outputs a,b,...] [--max-error E]\n"
+          "usage: mbcc trade M.yaml [--scene S] [--outputs a,b,...] [--max-error E[,E2,...]]\n"
           "                [--csv FILE] [--plot FILE.png|none] [--reps N] [--end T]\n"
           "                [--output-step H] [--integrators rk4@H,dopri5@R,genalpha@R,...] [--solvers ldl,klu,dense]\n"
           "                [--modes all,N,FHz,...] [--couplings full,partial,constant,rigid]\n"
@@ -224,8 +224,16 @@ static int parse_trade_options(int argc, char **argv, trade_options *o) {
     else if (!strcmp(a, "--plot")) o->plot = v;
     else if (!strcmp(a, "--workdir")) o->workdir = v;
     else if (!strcmp(a, "--max-error")) {
-      if (positive_number(a, v, &o->max_error)) return 2;
-      o->have_max_error = 1;
+      /* one target or a comma-separated list */
+      char buf[256];
+      snprintf(buf, sizeof buf, "%s", v);
+      char *save = NULL;
+      o->nmax_error = 0;
+      for (char *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        if (o->nmax_error == 8) { fprintf(stderr, "mbcc: error: --max-error: at most 8 targets\n"); return 2; }
+        if (positive_number(a, tok, &o->max_error[o->nmax_error++])) return 2;
+      }
+      if (!o->nmax_error) { fprintf(stderr, "mbcc: error: --max-error needs a value\n"); return 2; }
     } else if (!strcmp(a, "--end")) {
       if (positive_number(a, v, &o->end)) return 2;
     } else if (!strcmp(a, "--output-step")) {
@@ -336,7 +344,7 @@ static void last_error_line(const char *log, char *why, size_t n) {
     if (strstr(line, "error")) {
       line[strcspn(line, "\r\n")] = 0;
       const char *sim = strstr(line, "_sim: error: "); /* without the simulator's path */
-      textf(why, n, "%s", sim ? sim + 5 : line);
+      textf(why, n, "%s", sim ? sim + 6 : line);
     }
   fclose(f);
 }
@@ -926,17 +934,19 @@ int cmd_trade(int argc, char **argv) {
     else printf("  %-9.3g  %-9.3e  %-9.3e\n", r->cpu, r->err.max_err, r->err.rms_err);
   }
   printf("(* on the Pareto front: no other run is both faster and more accurate)\n");
-  if (o.have_max_error) {
-    int best = trade_cheapest(cpu, err, failed, nrun, o.max_error);
-    if (best < 0) printf("\nno run meets max_err <= %.3g (reference error %.3e)\n", o.max_error, ref_err.max_err);
+  for (int t = 0; t < o.nmax_error; t++) {
+    double target = o.max_error[t];
+    int best = trade_cheapest(cpu, err, failed, nrun, target);
+    if (t == 0) printf("\n");
+    if (best < 0) printf("max_err <= %.3g: no run meets it\n", target);
     else {
       char s[300];
       run_settings(V, I, &R[best], s, sizeof s);
-      printf("\ncheapest meeting max_err <= %.3g: run %d: %s: %.3g s CPU, max_err %.3e\n", o.max_error, best + 1, s,
+      printf("max_err <= %.3g: cheapest is run %d: %s: %.3g s CPU, max_err %.3e\n", target, best + 1, s,
              R[best].cpu, R[best].err.max_err);
     }
-    if (o.max_error < ref_err.max_err)
-      printf("warning: the target %.3g is below the reference's own error %.3e: tighten --ref-rtol\n", o.max_error,
+    if (target < ref_err.max_err)
+      printf("warning: the target %.3g is below the reference's own error %.3e: tighten --ref-rtol\n", target,
              ref_err.max_err);
   }
   int st = write_csv(csv, V, I, R, nrun);
