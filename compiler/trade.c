@@ -469,13 +469,13 @@ static int cmp_double(const void *a, const void *b) {
 /* the simulator's arguments for integrator setting s (rtol/atol or step), solver, end, extra */
 typedef struct {
   char *argv[32];
-  int n;
+  int n, nbuf;
   char buf[8][64];
 } sim_args;
 
 static void sim_arg(sim_args *a, const char *s) { a->argv[a->n++] = (char *)s; }
 static void sim_num(sim_args *a, const char *opt, double x) {
-  int k = a->n / 2 % 8;
+  int k = a->nbuf++ % 8; /* at most 5 numbers per run */
   snprintf(a->buf[k], sizeof a->buf[k], "%.6g", x);
   sim_arg(a, opt);
   sim_arg(a, a->buf[k]);
@@ -714,7 +714,7 @@ int cmd_trade(int argc, char **argv) {
   add_variant(V, &nv, "base");
   int ref_modes = -2; /* the reference's: the largest count swept, or all */
   double ref_cutoff = 0;
-  if (nflex && o.modes[0]) {
+  if (o.modes[0]) { /* checked even for a model without flexible bodies (then no variants) */
     char buf[256];
     snprintf(buf, sizeof buf, "%s", o.modes);
     char *save = NULL;
@@ -740,6 +740,7 @@ int cmd_trade(int argc, char **argv) {
         snprintf(label, sizeof label, "modes-%d", modes);
         if (modes == model_count) continue; /* that is the base */
       }
+      if (!nflex) continue;
       variant *v = add_variant(V, &nv, label);
       if (!v) { fprintf(stderr, "mbcc: error: too many variants\n"); return 2; }
       v->modes = modes;
