@@ -46,7 +46,8 @@ static void usage(void) {
           "                [--write-modal body.modal.yaml]\n"
           "       mbcc plot results.csv [-o out.png] [--columns a,b,...]\n"
           "       mbcc trade M.yaml [--scene S] [--outputs a,b,...] [--max-error E] [--csv FILE]\n"
-          "                [--plot FILE.png|none] [--reps N] [--end T] [--integrators rk4@H,dopri5@R,...]\n"
+          "                [--plot FILE.png|none] [--reps N] [--end T] [--output-step H]\n"
+          "                [--integrators rk4@H,dopri5@R,...]\n"
           "                [--modes all,N,FHz,...] [--couplings ...] [--joints ...] [--solvers ...]\n"
           "                [--reals double,float] [--ref-rtol R] [--workdir DIR] [--quiet]\n");
 }

@@ -890,7 +890,7 @@ int cmd_trade(int argc, char **argv) {
   const char *solver_names[] = {"ldl", "klu", "dense"};
   for (int v = 0; v < nv; v++) {
     if (&V[v] == ref) continue;
-    if (v == 0 && !base_double) continue;
+    if (!V[v].real_float && !base_double) continue; /* --reals float: only the float runs */
     for (int s = 0; s < 3; s++) {
       if (!in_list(solvers, solver_names[s])) continue;
       int first_solver = 1;
