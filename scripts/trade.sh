@@ -180,6 +180,13 @@ Two runs with the same time and error are both on it.
 (a precision target first, then CPU time), or "no run meets it". A target below the
 reference's own error is flagged: tighten `--ref-rtol`.
 
+**Reading the results.** An error that does not fall when the tolerance is tightened is
+the model's, not the integrator's: modes left out, a simpler coupling, or the
+reference's extra modes. RK4 near its stability limit damps the highest modes, which
+can bring a truncated model closer to the reference (slider-crank: `base` with RK4 at
+5e-5 against 1.25e-5); such a point on the front is luck of this model, not a method.
+Times below about 0.05 s are within the noise of a shared machine.
+
 **Output.** The table on stdout, `--csv FILE` (one row per run: `run, variant, modes,
 coupling, joints, real, integrator, step, rtol, solver, cpu_s, max_err, rms_err, failed,
 pareto, note`; written through a temporary file), and `--plot FILE.png` (default next to
