@@ -124,7 +124,7 @@ times the CPU time per simulated second). What that leaves out was measured once
 `mbcc trade models/slider_crank_flexible.yaml --modes all --end 0.02 --integrators
 rk4@5e-5,dopri5@1e-4,dopri5@1e-6 --couplings full --joints direct --reals double
 --solvers ldl --reps 1` (6 minutes): the 14-mode reference differs from the 48-mode one by
-1.8e-2 in total energy (the strain energy of high modes that the start excites), 1.8e-3 in
+1.8e-2 in total energy (the output slowest to converge in the number of modes), 1.8e-3 in
 the midspan deflection, 4e-5 in the slider position and nothing in the (driven) crank
 angle, relative to each output's range over 0.02 s. Error targets below those are
 targets against the 14-mode model; add `all` to `--modes` to measure against every mode.
