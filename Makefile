@@ -10,11 +10,12 @@ RT_SRC  := runtime/model_generic.c runtime/solver_select.c runtime/genalpha.c ru
            runtime/integrate.c runtime/driver.c runtime/ida.c runtime/bench.c
 RT_HDR  := $(wildcard runtime/*.h)
 CC_SRC  := compiler/main.c compiler/reader.c compiler/diag.c compiler/lower.c compiler/fe.c compiler/flex.c \
-           compiler/assemble.c compiler/emit.c compiler/order.c compiler/emit_ldl.c
+           compiler/assemble.c compiler/emit.c compiler/order.c compiler/emit_ldl.c \
+           compiler/trade.c compiler/trade_metric.c
 CC_HDR  := $(wildcard compiler/*.h)
 B       ?= build
 
-.PHONY: all test demo clean sanitize docs bench
+.PHONY: all test demo clean sanitize docs bench trade extremes
 all: $(B)/mbcc $(B)/libmbrt.a $(B)/libmbrt_float.a
 
 $(B)/rt/%.o: runtime/%.c $(RT_HDR)
@@ -46,6 +47,14 @@ demo: all
 # the timing comparison of every path (scripts/bench.sh): writes docs/benchmarks.md
 bench: all
 	MBCC=$(B)/mbcc sh scripts/bench.sh
+
+# the speed/accuracy study (scripts/trade.sh): writes docs/trade.md and docs/img/trade_*.png
+trade: all
+	MBCC=$(B)/mbcc sh scripts/trade.sh
+
+# the stability suite at the extremes (tests/extremes/run.sh): writes docs/stability.md
+extremes: all
+	MBCC=$(B)/mbcc bash tests/extremes/run.sh
 
 include tests/tests.mk
 include docs/results.mk

@@ -1,4 +1,4 @@
-/* main.c: the mbcc command line: check, compile, run, bench, modes, plot. */
+/* main.c: the mbcc command line: check, compile, run, bench, modes, plot, trade. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <math.h>
@@ -15,6 +15,7 @@
 #include "lower.h"
 #include "mb_driver.h"
 #include "order.h"
+#include "trade.h"
 
 #ifndef MBCC_ROOT
 #define MBCC_ROOT "."
@@ -44,7 +45,12 @@ static void usage(void) {
           "                [--integrator rk4|dopri5] [--end T] [--rtol R] [--atol A] [--quiet]\n"
           "       mbcc modes M.yaml --body NAME [--scene S] [--shapes shapes.csv]\n"
           "                [--write-modal body.modal.yaml]\n"
-          "       mbcc plot results.csv [-o out.png] [--columns a,b,...]\n");
+          "       mbcc plot results.csv [-o out.png] [--columns a,b,...]\n"
+          "       mbcc trade M.yaml [--scene S] [--outputs a,b,...] [--max-error E] [--csv FILE]\n"
+          "                [--plot FILE.png|none] [--reps N] [--end T] [--output-step H]\n"
+          "                [--integrators rk4@H,dopri5@R,...]\n"
+          "                [--modes all,N,FHz,...] [--couplings ...] [--joints ...] [--solvers ...]\n"
+          "                [--reals double,float] [--ref-rtol R] [--workdir DIR] [--quiet]\n");
 }
 
 typedef struct {
@@ -255,7 +261,7 @@ static int cmd_compile(const options *o, char *dir_out, size_t n, lmodel **Lp, i
   return st;
 }
 
-static int run_command(char *const argv[]) {
+int run_command(char *const argv[]) {
   fflush(stdout);
   fflush(stderr);
   pid_t pid = fork();
@@ -324,8 +330,8 @@ static void settings_from_ir(const ir_sim *s, mb_settings *set) {
 
 /* cc the generated model DIR/NAME.c and the main program 'main_src' against the
  * runtime library into 'exe'; 'extra' are more libraries (NULL-terminated) */
-static int compile_generated(const char *dir, const char *name, const char *main_src,
-                             const char *exe, char *const extra[], int quiet, int real_float) {
+int compile_generated(const char *dir, const char *name, const char *main_src, const char *exe,
+                      char *const extra[], int quiet, int real_float) {
   char src_c[8400], inc[8400], lib[8400];
   snprintf(src_c, sizeof src_c, "%s/%s.c", dir, name);
   snprintf(inc, sizeof inc, "-I%s/runtime", root_dir());
@@ -482,6 +488,7 @@ int main(int argc, char **argv) {
   }
   const char *cmd = argv[1];
   options o;
+  if (!strcmp(cmd, "trade")) return cmd_trade(argc, argv);
   if (!strcmp(cmd, "plot")) {
     if (parse_options(argc, argv, &o)) return 2;
     char png[4096];

@@ -1,0 +1,20 @@
+/* trade.h: `mbcc trade`, the speed/accuracy study of one model (trade.c), and
+ * the two helpers of main.c that it shares with `mbcc run`. */
+#ifndef MBCC_TRADE_H
+#define MBCC_TRADE_H
+
+/* mbcc trade M.yaml [options]: argv as given to mbcc (argv[1] is "trade").
+ * Returns 0, 1 if the study could not be completed (e.g. the reference
+ * failed), 2 on bad input. */
+int cmd_trade(int argc, char **argv);
+
+/* main.c: run argv[0] (PATH search), wait; its exit status, 128 if killed, -1
+ * if it could not be started */
+int run_command(char *const argv[]);
+/* main.c: cc the generated model DIR/NAME.c and main_src against the runtime
+ * library (real_float: the single-precision one, libmbrt_float.a) into exe;
+ * 'extra' more arguments (NULL-terminated) */
+int compile_generated(const char *dir, const char *name, const char *main_src, const char *exe,
+                      char *const extra[], int quiet, int real_float);
+
+#endif

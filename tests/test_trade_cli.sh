@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# test_trade_cli.sh: `mbcc trade` on the command line (exit 0 = pass):
+#   - bad input (unknown output, unknown scene, bad numbers, unknown values,
+#     unknown option) is an "error:" with exit status 2 and leaves no CSV;
+#   - an integrator the simulator does not know (as genalpha before it is
+#     merged) gives runs reported failed (failed = 1, empty errors, a reason,
+#     never on the front) while the study completes with exit 0; so does a
+#     single-precision build while there is none;
+#   - the CSV has one row per run with the documented columns, at least one
+#     run on the front, and the plot is written.
+# Runs in a scratch directory.  Environment: MBCC (default build/mbcc).
+set -u
+cd "$(dirname "$0")/.."
+root=$(pwd)
+MBCC=${MBCC:-build/mbcc}
+case $MBCC in /*) ;; *) MBCC="$root/$MBCC" ;; esac
+[ -x "$MBCC" ] || { echo "no mbcc at $MBCC"; exit 1; }
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+cd "$tmp" || exit 1
+fail=0
+err() { echo "FAIL: $*"; fail=1; }
+pend="$root/models/pendulum.yaml"
+
+# 1. bad input: exit 2, an error message, no CSV
+bad() {
+  "$MBCC" trade "$@" --csv "$tmp/bad.csv" --workdir "$tmp/w" --quiet >out.txt 2>err.txt
+  st=$?
+  [ $st = 2 ] || err "mbcc trade $* exited $st, expected 2"
+  grep -q "error:" err.txt || err "mbcc trade $*: no 'error:' message ($(cat err.txt))"
+  [ ! -e "$tmp/bad.csv" ] || err "mbcc trade $*: wrote a CSV"
+  rm -f "$tmp/bad.csv"
+}
+bad "$pend" --outputs angle,nosuch
+bad "$pend" --scene nosuch
+bad "$pend" --reps 0
+bad "$pend" --reps 2.5
+bad "$pend" --end -1
+bad "$pend" --max-error abc
+bad "$pend" --integrators dopri5
+bad "$pend" --integrators dopri5@x
+bad "$pend" --solvers ldl,lu
+bad "$pend" --couplings stiff
+bad "$pend" --modes two
+bad "$pend" --frobnicate 1
+bad "$root/models/nosuch.yaml"
+
+# 2. failures are rows, not aborts
+if "$MBCC" trade "$pend" --outputs angle,omega --end 1 --reps 1 --integrators rk4@0.01,dopri5@1e-6,nosuch@1e-6 \
+    --solvers ldl --reals double,float --csv "$tmp/t.csv" --workdir "$tmp/w" --max-error 1e-3 --quiet >out.txt 2>err.txt; then
+  head -1 t.csv | grep -q '^run,variant,modes,coupling,joints,real,integrator,step,rtol,solver,cpu_s,max_err,rms_err,failed,pareto,note$' \
+    || err "CSV header: $(head -1 t.csv)"
+  rows=$(($(wc -l <t.csv) - 1))
+  [ "$rows" = 6 ] || err "expected 6 runs (3 integrators x double, float), got $rows"
+  awk -F, 'NR > 1 && $7 == "nosuch" && !($14 == 1 && $12 == "" && $15 == 0) { bad = 1 } END { exit bad }' t.csv \
+    || err "the unknown integrator's runs are not failed rows without errors"
+  # float runs fail while there is no single-precision build, and succeed after: either way
+  # a failed row has no errors, a reason, and is not on the front
+  awk -F, 'NR > 1 && $14 == 1 && !($11 == "" && $12 == "" && $13 == "" && $15 == 0 && $16 != "") { bad = 1 }
+           NR > 1 && $14 == 0 && !($11 > 0 && $12 != "" && $13 != "") { bad = 1 } END { exit bad }' t.csv \
+    || err "a failed row with errors or without a reason, or a successful row without errors"
+  awk -F, 'NR > 1 && $6 == "double" && $7 != "nosuch" && !($14 == 0 && $12 != "" && $11 > 0) { bad = 1 } END { exit bad }' t.csv \
+    || err "the rk4 and dopri5 runs did not succeed"
+  [ "$(awk -F, 'NR > 1 && $15 == 1' t.csv | wc -l)" -ge 1 ] || err "no run on the Pareto front"
+  grep -q '^reference error: max_err ' out.txt || err "no reference error line"
+  grep -q '^max_err <= 0.001: cheapest is run ' out.txt || err "no cheapest run for 1e-3: $(cat out.txt)"
+  [ -s t.png ] || err "no plot t.png"
+else
+  err "mbcc trade with failing runs exited $?: $(tail -5 err.txt)"
+fi
+exit $fail
