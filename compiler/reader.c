@@ -173,6 +173,7 @@ typedef struct {
   bool *joint_off, *driver_off, *force_off;
   ir_sim sim;
   yaml_node_t *jof_list;
+  ir_flex **flex;   /* per body: the scene's modal settings, or NULL */
 } chosen_scene;
 
 typedef struct {
@@ -1237,6 +1238,69 @@ static void parse_beam_properties(reader *r, mapping *body, ir_beam *proto) {
  * modal data file, with reference conditions, mode selection, damping and
  * coupling.  Node positions are global at t = 0; they are stored in body axes
  * relative to the body frame origin. */
+/* The modal settings of a flexible body (a body definition or a scene's
+ * override): 'modes', 'damping', 'coupling'.  Only the keys given change fx. */
+static void parse_modal_settings(mapping *m, ir_flex *fx) {
+  reader *r = m->r;
+  int c;
+  if (get_choice(m, "coupling", "coupling", coupling_names, false, &c)) fx->coupling = (ir_coupling)c;
+  /* mode selection */
+  yaml_node_t *modes = map_get(m, "modes");
+  if (modes != NULL) {
+    if (modes->type == YAML_SCALAR_NODE && scalar_equals(modes, "all")) {
+      fx->select = MODES_ALL;
+    } else if (modes->type == YAML_SCALAR_NODE) {
+      double k;
+      if (to_number(r, modes, "'modes'", &k)) {
+        if (k != floor(k) || k < 1) error_at(r, loc_of(modes), "'modes' must be a positive whole number, 'all' or a mapping (got %g)", k);
+        fx->select = MODES_COUNT;
+        fx->count = (int)k;
+      }
+    } else {
+      mapping mm;
+      if (map_open(&mm, r, modes, loc_of(modes), "'modes' of %s", m->what)) {
+        static const char *const mkeys[] = {"count", "max_frequency", "list", NULL};
+        map_check_keys(&mm, mkeys);
+        double v;
+        if (map_has(&mm, "count") + map_has(&mm, "max_frequency") + map_has(&mm, "list") != 1)
+          error_at(r, loc_of(modes), "'modes' takes exactly one of 'count', 'max_frequency', 'list'");
+        if (get_positive(&mm, "count", false, &v)) { fx->select = MODES_COUNT; fx->count = (int)v; }
+        if (get_positive(&mm, "max_frequency", false, &v)) { fx->select = MODES_MAX_FREQUENCY; fx->max_frequency = v; }
+        yaml_node_t *l = map_get(&mm, "list");
+        if (l != NULL) {
+          fx->select = MODES_LIST;
+          fx->list = to_node_list(r, l, "'list' of modes", -1, &fx->nlist);
+          for (int i = 0; i < fx->nlist; i++)
+            if (fx->list[i] < 1) error_at(r, loc_of(l), "mode numbers start at 1");
+        }
+      }
+      map_close(&mm);
+    }
+  }
+  /* modal damping */
+  yaml_node_t *damp = map_get(m, "damping");
+  if (damp != NULL) {
+    if (damp->type == YAML_SCALAR_NODE && scalar_equals(damp, "bands")) {
+      fx->damping = DAMPING_BANDS;
+    } else if (damp->type == YAML_SCALAR_NODE && scalar_equals(damp, "none")) {
+      fx->damping = DAMPING_NONE;
+    } else if (damp->type == YAML_SEQUENCE_NODE) {
+      fx->damping = DAMPING_LIST;
+      fx->nratios = seq_length(damp);
+      fx->ratios = xcalloc((size_t)fx->nratios + 1, sizeof *fx->ratios);
+      for (int i = 0; i < fx->nratios; i++) {
+        char label[64];
+        snprintf(label, sizeof label, "item %d of 'damping'", i + 1);
+        if (to_number(r, seq_item(r, damp, i), label, &fx->ratios[i]) && fx->ratios[i] < 0)
+          error_at(r, loc_of(seq_item(r, damp, i)), "%s must be >= 0", label);
+      }
+    } else if (to_number(r, damp, "'damping' (a ratio, 'bands', 'none' or a list)", &fx->ratio)) {
+      fx->damping = DAMPING_RATIO;
+      if (fx->ratio < 0) error_at(r, loc_of(damp), "'damping' must be >= 0 (got %g)", fx->ratio);
+    }
+  }
+}
+
 static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
   reader *r = m->r;
   (void)type_loc;
@@ -1256,9 +1320,6 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
   if (orientation != NULL) parse_orientation(r, orientation, m->what, b->orientation);
   get_vector(m, "velocity", 3, false, b->velocity);
   get_vector(m, "angular_velocity", 3, false, b->angular_velocity);
-  int c;
-  if (get_choice(m, "coupling", "coupling", coupling_names, false, &c)) fx->coupling = (ir_coupling)c;
-
   yaml_node_t *modal_file = map_get(m, "modal_file");
   yaml_node_t *line = map_get(m, "line"), *nodes = map_get(m, "nodes");
   double *global = NULL; /* node positions, global */
@@ -1471,61 +1532,7 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
     free(global);
   }
 
-  /* mode selection */
-  yaml_node_t *modes = map_get(m, "modes");
-  if (modes != NULL) {
-    if (modes->type == YAML_SCALAR_NODE && scalar_equals(modes, "all")) {
-      fx->select = MODES_ALL;
-    } else if (modes->type == YAML_SCALAR_NODE) {
-      double k;
-      if (to_number(r, modes, "'modes'", &k)) {
-        if (k != floor(k) || k < 1) error_at(r, loc_of(modes), "'modes' must be a positive whole number, 'all' or a mapping (got %g)", k);
-        fx->select = MODES_COUNT;
-        fx->count = (int)k;
-      }
-    } else {
-      mapping mm;
-      if (map_open(&mm, r, modes, loc_of(modes), "'modes' of %s", m->what)) {
-        static const char *const mkeys[] = {"count", "max_frequency", "list", NULL};
-        map_check_keys(&mm, mkeys);
-        double v;
-        if (map_has(&mm, "count") + map_has(&mm, "max_frequency") + map_has(&mm, "list") != 1)
-          error_at(r, loc_of(modes), "'modes' takes exactly one of 'count', 'max_frequency', 'list'");
-        if (get_positive(&mm, "count", false, &v)) { fx->select = MODES_COUNT; fx->count = (int)v; }
-        if (get_positive(&mm, "max_frequency", false, &v)) { fx->select = MODES_MAX_FREQUENCY; fx->max_frequency = v; }
-        yaml_node_t *l = map_get(&mm, "list");
-        if (l != NULL) {
-          fx->select = MODES_LIST;
-          fx->list = to_node_list(r, l, "'list' of modes", -1, &fx->nlist);
-          for (int i = 0; i < fx->nlist; i++)
-            if (fx->list[i] < 1) error_at(r, loc_of(l), "mode numbers start at 1");
-        }
-      }
-      map_close(&mm);
-    }
-  }
-  /* modal damping */
-  yaml_node_t *damp = map_get(m, "damping");
-  if (damp != NULL) {
-    if (damp->type == YAML_SCALAR_NODE && scalar_equals(damp, "bands")) {
-      fx->damping = DAMPING_BANDS;
-    } else if (damp->type == YAML_SCALAR_NODE && scalar_equals(damp, "none")) {
-      fx->damping = DAMPING_NONE;
-    } else if (damp->type == YAML_SEQUENCE_NODE) {
-      fx->damping = DAMPING_LIST;
-      fx->nratios = seq_length(damp);
-      fx->ratios = xcalloc((size_t)fx->nratios + 1, sizeof *fx->ratios);
-      for (int i = 0; i < fx->nratios; i++) {
-        char label[64];
-        snprintf(label, sizeof label, "item %d of 'damping'", i + 1);
-        if (to_number(r, seq_item(r, damp, i), label, &fx->ratios[i]) && fx->ratios[i] < 0)
-          error_at(r, loc_of(seq_item(r, damp, i)), "%s must be >= 0", label);
-      }
-    } else if (to_number(r, damp, "'damping' (a ratio, 'bands', 'none' or a list)", &fx->ratio)) {
-      fx->damping = DAMPING_RATIO;
-      if (fx->ratio < 0) error_at(r, loc_of(damp), "'damping' must be >= 0 (got %g)", fx->ratio);
-    }
-  }
+  parse_modal_settings(m, fx);
 }
 
 /* global position of node k of flexible body b */
@@ -2565,6 +2572,69 @@ static void parse_deactivate(reader *r, yaml_node_t *n, bool *joint_off, bool *d
   }
 }
 
+static void free_scene_flex(ir_flex **flex, int nbodies) {
+  if (!flex) return;
+  for (int b = 0; b < nbodies; b++)
+    if (flex[b]) { free(flex[b]->list); free(flex[b]->ratios); free(flex[b]); }
+  free(flex);
+}
+
+/* A scene's 'bodies': flexible body name -> {modes, damping, coupling}, each
+ * overriding the body's own (coupling: rigid makes the body rigid).  Returns
+ * per body the settings the scene gives it (NULL for the others). */
+static ir_flex **parse_scene_bodies(reader *r, yaml_node_t *n, const char *what) {
+  ir_model *model = r->model;
+  mapping m;
+  if (!map_open(&m, r, n, loc_of(n), "'bodies' of %s", what))
+    return NULL;
+  ir_flex **flex = xcalloc((size_t)model->nbodies + 1, sizeof *flex);
+  for (int i = 0; i < m.npairs; i++) {
+    yaml_node_t *key = map_key_node(&m, i), *value = map_value_node(&m, i);
+    m.handled[i] = true;
+    int b = -1;
+    for (int k = 1; k < model->nbodies; k++)
+      if (model->bodies[k].name && scalar_equals(key, model->bodies[k].name)) b = k;
+    if (b < 0 || !model->bodies[b].flex) {
+      name_list l = {.length = 0};
+      for (int k = 1; k < model->nbodies; k++)
+        if (model->bodies[k].flex) name_list_add(&l, model->bodies[k].name);
+      error_at(r, loc_of(key), "%s %s in 'bodies' of %s (%s%s)",
+               b < 0 ? "unknown body" : "not a flexible body:", show_node(r, key), what,
+               l.count ? "expected a flexible body: " : "the model has no flexible body", l.text);
+      continue;
+    }
+    mapping bm;
+    char label[SHOWN_SIZE + 40];
+    snprintf(label, sizeof label, "body '%s' in %s", model->bodies[b].name, what);
+    if (!map_open(&bm, r, value, loc_of(key), "%s", label))
+      continue;
+    static const char *const keys[] = {"modes", "damping", "coupling", NULL};
+    map_check_keys(&bm, keys);
+    /* start from the body's own settings; the lists are copied */
+    const ir_flex *own = model->bodies[b].flex;
+    ir_flex *fx = xcalloc(1, sizeof *fx);
+    fx->select = own->select; fx->count = own->count; fx->max_frequency = own->max_frequency;
+    fx->damping = own->damping; fx->ratio = own->ratio; fx->coupling = own->coupling;
+    bool new_list = map_has(&bm, "modes"), new_ratios = map_has(&bm, "damping");
+    if (!new_list && own->nlist) {
+      fx->list = xcalloc((size_t)own->nlist, sizeof *fx->list);
+      memcpy(fx->list, own->list, sizeof *fx->list * (size_t)own->nlist);
+      fx->nlist = own->nlist;
+    }
+    if (!new_ratios && own->nratios) {
+      fx->ratios = xcalloc((size_t)own->nratios + 1, sizeof *fx->ratios);
+      memcpy(fx->ratios, own->ratios, sizeof *fx->ratios * (size_t)own->nratios);
+      fx->nratios = own->nratios;
+    }
+    parse_modal_settings(&bm, fx);
+    map_close(&bm);
+    if (flex[b]) { free(flex[b]->list); free(flex[b]->ratios); free(flex[b]); }
+    flex[b] = fx;
+  }
+  map_close(&m);
+  return flex;
+}
+
 static void parse_scene(reader *r, yaml_node_t *key, yaml_node_t *value,
                         const sim_settings *base_sim, bool chosen) {
   ir_model *model = r->model;
@@ -2574,7 +2644,7 @@ static void parse_scene(reader *r, yaml_node_t *key, yaml_node_t *value,
   mapping m;
   if (!map_open(&m, r, value, loc_of(key), "%s", what))
     return;
-  static const char *const keys[] = {"simulation", "outputs", "deactivate", "gravity", NULL};
+  static const char *const keys[] = {"simulation", "outputs", "deactivate", "gravity", "bodies", NULL};
   map_check_keys(&m, keys);
 
   sim_settings sim = *base_sim;
@@ -2601,6 +2671,10 @@ static void parse_scene(reader *r, yaml_node_t *key, yaml_node_t *value,
   n = map_get(&m, "deactivate");
   if (n != NULL)
     parse_deactivate(r, n, joint_off, driver_off, force_off);
+  ir_flex **flex = NULL;
+  n = map_get(&m, "bodies");
+  if (n != NULL)
+    flex = parse_scene_bodies(r, n, what);
   double gravity[3];
   bool has_gravity = get_vector(&m, "gravity", 3, false, gravity);
   bool has_outputs = map_has(&m, "outputs");
@@ -2612,6 +2686,7 @@ static void parse_scene(reader *r, yaml_node_t *key, yaml_node_t *value,
     free(joint_off);
     free(driver_off);
     free(force_off);
+    free_scene_flex(flex, model->nbodies);
     return;
   }
   s->found = true;
@@ -2626,6 +2701,7 @@ static void parse_scene(reader *r, yaml_node_t *key, yaml_node_t *value,
   s->force_off = force_off;
   s->sim = merged;
   s->jof_list = sim.jof_list;
+  s->flex = flex;
 }
 
 /* Every scene is validated; the one named 'chosen' is kept in r->scene. */
@@ -2713,10 +2789,23 @@ static void apply_scene(ir_model *model, chosen_scene *s) {
   for (int i = 0; i < model->nforces; i++)
     if (s->force_off[i])
       model->forces[i].active = false;
+  for (int b = 0; s->flex && b < model->nbodies; b++) {
+    ir_flex *to = model->bodies[b].flex, *from = s->flex[b];
+    if (!from || !to) continue;
+    free(to->list); free(to->ratios);
+    to->select = from->select; to->count = from->count; to->max_frequency = from->max_frequency;
+    to->list = from->list; to->nlist = from->nlist;
+    to->damping = from->damping; to->ratio = from->ratio;
+    to->ratios = from->ratios; to->nratios = from->nratios;
+    to->coupling = from->coupling;
+    free(from);
+    s->flex[b] = NULL;
+  }
   model->sim = s->sim;
 }
 
-static void free_chosen_scene(chosen_scene *s) {
+static void free_chosen_scene(chosen_scene *s, int nbodies) {
+  free_scene_flex(s->flex, nbodies);
   free(s->name);
   free_outputs(s->outputs, s->noutputs);
   free(s->joint_off);
@@ -2958,7 +3047,7 @@ ir_model *ir_read(const char *path, const char *scene) {
       r.model = model;
       parse_model(&r, root, scene);
       table_free(&r.names);
-      free_chosen_scene(&r.scene);
+      free_chosen_scene(&r.scene, model->nbodies);
     }
     yaml_document_delete(&doc);
   }

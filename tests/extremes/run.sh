@@ -185,20 +185,16 @@ md "costs in accuracy is the difference between the damped and the undamped"
 md "beam, each computed by the reference method; what it buys is the number of"
 md "steps and the Newton work of the implicit method:"
 table_head
-sed 's/^    modes: {max_frequency: 10000}$/    modes: {max_frequency: 10000}\n    damping: none/' "$ROOT/$M" > "$W/beam_10khz_undamped.yaml"
-grep -q "damping: none" "$W/beam_10khz_undamped.yaml" || say "could not make the undamped beam"
-cp "$W/beam_10khz_undamped.yaml" "$ROOT/build/extremes_beam_10khz_undamped.yaml"
-run b10u_ref build/extremes_beam_10khz_undamped.yaml --integrator dopri5 --rtol 1e-9 --atol 1e-11
+run b10u_ref $M --scene undamped --integrator dopri5 --rtol 1e-9 --atol 1e-11
 row "undamped, dopri5 rtol 1e-9 (its reference)" "$STEPS ($REJ)" "$SECS" "-" "-"
 eb=$(relerr "$W/b10u_ref.csv" "$ref" tip)
 ebm=$(relerr "$W/b10u_ref.csv" "$ref" mid_deflection)
 ok=0; le "$eb" 1e-2 && ok=1
 row "three bands vs undamped (both references)" "" "" "tip $eb, mid deflection $ebm" "tip ≤ 1e-2: $(verdict $ok)"
-run b10u_ga build/extremes_beam_10khz_undamped.yaml --integrator genalpha --rtol 1e-5 --atol 1e-9
+run b10u_ga $M --scene undamped --integrator genalpha --rtol 1e-5 --atol 1e-9
 e=$(relerr "$W/b10u_ref.csv" "$W/b10u_ga.csv" tip)
 ok=0; [ $RC = 0 ] && ok=1
 row "undamped, genalpha rtol 1e-5" "$STEPS ($REJ)" "$SECS" "tip $e vs undamped reference" "completes: $(verdict $ok)"
-rm -f "$ROOT/build/extremes_beam_10khz_undamped.yaml"
 gnuplot <<EOF
 set terminal pngcairo size 1000,380 noenhanced font ',9'
 set output '$ROOT/$IMG/stability_beam_10khz.png'

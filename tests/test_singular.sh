@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# test_singular.sh: singular configurations are handled or reported
+# (the quick cases of tests/extremes/run.sh):
+#   - the slider-crank with rod = crank passes its dead point (theta = pi/2)
+#     on the branch x = 2 r cos(theta), to 1e-8 of the stroke;
+#   - when a step ends exactly on the dead point, DOPRI5 stops there with
+#     exit 1, no CSV, and a note that the constraint Jacobian is singular;
+#   - the parallelogram four-bar passes its change point (t = 0.25 s) as a
+#     parallelogram and warns that K's condition estimate collapsed there.
+# Environment: MBCC (set by tests/run_tests.sh; default build/mbcc).
+set -u
+cd "$(dirname "$0")/.."
+root=$(pwd)
+MBCC=${MBCC:-build/mbcc}
+case $MBCC in /*) ;; *) MBCC="$root/$MBCC" ;; esac
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+cd "$tmp" || exit 1
+fail=0
+err() { echo "FAIL: $*"; fail=1; }
+X=$root/tests/extremes/models
+
+"$MBCC" run "$X/slider_crank_equal.yaml" -o "$tmp/a.csv" --plot none > "$tmp/a.log" 2>&1 || err "dead point run: $(cat "$tmp/a.log")"
+e=$(awk -F, 'NR > 1 { d = $3 - 2 * 0.1524 * cos($2); if (d < 0) d = -d; if (d > m) m = d } END { printf "%.2e", m / 0.3048 }' "$tmp/a.csv")
+echo "  slider-crank r = L through the dead point: x vs 2 r cos(theta) $e of the stroke"
+awk -v e="$e" 'BEGIN { exit !(e <= 1e-8) }' || err "branch error $e"
+
+h=$(awk 'BEGIN { printf "%.17g", atan2(1, 0) / 124.8 / 100 }')
+"$MBCC" run "$X/slider_crank_equal.yaml" --output-step "$h" -o "$tmp/b.csv" --plot none > "$tmp/b.log" 2>&1
+rc=$?
+[ $rc = 1 ] || err "step on the dead point: exit $rc, expected 1"
+[ -e "$tmp/b.csv" ] && err "step on the dead point: a CSV was written"
+grep -q "error: at t = 0.01258650" "$tmp/b.log" || err "no error at the dead point: $(cat "$tmp/b.log")"
+grep -q "note: at t = 0.01258650.* the constraint Jacobian is nearly singular" "$tmp/b.log" ||
+  err "no singular-configuration note: $(cat "$tmp/b.log")"
+grep "_sim: \(error\|note\)" "$tmp/b.log" | sed 's/^[^ ]*_sim: /  /'
+
+"$MBCC" run "$X/four_bar_change.yaml" -o "$tmp/c.csv" --plot none > "$tmp/c.log" 2>&1 || err "change point run: $(cat "$tmp/c.log")"
+e=$(awk -F, 'NR > 1 { d = $3 - $2; if (d < 0) d = -d; if (d > m) m = d } END { printf "%.2e", m }' "$tmp/c.csv")
+echo "  parallelogram four-bar through its change point: |rocker - crank| $e rad"
+awk -v e="$e" 'BEGIN { exit !(e <= 1e-8) }' || err "parallelogram error $e"
+grep -q "warning: near t = 0.25 the condition estimate of K fell" "$tmp/c.log" || err "no near-singular warning: $(cat "$tmp/c.log")"
+exit $fail
