@@ -154,7 +154,7 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
 #ifdef MB_REAL_FLOAT
   /* single precision resolves about 1e-7: a tighter tolerance only makes the
      step control chase round-off */
-  if (set.rtol < 1e-5) {
+  if (set.rtol < 1e-5 && set.integrator != MB_RK4) {
     if (!quiet)
       fprintf(stderr, "%s: warning: rtol %g is below what single precision resolves; using 1e-5\n",
               argv[0], set.rtol);
@@ -167,7 +167,7 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
   for (int b = 0; b < m->nbody; b++)
     for (int j = 0; j < 3; j++) size = fmax(size, fabs((double)m->q0[m->body[b].qadr + j]));
   double atol_min = 4 * 1.1920929e-7 * size;
-  if (set.atol < atol_min) {
+  if (set.atol < atol_min && set.integrator != MB_RK4) {
     if (!quiet)
       fprintf(stderr, "%s: warning: atol %g is below what single precision resolves for this model; "
               "using %.2g\n", argv[0], set.atol, atol_min);

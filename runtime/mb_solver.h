@@ -21,8 +21,9 @@ typedef struct mb_solver {
    * failed in the last factorization, or -1 (other solvers leave these 0) */
   double residual, residual_max;
   int bad_pivot;
-  /* klu: the reciprocal condition estimate of the last factorization
-     (min |u_ii| / max |u_ii|); 0 when the solver does not estimate it */
+  /* klu: the reciprocal condition estimate (min |u_ii| / max |u_ii|) of the
+     last factorization with fresh pivots: with the pivot order of an earlier
+     configuration a small u_ii says little; 0 when not estimated */
   double rcond;
 } mb_solver;
 

@@ -33,10 +33,8 @@ static int klu_factor_fn(mb_solver *s, const mb_real *Kx) {
   /* same pivot order: refactor, unless it fails or the pivots degrade */
   if (klu_refactor(k->Ap, k->Ai, k->Ax, k->symbolic, k->numeric, &k->common) &&
       k->common.status == KLU_OK && klu_rcond(k->symbolic, k->numeric, &k->common) &&
-      k->common.rcond > 1e-3 * k->rcond_full) {
-    s->rcond = k->common.rcond;
+      k->common.rcond > 1e-3 * k->rcond_full)
     return MB_OK;
-  }
   return full_factor(k);
 }
 

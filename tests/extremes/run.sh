@@ -355,12 +355,13 @@ M=models/pendulum.yaml
 : > "$W/sweep_dopri5_double.dat"; : > "$W/sweep_genalpha_double.dat"; : > "$W/sweep_rk4_double.dat"
 : > "$W/sweep_dopri5_float.dat"; : > "$W/sweep_genalpha_float.dat"; : > "$W/sweep_rk4_float.dat"
 sweep() { # method real value
-  local integ=$1 real=$2 v=$3 name="pend_$1_$2_$3" args=(--integrator "$1" --real "$2" --output-step 0.1)
+  local integ=$1 real=$2 v=$3 name="pend_$1_$2_$3" args=(--integrator "$1" --real "$2" --output-step 0.1) what=rtol
+  [ "$integ" = rk4 ] && what=step
   if [ "$integ" = rk4 ]; then args+=(--step "$v"); else args+=(--rtol "$v" --atol "$(awk -v r="$v" 'BEGIN { print r / 100 }')"); fi
   run "$name" $M "${args[@]}"
   if [ $RC != 0 ]; then
     ok=0; [ -n "$ERR" ] && ok=1
-    row "$integ $real ${integ/rk4/step}${integ/rk4/} $v" "" "" "stops: $ERR" "clear diagnostic: $(verdict $ok)"
+    row "$integ, $real, $what $v" "" "" "stops: $ERR" "clear diagnostic: $(verdict $ok)"
     return
   fi
   local e bound
@@ -375,7 +376,7 @@ sweep() { # method real value
   esac
   ok=0; le "$e" "$bound" && ok=1
   local w=""; [ -n "$WARN" ] && w=" (warning: $WARN)"
-  row "$integ, $real, ${integ/rk4/step}$( [ "$integ" = rk4 ] || echo rtol) $v" "$STEPS ($REJ)" "$SECS" "max angle error $e rad$w" "≤ $(printf '%.1e' "$bound"): $(verdict $ok)"
+  row "$integ, $real, $what $v" "$STEPS ($REJ)" "$SECS" "max angle error $e rad$w" "≤ $(printf '%.1e' "$bound"): $(verdict $ok)"
   echo "$v $e $SECS" >> "$W/sweep_${integ}_$real.dat"
 }
 for r in 1e-2 1e-3 1e-4 1e-5 1e-6 1e-7 1e-8 1e-9 1e-10 1e-11 1e-12; do sweep dopri5 double $r; done
