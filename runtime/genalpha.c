@@ -208,14 +208,7 @@ int mb_genalpha_run(mb_sim *s, mb_output_fn out, void *user) {
   memcpy(g.a, g.vd, sizeof(mb_real) * (size_t)nv);
   while (1) {
     double tout = (double)iout * set->output_step;
-    if ((double)(s->stats.steps + s->stats.rejected) >= set->max_steps) {
-      s->fail_time = s->t;
-      snprintf(s->fail_detail, sizeof s->fail_detail,
-               "%ld steps (%ld rejected) reached max_steps %.3g at t = %.6g s (last step %.3g s)",
-               s->stats.steps, s->stats.rejected, set->max_steps, s->t, h);
-      st = MB_ERR_STEP_BUDGET;
-      goto done;
-    }
+    if ((st = mb_sim_step_budget(s, h))) goto done;
     if (fabs(s->t - tout) <= 1e-9 * set->output_step) {
       /* outputs from the index-1 accelerations of the (projected) state */
       if ((st = mb_sim_accel(s, s->t, s->q, s->v, g.vd_out, g.lam_out))) goto done;

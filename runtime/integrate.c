@@ -217,6 +217,15 @@ static void combine(int ny, const mb_real *y, double h, const double *a, mb_real
   }
 }
 
+int mb_sim_step_budget(mb_sim *s, double h) {
+  if ((double)(s->stats.steps + s->stats.rejected) < s->set.max_steps) return MB_OK;
+  s->fail_time = s->t;
+  snprintf(s->fail_detail, sizeof s->fail_detail,
+           "%ld steps (%ld rejected) reached max_steps %.3g at t = %.6g s (last step %.3g s)",
+           s->stats.steps, s->stats.rejected, s->set.max_steps, s->t, h);
+  return MB_ERR_STEP_BUDGET;
+}
+
 const char *mb_integrator_name(int integrator) {
   switch (integrator) {
   case MB_RK4: return "rk4";
@@ -294,14 +303,7 @@ int mb_sim_run(mb_sim *s, mb_output_fn out, void *user) {
   if (set->stabilization == MB_STAB_PROJECTION && (st = mb_sim_project(s, 0, s->q, s->v))) goto done;
   while (1) {
     double tout = (double)iout * set->output_step;
-    if ((double)(s->stats.steps + s->stats.rejected) >= set->max_steps) {
-      s->fail_time = s->t;
-      snprintf(s->fail_detail, sizeof s->fail_detail,
-               "%ld steps (%ld rejected) reached max_steps %.3g at t = %.6g s (last step %.3g s)",
-               s->stats.steps, s->stats.rejected, set->max_steps, s->t, h);
-      st = MB_ERR_STEP_BUDGET;
-      goto done;
-    }
+    if ((st = mb_sim_step_budget(s, h))) goto done;
     /* the stage-1 derivative at (t, y): also gives the outputs at output times */
     memcpy(s->y, s->q, sizeof(mb_real) * (size_t)nq);
     memcpy(s->y + nq, s->v, sizeof(mb_real) * (size_t)nv);

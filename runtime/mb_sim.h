@@ -72,6 +72,8 @@ const char *mb_integrator_name(int integrator);
 int mb_sim_fail(mb_sim *s, double t, int status, const char *what);
 double mb_sim_clock(void); /* monotonic seconds */
 int mb_sim_finish_step(mb_sim *s, double t);
+/* MB_ERR_STEP_BUDGET (with the detail) once steps + rejections reach max_steps */
+int mb_sim_step_budget(mb_sim *s, double h);
 int mb_genalpha_run(mb_sim *s, mb_output_fn out, void *user);
 
 #endif

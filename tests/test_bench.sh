@@ -11,15 +11,8 @@
 # Environment: MBCC (set by tests/run_tests.sh; default build/mbcc).
 set -u
 cd "$(dirname "$0")/.."
-root=$(pwd)
-MBCC=${MBCC:-build/mbcc}
-case $MBCC in /*) ;; *) MBCC="$root/$MBCC" ;; esac
-[ -x "$MBCC" ] || { echo "no mbcc at $MBCC"; exit 1; }
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-cd "$tmp" || exit 1
-fail=0
-err() { echo "FAIL: $*"; fail=1; }
+# shellcheck source=tests/shell_setup.sh
+. tests/shell_setup.sh
 
 model="$root/models/slider_crank.yaml"
 if "$MBCC" bench "$model" --end 0.01 --reps 1 --csv b.csv --quiet > bench.txt 2> bench.log; then

@@ -12,15 +12,8 @@
 # Environment: MBCC (set by tests/run_tests.sh; default build/mbcc).
 set -u
 cd "$(dirname "$0")/.."
-root=$(pwd)
-MBCC=${MBCC:-build/mbcc}
-case $MBCC in /*) ;; *) MBCC="$root/$MBCC" ;; esac
-[ -x "$MBCC" ] || { echo "no mbcc at $MBCC"; exit 1; }
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-cd "$tmp" || exit 1
-fail=0
-err() { echo "FAIL: $*"; fail=1; }
+# shellcheck source=tests/shell_setup.sh
+. tests/shell_setup.sh
 
 # 1. run + plot
 if "$MBCC" run "$root/models/slider_crank.yaml" -o "$tmp/sc.csv" --plot "$tmp/sc.png" --quiet > run.log 2>&1; then

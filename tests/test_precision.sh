@@ -13,14 +13,8 @@
 # Environment: MBCC (set by tests/run_tests.sh; default build/mbcc).
 set -u
 cd "$(dirname "$0")/.."
-root=$(pwd)
-MBCC=${MBCC:-build/mbcc}
-case $MBCC in /*) ;; *) MBCC="$root/$MBCC" ;; esac
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-cd "$tmp" || exit 1
-fail=0
-err() { echo "FAIL: $*"; fail=1; }
+# shellcheck source=tests/shell_setup.sh
+. tests/shell_setup.sh
 
 # max |x - closed form| / stroke (2 r) over the run, from columns t, crank_angle, slider_x
 closed_form_error() {

@@ -10,14 +10,8 @@
 # Environment: MBCC (set by tests/run_tests.sh; default build/mbcc).
 set -u
 cd "$(dirname "$0")/.."
-root=$(pwd)
-MBCC=${MBCC:-build/mbcc}
-case $MBCC in /*) ;; *) MBCC="$root/$MBCC" ;; esac
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-cd "$tmp" || exit 1
-fail=0
-err() { echo "FAIL: $*"; fail=1; }
+# shellcheck source=tests/shell_setup.sh
+. tests/shell_setup.sh
 X=$root/tests/extremes/models
 
 "$MBCC" run "$X/slider_crank_equal.yaml" -o "$tmp/a.csv" --plot none > "$tmp/a.log" 2>&1 || err "dead point run: $(cat "$tmp/a.log")"

@@ -11,15 +11,8 @@
 # Runs in a scratch directory.  Environment: MBCC (default build/mbcc).
 set -u
 cd "$(dirname "$0")/.."
-root=$(pwd)
-MBCC=${MBCC:-build/mbcc}
-case $MBCC in /*) ;; *) MBCC="$root/$MBCC" ;; esac
-[ -x "$MBCC" ] || { echo "no mbcc at $MBCC"; exit 1; }
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-cd "$tmp" || exit 1
-fail=0
-err() { echo "FAIL: $*"; fail=1; }
+# shellcheck source=tests/shell_setup.sh
+. tests/shell_setup.sh
 pend="$root/models/pendulum.yaml"
 
 # 1. bad input: exit 2, an error message, no CSV
