@@ -571,7 +571,7 @@ static int write_plot(const char *png, const char *title, const trade_run *R, in
   int nok = 0;
   for (int k = 0; k < nrun; k++) nok += !R[k].failed;
   if (!nok) { printf("no plot: every run failed\n"); return -1; }
-  char dat[4300], gp[4300];
+  char dat[8400], gp[8400];
   snprintf(dat, sizeof dat, "%s.dat", png);
   snprintf(gp, sizeof gp, "%s.gp", png);
   FILE *d = fopen(dat, "w");
