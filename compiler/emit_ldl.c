@@ -11,8 +11,10 @@
  *     solves K x = b in place: x from the factors of K_aug with right side
  *     [b_top + D^T W b_bot; b_bot], then iterative refinement on the exact
  *     system (r = b - K x with the original Kx, correction from the same
- *     factors): one step, a second when ||r||_inf / (||K||_inf ||x||_inf +
- *     ||b||_inf) is still above 1e-12; *res gets that relative residual.
+ *     factors): none when the relative residual ||r||_inf / (||K||_inf
+ *     ||x||_inf + ||b||_inf) of the first solution is already at roundoff
+ *     level (<= LDL_REFINE_TOL = 1e-15), else one step, a second when it is
+ *     still above 1e-12; *res gets that relative residual.
  *     Returns MB_OK or MB_ERR_NONFINITE.
  *
  * Below the flop budget (LDL_FLOP_BUDGET, order.h) every operation is emitted
@@ -354,9 +356,11 @@ static void emit_solve(FILE *f, const char *nm) {
         "    rel = den > 0 ? rn / den : rn;\n"
         "    if (it > 0 && !(rel < best)) break; /* no longer improving: keep the best */\n"
         "    best = rel;\n"
+        "    if (rel <= LDL_REFINE_TOL) break; /* at roundoff level: x is kept as it is */\n"
         "    for (int i = 0; i < LDL_N; i++) xb[i] = x[i];\n"
         "    if (it > 0 && rel <= 1e-12) break;\n  }\n"
-        "  for (int i = 0; i < LDL_N; i++) b[i] = xb[i];\n"
+        "  if (best <= LDL_REFINE_TOL) for (int i = 0; i < LDL_N; i++) b[i] = x[i];\n"
+        "  else for (int i = 0; i < LDL_N; i++) b[i] = xb[i];\n"
         "  if (residual) *residual = best;\n"
         "  return isfinite(best) ? MB_OK : MB_ERR_NONFINITE;\n}\n\n", f);
 }
@@ -394,6 +398,8 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
   fprintf(f, "#define LDL_N %d\n#define LDL_DINV %s_LDL_NNZL\n#define LDL_KNORM (LDL_DINV + LDL_N)\n"
              "#define LDL_X (LDL_KNORM + 1)\n#define LDL_R (LDL_X + LDL_N)\n#define LDL_T (LDL_R + LDL_N)\n"
              "#define LDL_XB (LDL_T + LDL_N)\n#define LDL_PIVTOL 1e-14\n"
+             "/* a solve whose relative residual is already this small is not refined */\n"
+             "#define LDL_REFINE_TOL 1e-15\n"
              "#if defined(__GNUC__)\n#define LDL_NOINLINE __attribute__((noinline))\n#else\n#define LDL_NOINLINE\n#endif\n",
           n, U);
   /* pivot order as a comment (straight) or a table (looped) */

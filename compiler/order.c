@@ -94,10 +94,64 @@ static double *kx_at_start(const mb_model *m) {
   return Kx;
 }
 
+/* the body whose velocity columns include column j, or -1 */
+static int body_of_column(const mb_model *m, int j) {
+  for (int b = 0; b < m->nbody; b++) {
+    const mb_body *B = &m->body[b];
+    int nb = 6 + (B->kind == MB_BODY_FLEXIBLE ? B->nm : 0);
+    if (j >= B->vadr && j < B->vadr + nb) return b;
+  }
+  return -1;
+}
+
+/* whether every velocity column of body b (-1: the ground) is massive */
+static int body_massive(const mb_model *m, int b, const char *massive) {
+  if (b < 0) return 1;
+  const mb_body *B = &m->body[b];
+  int nb = 6 + (B->kind == MB_BODY_FLEXIBLE ? B->nm : 0);
+  for (int c = 0; c < nb; c++)
+    if (!massive[B->vadr + c]) return 0;
+  return 1;
+}
+
+/* constraint row r is a row of the rigid joint (weld) of virtual body b to a
+ * massive body (lower.c: no source joint or driver, marker 1 on the virtual
+ * body): returns b, else -1 */
+static int row_weld_body(const mb_model *m, int r, const char *massive) {
+  if (m->nrow != m->nc || r >= m->nrow) return -1;
+  const mb_rowdef *R = &m->row[r];
+  if (R->joint >= 0 || R->driver >= 0) return -1;
+  int b1 = m->marker[R->m1].body, b0 = m->marker[R->m0].body;
+  if (b1 < 0 || m->body[b1].kind != MB_BODY_VIRTUAL || b0 == b1) return -1;
+  if (R->kind != MB_PRIM_SPH && R->kind != MB_PRIM_DOT1) return -1;
+  return body_massive(m, b0, massive) ? b1 : -1;
+}
+
+/* per body: the number of weld rows when it is a virtual body held by exactly
+ * the 6 rows of one rigid joint to a massive body (3 coincidence, 3
+ * orientation), else -1 */
+static int *welded_rows(const mb_model *m, const char *massive) {
+  int *cnt = malloc(sizeof(int) * (size_t)(m->nbody + 1));
+  int *sph = calloc((size_t)m->nbody + 1, sizeof(int)), *other = calloc((size_t)m->nbody + 1, sizeof(int));
+  if (!cnt || !sph || !other) { free(cnt); free(sph); free(other); return NULL; }
+  for (int r = 0; r < m->nc && m->nrow == m->nc; r++) {
+    int b = row_weld_body(m, r, massive);
+    if (b < 0) continue;
+    const mb_rowdef *R = &m->row[r];
+    if (R->kind == MB_PRIM_SPH) sph[b] |= 1 << R->a;
+    else other[b] |= 1 << R->a;
+  }
+  for (int b = 0; b < m->nbody; b++) cnt[b] = sph[b] == 7 && other[b] == 7 ? 6 : -1;
+  free(sph); free(other);
+  return cnt;
+}
+
 /* weights: rows touching a massless column get w_r = mref / |D_r|^2 with
  * mref the geometric mean of the nonzero M diagonals of the row's other
  * columns (or of all of M when it has none): D_r^T w_r D_r then adds to the
- * massless columns the scale of the masses (inertias) it couples them to. */
+ * massless columns the scale of the masses (inertias) it couples them to.
+ * The columns of a virtual body welded to a massive body are covered by the
+ * 6 rows of the weld alone (see below). */
 static int choose_weights(const mb_model *m, const double *Kx, ldl_plan *p) {
   int nv = m->nv, nc = m->nc;
   char *massive = calloc((size_t)nv + 1, 1), *wmark = calloc((size_t)nc + 1, 1);
@@ -113,13 +167,28 @@ static int choose_weights(const mb_model *m, const double *Kx, ldl_plan *p) {
     if (massive[j] && mdiag[j] > 0) { glog += log(mdiag[j]); gcount++; }
   }
   double gmean = gcount ? exp(glog / gcount) : 1.0;
+  /* a massless body welded to a massive one (a virtual body inserted for a
+     joint on a flexible node: the 6 rows of its rigid joint) needs only those
+     6 rows weighted: their block on its own 6 columns is nonsingular in every
+     configuration the constraints allow, so M + D_W^T W D_W is positive
+     definite on its columns without weighting the rows of the joint it
+     carries (which would join the bodies on both sides into one dense block) */
+  int *weld = welded_rows(m, massive);
+  if (!weld) { free(massive); free(wmark); free(mdiag); return -1; }
   p->nmassless = 0;
   for (int j = 0; j < nv; j++) {
     if (massive[j]) continue;
     p->nmassless++;
+    int b = body_of_column(m, j);
+    if (b >= 0 && weld[b] >= 0) {
+      for (int r = 0; r < nc; r++)
+        if (row_weld_body(m, r, massive) == b) wmark[r] = 1;
+      continue;
+    }
     for (int q = m->Kp[j]; q < m->Kp[j + 1]; q++)
       if (m->Ki[q] >= nv) wmark[m->Ki[q] - nv] = 1;
   }
+  free(weld);
   p->nw = 0;
   for (int r = 0; r < nc; r++) p->nw += wmark[r];
   p->wrow = malloc(sizeof(int) * (size_t)(p->nw + 1));
