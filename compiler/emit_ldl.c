@@ -60,7 +60,17 @@ static void real_array(FILE *f, const char *name, const double *x, long n) {
   fprintf(f, "\n};\n");
 }
 
-static long work_size(const ldl_plan *p) { return p->nnzL + 5L * p->n + 1; }
+/* the block pivots' workspace: LU of Du (36), its row swaps (6), W = Eu Du^-1 (6 per S row) */
+static long block_work(const ldl_plan *p, int e) { return 42L + 6L * (p->esp[e + 1] - p->esp[e]); }
+
+static long work_size(const ldl_plan *p) {
+  long w = p->nnzL + 5L * p->n + 1;
+  if (p->nelim) {
+    w += p->nnzR + 2L * p->n;
+    for (int e = 0; e < p->nelim; e++) w += block_work(p, e);
+  }
+  return w;
+}
 
 void emit_ldl_header(FILE *f, const lmodel *L, const char *nm) {
   ldl_plan p;
@@ -198,9 +208,11 @@ static void emit_factor_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
     for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) slot_of[p->Rj[r]] = -1;
   }
   if (n) fputs("  (void)t;\n  (void)l;\n  return 0;\n}\n\n", f);
-  fprintf(f, "int %s_ldl_factor(const mb_real *Kx, mb_real *work) {\n", nm);
+  (void)L;
+  (void)nm;
+  fputs("/* L D L^T of K_aug, whose entries come from Kx (K, or K' after the block pivots) */\n", f);
+  fputs("static int ldl_factor_aug(const mb_real *Kx, mb_real *work) {\n", f);
   fputs("  mb_real *Lx = work, *Dinv = work + LDL_DINV;\n  int rc;\n", f);
-  emit_knorm(f, L, p);
   fputs("  /* the pivots in order, in parts */\n", f);
   for (int c = 0; c < nchunk; c++)
     fprintf(f, "  if ((rc = ldl_factor_part%d(Kx, Lx, Dinv)) != 0) return rc;\n", c);
@@ -210,9 +222,11 @@ static void emit_factor_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
 }
 
 static void emit_factor_looped(FILE *f, const lmodel *L, const ldl_plan *p, const char *nm) {
-  fprintf(f, "int %s_ldl_factor(const mb_real *Kx, mb_real *work) {\n", nm);
+  (void)L;
+  (void)nm;
+  fputs("/* L D L^T of K_aug, whose entries come from Kx (K, or K' after the block pivots) */\n", f);
+  fputs("static int ldl_factor_aug(const mb_real *Kx, mb_real *work) {\n", f);
   fputs("  mb_real *Lx = work, *Dinv = work + LDL_DINV, *y = work + LDL_T;\n", f);
-  emit_knorm(f, L, p);
   fputs("  for (int i = 0; i < LDL_N; i++) y[i] = 0;\n", f);
   fputs("  for (int k = 0; k < LDL_N; k++) {\n", f);
   fputs("    /* column k of the upper triangle of K_aug, scattered into y */\n", f);
@@ -231,6 +245,168 @@ static void emit_factor_looped(FILE *f, const lmodel *L, const ldl_plan *p, cons
   fputs("      l = Lx[pkj] = t * Dinv[j];\n      d -= l * t;\n      s += fabs(l * t);\n    }\n", f);
   fputs("    if (!(fabs(d) > LDL_PIVTOL * s) || !isfinite(s)) return 1 + ldl_perm[k];\n", f);
   fputs("    Dinv[k] = 1 / d;\n  }\n  return 0;\n}\n\n", f);
+}
+
+/* ----------------------------------------------------------- block pivots */
+
+static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
+  const mb_model *m = &L->m;
+  char name[512];
+  fputs("/* block pivots: each virtual body welded to a massive body is eliminated with\n"
+        " * its 6 weld rows as one 12 x 12 pivot [0 Du^T; Du 0] before the LDL^T:\n"
+        " *   K'(s, x) = K(s, x) - (Eu Du^-1 Dx)(s, x)  (S: the other rows on its columns,\n"
+        " *   X: the columns of the body it is welded to); see docs/formulation.md. */\n", f);
+  fputs("typedef struct {\n"
+        "  int nx, ns;      /* columns X, rows S */\n"
+        "  int kr, w;       /* first pair in ldl_ekr; workspace: LU of Du, row swaps, W = Eu Du^-1 */\n"
+        "  const int *u, *r, *x, *s; /* its columns, weld rows, X, S (K indices) */\n"
+        "  const int *du, *dx, *eu;  /* Kx slots (-1: zero) of Du (6 x 6), Dx (6 per x), Eu (6 per s) */\n"
+        "} ldl_block;\n", f);
+  long w = (long)p->nnzL + 5L * p->n + 1 + p->nnzR + 2L * p->n;
+  long *woff = malloc(sizeof(long) * (size_t)(p->nelim + 1));
+  if (!woff) return;
+  for (int e = 0; e < p->nelim; e++) {
+    const mb_body *B = &m->body[p->eb[e]];
+    int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
+    fprintf(f, "/* block %d: virtual body '%s' (unknowns %d..%d) and its weld rows", e, B->name,
+            p->eu[e][0], p->eu[e][5]);
+    for (int i = 0; i < 6; i++) fprintf(f, "%s%d", i ? " " : " ", p->er[e][i]);
+    ldl_unknown_name(L, p->ex[xs], name, sizeof name);
+    fprintf(f, ";\n * X: %d columns from %s; S: %d rows:", nx, name, ns);
+    for (int k = 0; k < ns; k++) {
+      ldl_unknown_name(L, p->es[ss + k], name, sizeof name);
+      fprintf(f, "\n *   %s", name);
+    }
+    fputs(" */\n", f);
+    char nmx[64];
+    snprintf(nmx, sizeof nmx, "ldl_b%d_u", e); int_array(f, nmx, p->eu[e], 6);
+    snprintf(nmx, sizeof nmx, "ldl_b%d_r", e); int_array(f, nmx, p->er[e], 6);
+    snprintf(nmx, sizeof nmx, "ldl_b%d_x", e); int_array(f, nmx, p->ex + xs, nx);
+    snprintf(nmx, sizeof nmx, "ldl_b%d_s", e); int_array(f, nmx, p->es + ss, ns);
+    snprintf(nmx, sizeof nmx, "ldl_b%d_du", e); int_array(f, nmx, p->edu[e], 36);
+    snprintf(nmx, sizeof nmx, "ldl_b%d_dx", e); int_array(f, nmx, p->edx + 6 * xs, 6L * nx);
+    snprintf(nmx, sizeof nmx, "ldl_b%d_eu", e); int_array(f, nmx, p->eeu + 6 * ss, 6L * ns);
+    woff[e] = w;
+    w += block_work(p, e);
+  }
+  fprintf(f, "#define LDL_NBLOCK %d\n", p->nelim);
+  fprintf(f, "static const ldl_block ldl_blocks[LDL_NBLOCK] = {\n");
+  for (int e = 0; e < p->nelim; e++)
+    fprintf(f, "  {%d, %d, %d, %ld, ldl_b%d_u, ldl_b%d_r, ldl_b%d_x, ldl_b%d_s, ldl_b%d_du, ldl_b%d_dx, ldl_b%d_eu},\n",
+            p->exp_[e + 1] - p->exp_[e], p->esp[e + 1] - p->esp[e], p->ekrp[e], woff[e], e, e, e, e, e, e, e);
+  fputs("};\n", f);
+  free(woff);
+  fputs("/* K' positions of the corrected pairs (s, x), (x, s), block by block, s-major */\n", f);
+  int_array(f, "ldl_ekr", p->ekr, 2L * p->ekrp[p->nelim]);
+  fputs("/* K' (CSC, both triangles) from Kx: a Kx slot, or -1: 0, -2: 1 (eliminated column),\n"
+        " * -3: -1 (eliminated row) */\n", f);
+  fprintf(f, "#define LDL_NKR %d\n", p->nnzR);
+  int_array(f, "ldl_Krmap", p->Krmap, p->nnzR);
+  fputs("\n/* 6 x 6 LU with partial pivoting (A row-major, row swaps in piv); 1 if a pivot\n"
+        " * is below 1e-12 of the largest entry */\n"
+        "static int ldl_lu6(mb_real *A, mb_real *piv) {\n"
+        "  mb_real amax = 0;\n"
+        "  for (int i = 0; i < 36; i++) if (fabs(A[i]) > amax) amax = fabs(A[i]);\n"
+        "  for (int k = 0; k < 6; k++) {\n"
+        "    int pr = k;\n"
+        "    for (int i = k + 1; i < 6; i++) if (fabs(A[6 * i + k]) > fabs(A[6 * pr + k])) pr = i;\n"
+        "    piv[k] = pr;\n"
+        "    if (!(fabs(A[6 * pr + k]) > 1e-12 * amax)) return 1;\n"
+        "    if (pr != k)\n"
+        "      for (int j = 0; j < 6; j++) { mb_real t = A[6 * k + j]; A[6 * k + j] = A[6 * pr + j]; A[6 * pr + j] = t; }\n"
+        "    for (int i = k + 1; i < 6; i++) {\n"
+        "      mb_real l = A[6 * i + k] /= A[6 * k + k];\n"
+        "      for (int j = k + 1; j < 6; j++) A[6 * i + j] -= l * A[6 * k + j];\n"
+        "    }\n  }\n  return 0;\n}\n\n"
+        "/* b <- A^-1 b */\n"
+        "static void ldl_lu6_solve(const mb_real *A, const mb_real *piv, mb_real *b) {\n"
+        "  for (int k = 0; k < 6; k++) {\n"
+        "    int pr = (int)piv[k];\n"
+        "    if (pr != k) { mb_real t = b[k]; b[k] = b[pr]; b[pr] = t; }\n  }\n"
+        "  for (int k = 0; k < 6; k++) for (int j = 0; j < k; j++) b[k] -= A[6 * k + j] * b[j];\n"
+        "  for (int k = 5; k >= 0; k--) {\n"
+        "    for (int j = k + 1; j < 6; j++) b[k] -= A[6 * k + j] * b[j];\n"
+        "    b[k] /= A[6 * k + k];\n  }\n}\n\n"
+        "/* b <- A^-T b */\n"
+        "static void ldl_lu6_solve_t(const mb_real *A, const mb_real *piv, mb_real *b) {\n"
+        "  for (int k = 0; k < 6; k++) {\n"
+        "    for (int j = 0; j < k; j++) b[k] -= A[6 * j + k] * b[j];\n"
+        "    b[k] /= A[6 * k + k];\n  }\n"
+        "  for (int k = 5; k >= 0; k--) for (int j = k + 1; j < 6; j++) b[k] -= A[6 * j + k] * b[j];\n"
+        "  for (int k = 5; k >= 0; k--) {\n"
+        "    int pr = (int)piv[k];\n"
+        "    if (pr != k) { mb_real t = b[k]; b[k] = b[pr]; b[pr] = t; }\n  }\n}\n\n", f);
+  fputs("/* Kr = K' from Kx; returns 0, or 1 + a column of a virtual body whose Du is singular */\n"
+        "static int ldl_block_pivots(const mb_real *Kx, mb_real *work) {\n"
+        "  mb_real *Kr = work + LDL_KR;\n"
+        "  for (int q = 0; q < LDL_NKR; q++) {\n"
+        "    int s = ldl_Krmap[q];\n"
+        "    Kr[q] = s >= 0 ? Kx[s] : s == -2 ? 1 : s == -3 ? -1 : 0;\n  }\n"
+        "  for (int e = 0; e < LDL_NBLOCK; e++) {\n"
+        "    const ldl_block *B = &ldl_blocks[e];\n"
+        "    mb_real *A = work + B->w, *piv = A + 36, *W = A + 42;\n"
+        "    int k = B->kr;\n"
+        "    for (int i = 0; i < 36; i++) A[i] = B->du[i] >= 0 ? Kx[B->du[i]] : 0;\n"
+        "    if (ldl_lu6(A, piv)) return 1 + B->u[0];\n"
+        "    for (int si = 0; si < B->ns; si++) {\n"
+        "      mb_real *w = W + 6 * si; /* row s of W = Eu Du^-1: Du^T w = Eu(s, :)^T */\n"
+        "      for (int c = 0; c < 6; c++) w[c] = B->eu[6 * si + c] >= 0 ? Kx[B->eu[6 * si + c]] : 0;\n"
+        "      ldl_lu6_solve_t(A, piv, w);\n"
+        "      for (int xi = 0; xi < B->nx; xi++, k++) {\n"
+        "        const int *dx = B->dx + 6 * xi;\n"
+        "        mb_real v = 0;\n"
+        "        for (int i = 0; i < 6; i++) if (dx[i] >= 0) v += w[i] * Kx[dx[i]];\n"
+        "        Kr[ldl_ekr[2 * k]] -= v;\n"
+        "        Kr[ldl_ekr[2 * k + 1]] -= v;\n"
+        "      }\n    }\n  }\n  return 0;\n}\n\n", f);
+  fputs("/* rr = the right side of K' from r: g'_s = g_s - W g_r, f'_x = f_x - Dx^T Du^-T f_u */\n"
+        "static void ldl_block_rhs(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *rr) {\n"
+        "  for (int i = 0; i < LDL_N; i++) rr[i] = r[i];\n"
+        "  for (int e = 0; e < LDL_NBLOCK; e++) {\n"
+        "    const ldl_block *B = &ldl_blocks[e];\n"
+        "    const mb_real *A = work + B->w, *piv = A + 36, *W = A + 42;\n"
+        "    mb_real z[6];\n"
+        "    for (int si = 0; si < B->ns; si++) {\n"
+        "      mb_real v = 0;\n"
+        "      for (int c = 0; c < 6; c++) v += W[6 * si + c] * r[B->r[c]];\n"
+        "      rr[B->s[si]] -= v;\n    }\n"
+        "    for (int c = 0; c < 6; c++) z[c] = r[B->u[c]];\n"
+        "    ldl_lu6_solve_t(A, piv, z);\n"
+        "    for (int xi = 0; xi < B->nx; xi++) {\n"
+        "      const int *dx = B->dx + 6 * xi;\n"
+        "      mb_real v = 0;\n"
+        "      for (int i = 0; i < 6; i++) if (dx[i] >= 0) v += Kx[dx[i]] * z[i];\n"
+        "      rr[B->x[xi]] -= v;\n    }\n"
+        "    for (int c = 0; c < 6; c++) rr[B->u[c]] = rr[B->r[c]] = 0;\n  }\n}\n\n", f);
+  fputs("/* the eliminated unknowns of d from the others: a_u = Du^-1 (g_r - Dx a_x),\n"
+        " * lambda_r = Du^-T (f_u - Eu^T lambda_s) */\n"
+        "static void ldl_block_back(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *d) {\n"
+        "  for (int e = 0; e < LDL_NBLOCK; e++) {\n"
+        "    const ldl_block *B = &ldl_blocks[e];\n"
+        "    const mb_real *A = work + B->w, *piv = A + 36;\n"
+        "    mb_real y[6], z[6];\n"
+        "    for (int i = 0; i < 6; i++) y[i] = r[B->r[i]];\n"
+        "    for (int xi = 0; xi < B->nx; xi++) {\n"
+        "      const int *dx = B->dx + 6 * xi;\n"
+        "      for (int i = 0; i < 6; i++) if (dx[i] >= 0) y[i] -= Kx[dx[i]] * d[B->x[xi]];\n    }\n"
+        "    ldl_lu6_solve(A, piv, y);\n"
+        "    for (int c = 0; c < 6; c++) z[c] = r[B->u[c]];\n"
+        "    for (int si = 0; si < B->ns; si++)\n"
+        "      for (int c = 0; c < 6; c++) if (B->eu[6 * si + c] >= 0) z[c] -= Kx[B->eu[6 * si + c]] * d[B->s[si]];\n"
+        "    ldl_lu6_solve_t(A, piv, z);\n"
+        "    for (int c = 0; c < 6; c++) { d[B->u[c]] = y[c]; d[B->r[c]] = z[c]; }\n  }\n}\n\n", f);
+}
+
+/* the public factorization: ||K||, the block pivots, then L D L^T of K_aug */
+static void emit_factor_entry(FILE *f, const lmodel *L, const ldl_plan *p, const char *nm) {
+  fprintf(f, "int %s_ldl_factor(const mb_real *Kx, mb_real *work) {\n", nm);
+  emit_knorm(f, L, p);
+  if (p->nelim) {
+    fputs("  int rc = ldl_block_pivots(Kx, work);\n  if (rc) return rc;\n", f);
+    fputs("  return ldl_factor_aug(work + LDL_KR, work);\n}\n\n", f);
+  } else {
+    fputs("  return ldl_factor_aug(Kx, work);\n}\n\n", f);
+  }
 }
 
 /* ------------------------------------------------------------------ solve */
@@ -276,10 +452,17 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
   if (p->nnzL == 0) fputs("  (void)Lx;\n", f);
   fputs("}\n\n", f);
 
-  fputs("/* x += P^T t */\n", f);
-  fputs("static void ldl_scatter_add(const mb_real *t, mb_real *x) {\n", f);
-  for (int k = 0; k < n; k++) fprintf(f, "  x[%d] += t[%d];\n", p->perm[k], k);
-  fputs("}\n\n", f);
+  if (p->nelim) {
+    fputs("/* x = P^T t */\n", f);
+    fputs("static void ldl_scatter(const mb_real *t, mb_real *x) {\n", f);
+    for (int k = 0; k < n; k++) fprintf(f, "  x[%d] = t[%d];\n", p->perm[k], k);
+    fputs("}\n\n", f);
+  } else {
+    fputs("/* x += P^T t */\n", f);
+    fputs("static void ldl_scatter_add(const mb_real *t, mb_real *x) {\n", f);
+    for (int k = 0; k < n; k++) fprintf(f, "  x[%d] += t[%d];\n", p->perm[k], k);
+    fputs("}\n\n", f);
+  }
 
   /* r = b - K x by rows */
   fputs("/* r = b - K x (the exact system, original Kx) */\n", f);
@@ -324,9 +507,14 @@ static void emit_solve_helpers_looped(FILE *f, const ldl_plan *p) {
         "    mb_real s = t[j];\n"
         "    for (int q = ldl_Lp[j]; q < ldl_Lp[j + 1]; q++) s -= Lx[q] * t[ldl_Li[q]];\n"
         "    t[j] = s;\n  }\n}\n\n", f);
-  fputs("/* x += P^T t */\n", f);
-  fputs("static void ldl_scatter_add(const mb_real *t, mb_real *x) {\n"
-        "  for (int k = 0; k < LDL_N; k++) x[ldl_perm[k]] += t[k];\n}\n\n", f);
+  if (p->nelim)
+    fputs("/* x = P^T t */\n"
+          "static void ldl_scatter(const mb_real *t, mb_real *x) {\n"
+          "  for (int k = 0; k < LDL_N; k++) x[ldl_perm[k]] = t[k];\n}\n\n", f);
+  else
+    fputs("/* x += P^T t */\n"
+          "static void ldl_scatter_add(const mb_real *t, mb_real *x) {\n"
+          "  for (int k = 0; k < LDL_N; k++) x[ldl_perm[k]] += t[k];\n}\n\n", f);
   fputs("/* r = b - K x (the exact system, original Kx) */\n", f);
   fputs("static void ldl_residual(const mb_real *Kx, const mb_real *x, const mb_real *b, mb_real *r) {\n"
         "  for (int i = 0; i < LDL_N; i++) r[i] = b[i];\n"
@@ -335,19 +523,17 @@ static void emit_solve_helpers_looped(FILE *f, const ldl_plan *p) {
         "    for (int q = ldl_Kp[j]; q < ldl_Kp[j + 1]; q++) r[ldl_Ki[q]] -= Kx[q] * xj;\n  }\n}\n\n", f);
 }
 
-static void emit_solve(FILE *f, const char *nm) {
+static void emit_solve(FILE *f, const ldl_plan *p, const char *nm) {
   fprintf(f, "int %s_ldl_solve(const mb_real *Kx, mb_real *work, mb_real *b, mb_real *residual) {\n", nm);
-  fputs("  const mb_real *Lx = work, *Dinv = work + LDL_DINV;\n"
-        "  mb_real *x = work + LDL_X, *r = work + LDL_R, *t = work + LDL_T, *xb = work + LDL_XB;\n"
+  fprintf(f, "  const mb_real *Lx = work, *Dinv = work + LDL_DINV;\n"
+        "  mb_real *x = work + LDL_X, *r = work + LDL_R, *t = work + LDL_T, *xb = work + LDL_XB;\n%s"
         "  mb_real knorm = work[LDL_KNORM], bn = 0, best = 0;\n"
         "  for (int i = 0; i < LDL_N; i++) {\n"
         "    x[i] = 0;\n    r[i] = b[i];\n    if (fabs(b[i]) > bn) bn = fabs(b[i]);\n  }\n"
         "  /* pass 0: the solve; pass 1: refinement; pass 2: a second one if still above 1e-12 */\n"
         "  for (int it = 0; it < 3; it++) {\n"
         "    mb_real rn = 0, xn = 0, den, rel;\n"
-        "    ldl_aug(Kx, r, t);\n"
-        "    ldl_lsolve(Lx, Dinv, t);\n"
-        "    ldl_scatter_add(t, x);\n"
+        "%s"
         "    ldl_residual(Kx, x, b, r);\n"
         "    for (int i = 0; i < LDL_N; i++) {\n"
         "      if (!(fabs(r[i]) <= rn)) rn = fabs(r[i]);\n"
@@ -362,7 +548,18 @@ static void emit_solve(FILE *f, const char *nm) {
         "  if (best <= LDL_REFINE_TOL) for (int i = 0; i < LDL_N; i++) b[i] = x[i];\n"
         "  else for (int i = 0; i < LDL_N; i++) b[i] = xb[i];\n"
         "  if (residual) *residual = best;\n"
-        "  return isfinite(best) ? MB_OK : MB_ERR_NONFINITE;\n}\n\n", f);
+        "  return isfinite(best) ? MB_OK : MB_ERR_NONFINITE;\n}\n\n",
+        p->nelim ? "  mb_real *rr = work + LDL_RR, *d = work + LDL_DD;\n" : "",
+        p->nelim ? "    /* the block pivots' right side, K_aug of K', their unknowns back, x += d */\n"
+                   "    ldl_block_rhs(Kx, work, r, rr);\n"
+                   "    ldl_aug(work + LDL_KR, rr, t);\n"
+                   "    ldl_lsolve(Lx, Dinv, t);\n"
+                   "    ldl_scatter(t, d);\n"
+                   "    ldl_block_back(Kx, work, r, d);\n"
+                   "    for (int i = 0; i < LDL_N; i++) x[i] += d[i];\n"
+                 : "    ldl_aug(Kx, r, t);\n"
+                   "    ldl_lsolve(Lx, Dinv, t);\n"
+                   "    ldl_scatter_add(t, x);\n");
 }
 
 int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
@@ -398,10 +595,11 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
   fprintf(f, "#define LDL_N %d\n#define LDL_DINV %s_LDL_NNZL\n#define LDL_KNORM (LDL_DINV + LDL_N)\n"
              "#define LDL_X (LDL_KNORM + 1)\n#define LDL_R (LDL_X + LDL_N)\n#define LDL_T (LDL_R + LDL_N)\n"
              "#define LDL_XB (LDL_T + LDL_N)\n#define LDL_PIVTOL 1e-14\n"
+             "#define LDL_KR (LDL_XB + LDL_N)\n#define LDL_RR (LDL_KR + %d)\n#define LDL_DD (LDL_RR + LDL_N)\n"
              "/* a solve whose relative residual is already this small is not refined */\n"
              "#define LDL_REFINE_TOL 1e-15\n"
              "#if defined(__GNUC__)\n#define LDL_NOINLINE __attribute__((noinline))\n#else\n#define LDL_NOINLINE\n#endif\n",
-          n, U);
+          n, U, p.nelim ? p.nnzR : 0);
   /* pivot order as a comment (straight) or a table (looped) */
   if (p.straight) {
     fputs("/* pivot order: ", f);
@@ -457,11 +655,13 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
     int_array(f, "ldl_Ki", m->Ki, m->nnz);
     fputc('\n', f);
   }
+  if (p.nelim) emit_blocks(f, L, &p);
   if (p.straight) emit_factor_straight(f, L, &p, nm);
   else emit_factor_looped(f, L, &p, nm);
+  emit_factor_entry(f, L, &p, nm);
   if (p.straight) emit_solve_helpers_straight(f, L, &p);
   else emit_solve_helpers_looped(f, &p);
-  emit_solve(f, nm);
+  emit_solve(f, &p, nm);
   fputs("static int ldl_factor_m(const mb_model *m, const mb_real *Kx, mb_real *work) {\n", f);
   fprintf(f, "  (void)m;\n  return %s_ldl_factor(Kx, work);\n}\n", nm);
   fputs("static int ldl_solve_m(const mb_model *m, const mb_real *Kx, mb_real *work, mb_real *b,\n"
