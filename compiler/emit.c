@@ -236,8 +236,8 @@ static int emit_cols(FILE *f, const lmodel *L, int k, const char *P, const char 
   const mb_markerdef *d = &L->marker[k];
   const mb_body *B = &L->body[d->body];
   if (d->node >= 0) {
-    fprintf(f, "%smb_node_cols(&f[%d], &flex%d, %d, q + %d, %s, %s, %s, c);\n", indent, d->body,
-            d->body, d->node, B->qadr + 7, P, dV, dW);
+    fprintf(f, "%smb_node_cols_mk(&f[%d], &flex%d, %d, &k[%d], %s, %s, c);\n", indent, d->body,
+            d->body, d->node, k, dV, dW);
     return 6 + B->nm;
   }
   fprintf(f, "%smb_rigid_cols(&f[%d], %s, %s, %s, c);\n", indent, d->body, P, dV, dW);

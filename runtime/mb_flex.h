@@ -98,6 +98,7 @@ static inline void mb_marker_node(const mb_frame *f, const mb_flex *fx, int k, c
   mb_modal3(Psi, nm, wd, thd);
   mb_modal3(X, nm, wd, Xwd);
   mb_so3_jl(th, thd, Jl, Jld);
+  for (int i = 0; i < 9; i++) m->Jl[i] = Jl[i];
   mb_so3_exp(th, Ex);
   mb_matmul3(f->A, Ex, AE);
   mb_matmul3(AE, C, m->R);
@@ -136,6 +137,21 @@ static inline void mb_node_cols(const mb_frame *f, const mb_flex *fx, int k, con
   mb_mul3t(f->A, dV, lV);
   mb_mul3t(f->A, dW, lW);
   mb_mul3t(Jl, lW, JtW);
+  for (int j = 0; j < nm; j++) c[6 + j] = mb_dot3(X + 3 * j, lV) + mb_dot3(Psi + 3 * j, JtW);
+}
+
+/* mb_node_cols at the marker mk of node k as set by mb_marker_node (its point
+ * and the left Jacobian it computed): the same columns without evaluating
+ * the node's rotation again for every row and force on the marker */
+static inline void mb_node_cols_mk(const mb_frame *f, const mb_flex *fx, int k, const mb_marker *mk,
+                                   const mb_real dV[3], const mb_real dW[3], mb_real *c) {
+  int nm = fx->nm;
+  const mb_real *X = fx->node_X + 3 * k * nm, *Psi = fx->node_Psi + 3 * k * nm;
+  mb_real lV[3], lW[3], JtW[3];
+  mb_rigid_cols(f, mk->P, dV, dW, c);
+  mb_mul3t(f->A, dV, lV);
+  mb_mul3t(f->A, dW, lW);
+  mb_mul3t(mk->Jl, lW, JtW);
   for (int j = 0; j < nm; j++) c[6 + j] = mb_dot3(X + 3 * j, lV) + mb_dot3(Psi + 3 * j, JtW);
 }
 
