@@ -60,7 +60,7 @@ static void real_array(FILE *f, const char *name, const double *x, long n) {
   fprintf(f, "\n};\n");
 }
 
-/* the block pivots' workspace: LU of Du (36), its row swaps (6), W = Eu Du^-1 (6 per S row) */
+/* the block pivots' workspace: Du^-1 (36, then 6 unused), W = Eu Du^-1 (6 per S row) */
 static long block_work(const ldl_plan *p, int e) { return 42L + 6L * (p->esp[e + 1] - p->esp[e]); }
 
 static long work_size(const ldl_plan *p) {
@@ -99,14 +99,30 @@ void emit_ldl_fields(FILE *f, const char *nm, int emitted) {
 
 /* ---------------------------------------------------------------- helpers */
 
+/* Where the straight-line code reads the entry at position q of K' (the
+ * plan's slots): with block pivots, the entries they change (and the
+ * decoupled diagonals) are in Kc (the block pivots' output, kc_of[q] >= 0),
+ * all others straight from Kx (slot Krmap[q]); without, K' = K.  (The looped
+ * code gathers all of K' into Kc instead: kc_of[q] = q.) */
+static const int *kc_of, *kc_map;
+
+static void kval(FILE *f, int q) {
+  if (!kc_of) fprintf(f, "Kx[%d]", q);
+  else if (kc_of[q] >= 0) fprintf(f, "Kc[%d]", kc_of[q]);
+  else fprintf(f, "Kx[%d]", kc_map[q]);
+}
+
 /* the value of K_aug entry e (upper triangle, permuted) as a C expression */
 static void aug_value(FILE *f, const ldl_plan *p, int e) {
   int any = 0;
-  if (p->Us[e] >= 0) { fprintf(f, "Kx[%d]", p->Us[e]); any = 1; }
+  if (p->Us[e] >= 0) { kval(f, p->Us[e]); any = 1; }
   for (int t = p->Tp[e]; t < p->Tp[e + 1]; t++) {
     fputs(any ? " + " : "", f);
     num(f, p->w[p->Tw[t]]);
-    fprintf(f, " * Kx[%d] * Kx[%d]", p->Ta[t], p->Tb[t]);
+    fputs(" * ", f);
+    kval(f, p->Ta[t]);
+    fputs(" * ", f);
+    kval(f, p->Tb[t]);
     any = 1;
   }
   if (!any) fputs("0", f);
@@ -166,9 +182,9 @@ static void emit_factor_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
   for (int k = 0; k < n; k++) {
     if (k == 0 || chunk_flops > LDL_CHUNK_FLOPS) {
       if (k) fputs("  (void)t;\n  (void)l;\n  return 0;\n}\n\n", f);
-      fprintf(f, "static LDL_NOINLINE int ldl_factor_part%d(const mb_real *Kx, mb_real *Lx, mb_real *Dinv) {\n",
-              nchunk++);
-      fputs("  mb_real d, s, t = 0, l = 0;\n  (void)Kx;\n  (void)Lx;\n", f);
+      fprintf(f, "static LDL_NOINLINE int ldl_factor_part%d(const mb_real *Kx,%s mb_real *Lx, mb_real *Dinv) {\n",
+              nchunk++, p->nelim ? " const mb_real *Kc," : "");
+      fprintf(f, "  mb_real d, s, t = 0, l = 0;\n  (void)Kx;\n%s  (void)Lx;\n", p->nelim ? "  (void)Kc;\n" : "");
       chunk_flops = 0;
     }
     int u = p->perm[k];
@@ -211,11 +227,11 @@ static void emit_factor_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
   (void)L;
   (void)nm;
   fputs("/* L D L^T of K_aug, whose entries come from Kx (K, or K' after the block pivots) */\n", f);
-  fputs("static int ldl_factor_aug(const mb_real *Kx, mb_real *work) {\n", f);
+  fprintf(f, "static int ldl_factor_aug(const mb_real *Kx,%s mb_real *work) {\n", p->nelim ? " const mb_real *Kc," : "");
   fputs("  mb_real *Lx = work, *Dinv = work + LDL_DINV;\n  int rc;\n", f);
   fputs("  /* the pivots in order, in parts */\n", f);
   for (int c = 0; c < nchunk; c++)
-    fprintf(f, "  if ((rc = ldl_factor_part%d(Kx, Lx, Dinv)) != 0) return rc;\n", c);
+    fprintf(f, "  if ((rc = ldl_factor_part%d(Kx,%s Lx, Dinv)) != 0) return rc;\n", c, p->nelim ? " Kc," : "");
   fputs("  (void)Lx;\n  (void)Dinv;\n  (void)rc;\n  return 0;\n}\n\n", f);
   free(written);
   free(slot_of);
@@ -249,6 +265,167 @@ static void emit_factor_looped(FILE *f, const lmodel *L, const ldl_plan *p, cons
 
 /* ----------------------------------------------------------- block pivots */
 
+/* ldl_inv6 of the generated code */
+static void emit_inv6(FILE *f) {
+  fputs("\n/* X = A^-1 for a 6 x 6 A (row-major: rows the weld rows, columns the body's\n"
+        " * unknowns), Gauss-Jordan with partial pivoting; 1 if a pivot is below 1e-12\n"
+        " * of the largest entry.  D_u is a rotation and the identity up to signs, so\n"
+        " * the explicit inverse is accurate, and every later use is a 6 x 6 product */\n"
+        "static int ldl_inv6(const mb_real *A0, mb_real *X) {\n"
+        "  mb_real A[36], amax = 0;\n"
+        "  for (int i = 0; i < 36; i++) {\n"
+        "    A[i] = A0[i];\n    X[i] = i % 7 == 0;\n"
+        "    if (fabs(A[i]) > amax) amax = fabs(A[i]);\n  }\n"
+        "  for (int k = 0; k < 6; k++) {\n"
+        "    int pr = k;\n"
+        "    for (int i = k + 1; i < 6; i++) if (fabs(A[6 * i + k]) > fabs(A[6 * pr + k])) pr = i;\n"
+        "    if (!(fabs(A[6 * pr + k]) > 1e-12 * amax)) return 1;\n"
+        "    if (pr != k)\n"
+        "      for (int j = 0; j < 6; j++) {\n"
+        "        mb_real t = A[6 * k + j]; A[6 * k + j] = A[6 * pr + j]; A[6 * pr + j] = t;\n"
+        "        t = X[6 * k + j]; X[6 * k + j] = X[6 * pr + j]; X[6 * pr + j] = t;\n      }\n"
+        "    mb_real d = 1 / A[6 * k + k];\n"
+        "    for (int j = 0; j < 6; j++) { A[6 * k + j] *= d; X[6 * k + j] *= d; }\n"
+        "    for (int i = 0; i < 6; i++) {\n"
+        "      mb_real l = A[6 * i + k];\n"
+        "      if (i == k || l == 0) continue;\n"
+        "      for (int j = 0; j < 6; j++) { A[6 * i + j] -= l * A[6 * k + j]; X[6 * i + j] -= l * X[6 * k + j]; }\n"
+        "    }\n  }\n  return 0;\n}\n\n", f);
+}
+
+/* "Kx[slot]" or "0" */
+static void kx_or_zero(FILE *f, int slot) {
+  if (slot >= 0) fprintf(f, "Kx[%d]", slot);
+  else fputs("0", f);
+}
+
+/* the block pivots straight-line (below the flop budget): every slot a
+ * constant, structural zeros of Du, Dx and Eu skipped */
+static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, const long *woff) {
+  char name[512];
+  int nkc = 0;
+  for (int q = 0; q < p->nnzR; q++)
+    if (kc_of[q] >= 0 && kc_of[q] + 1 > nkc) nkc = kc_of[q] + 1;
+  int *src = malloc(sizeof(int) * (size_t)(nkc + 1));
+  if (!src) return;
+  for (int q = 0; q < p->nnzR; q++)
+    if (kc_of[q] >= 0) src[kc_of[q]] = p->Krmap[q];
+  fputs("/* Kc (the entries of K' the block pivots set) from Kx; returns 0, or 1 + a column\n"
+        " * of a virtual body whose Du is singular */\n"
+        "static int ldl_block_pivots(const mb_real *Kx, mb_real *work) {\n"
+        "  mb_real *Kc = work + LDL_KR, A[36], *Di, *W, v;\n"
+        "  /* the entries of K' that the blocks change, and the decoupled diagonals */\n", f);
+  for (int k = 0; k < nkc; k++) {
+    fprintf(f, "  Kc[%d] = ", k);
+    if (src[k] >= 0) fprintf(f, "Kx[%d]", src[k]);
+    else fputs(src[k] == -2 ? "1" : src[k] == -3 ? "-1" : "0", f);
+    fputs(";\n", f);
+  }
+  free(src);
+  for (int e = 0; e < p->nelim; e++) {
+    int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
+    fprintf(f, "  /* block %d: Du^-1, W = Eu Du^-1, K'(s, x) -= (W Dx)(s, x) */\n", e);
+    fprintf(f, "  Di = work + %ld;\n  W = Di + 42;\n", woff[e]);
+    for (int i = 0; i < 36; i++) {
+      fprintf(f, "  A[%d] = ", i);
+      kx_or_zero(f, p->edu[e][i]);
+      fputs(";\n", f);
+    }
+    fprintf(f, "  if (ldl_inv6(A, Di)) return %d;\n", 1 + p->eu[e][0]);
+    int k = p->ekrp[e];
+    for (int si = 0; si < ns; si++) {
+      const int *eu = p->eeu + 6 * (ss + si);
+      ldl_unknown_name(L, p->es[ss + si], name, sizeof name);
+      fprintf(f, "  /* %s */\n", name);
+      for (int i = 0; i < 6; i++) {
+        fprintf(f, "  W[%d] = ", 6 * si + i);
+        int any = 0;
+        for (int c = 0; c < 6; c++)
+          if (eu[c] >= 0) { fprintf(f, "%sKx[%d] * Di[%d]", any ? " + " : "", eu[c], 6 * c + i); any = 1; }
+        if (!any) fputs("0", f);
+        fputs(";\n", f);
+      }
+      for (int xi = 0; xi < nx; xi++, k++) {
+        const int *dx = p->edx + 6 * (xs + xi);
+        int any = 0;
+        for (int i = 0; i < 6; i++)
+          if (dx[i] >= 0) {
+            fprintf(f, "%sW[%d] * Kx[%d]", any ? " + " : "  v = ", 6 * si + i, dx[i]);
+            any = 1;
+          }
+        if (!any) continue;
+        fprintf(f, ";\n  Kc[%d] -= v;\n  Kc[%d] -= v;\n", kc_of[p->ekr[2 * k]], kc_of[p->ekr[2 * k + 1]]);
+      }
+    }
+  }
+  fputs("  (void)v;\n  (void)W;\n  return 0;\n}\n\n", f);
+
+  fputs("/* rr = the right side of K' from r: g'_s = g_s - W g_r, f'_x = f_x - Dx^T Du^-T f_u */\n"
+        "static void ldl_block_rhs(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *rr) {\n"
+        "  const mb_real *Di, *W;\n  mb_real z[6];\n"
+        "  for (int i = 0; i < LDL_N; i++) rr[i] = r[i];\n", f);
+  for (int e = 0; e < p->nelim; e++) {
+    int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
+    fprintf(f, "  /* block %d */\n  Di = work + %ld;\n  W = Di + 42;\n", e, woff[e]);
+    for (int si = 0; si < ns; si++) {
+      fprintf(f, "  rr[%d] -= ", p->es[ss + si]);
+      for (int c = 0; c < 6; c++) fprintf(f, "%sW[%d] * r[%d]", c ? " + " : "", 6 * si + c, p->er[e][c]);
+      fputs(";\n", f);
+    }
+    for (int i = 0; i < 6; i++) {
+      fprintf(f, "  z[%d] = ", i);
+      for (int c = 0; c < 6; c++) fprintf(f, "%sDi[%d] * r[%d]", c ? " + " : "", 6 * c + i, p->eu[e][c]);
+      fputs(";\n", f);
+    }
+    for (int xi = 0; xi < nx; xi++) {
+      const int *dx = p->edx + 6 * (xs + xi);
+      int any = 0;
+      for (int i = 0; i < 6; i++)
+        if (dx[i] >= 0) {
+          if (!any) fprintf(f, "  rr[%d] -= ", p->ex[xs + xi]);
+          fprintf(f, "%sKx[%d] * z[%d]", any ? " + " : "", dx[i], i);
+          any = 1;
+        }
+      if (any) fputs(";\n", f);
+    }
+    for (int c = 0; c < 6; c++) fprintf(f, "  rr[%d] = rr[%d] = 0;\n", p->eu[e][c], p->er[e][c]);
+  }
+  fputs("  (void)Kx;\n  (void)W;\n}\n\n", f);
+
+  fputs("/* the eliminated unknowns of d from the others: a_u = Du^-1 (g_r - Dx a_x),\n"
+        " * lambda_r = Du^-T (f_u - Eu^T lambda_s) */\n"
+        "static void ldl_block_back(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *d) {\n"
+        "  const mb_real *Di;\n  mb_real y[6], z[6];\n", f);
+  for (int e = 0; e < p->nelim; e++) {
+    int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
+    fprintf(f, "  /* block %d */\n  Di = work + %ld;\n", e, woff[e]);
+    for (int i = 0; i < 6; i++) {
+      fprintf(f, "  y[%d] = r[%d]", i, p->er[e][i]);
+      for (int xi = 0; xi < nx; xi++) {
+        int sl = p->edx[6 * (xs + xi) + i];
+        if (sl >= 0) fprintf(f, " - Kx[%d] * d[%d]", sl, p->ex[xs + xi]);
+      }
+      fputs(";\n", f);
+    }
+    for (int c = 0; c < 6; c++) {
+      fprintf(f, "  z[%d] = r[%d]", c, p->eu[e][c]);
+      for (int si = 0; si < ns; si++) {
+        int sl = p->eeu[6 * (ss + si) + c];
+        if (sl >= 0) fprintf(f, " - Kx[%d] * d[%d]", sl, p->es[ss + si]);
+      }
+      fputs(";\n", f);
+    }
+    for (int c = 0; c < 6; c++) {
+      fprintf(f, "  d[%d] = ", p->eu[e][c]);
+      for (int i = 0; i < 6; i++) fprintf(f, "%sDi[%d] * y[%d]", i ? " + " : "", 6 * c + i, i);
+      fprintf(f, ";\n  d[%d] = ", p->er[e][c]);
+      for (int i = 0; i < 6; i++) fprintf(f, "%sDi[%d] * z[%d]", i ? " + " : "", 6 * i + c, i);
+      fputs(";\n", f);
+    }
+  }
+  fputs("  (void)Kx;\n}\n\n", f);
+}
+
 static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
   const mb_model *m = &L->m;
   char name[512];
@@ -256,9 +433,10 @@ static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
         " * its 6 weld rows as one 12 x 12 pivot [0 Du^T; Du 0] before the LDL^T:\n"
         " *   K'(s, x) = K(s, x) - (Eu Du^-1 Dx)(s, x)  (S: the other rows on its columns,\n"
         " *   X: the columns of the body it is welded to); see docs/formulation.md. */\n", f);
+  if (!p->straight)
   fputs("typedef struct {\n"
         "  int nx, ns;      /* columns X, rows S */\n"
-        "  int kr, w;       /* first pair in ldl_ekr; workspace: LU of Du, row swaps, W = Eu Du^-1 */\n"
+        "  int kr, w;       /* first pair in ldl_ekc; workspace: Du^-1, W = Eu Du^-1 */\n"
         "  const int *u, *r, *x, *s; /* its columns, weld rows, X, S (K indices) */\n"
         "  const int *du, *dx, *eu;  /* Kx slots (-1: zero) of Du (6 x 6), Dx (6 per x), Eu (6 per s) */\n"
         "} ldl_block;\n", f);
@@ -278,6 +456,9 @@ static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
       fprintf(f, "\n *   %s", name);
     }
     fputs(" */\n", f);
+    woff[e] = w;
+    w += block_work(p, e);
+    if (p->straight) continue;
     char nmx[64];
     snprintf(nmx, sizeof nmx, "ldl_b%d_u", e); int_array(f, nmx, p->eu[e], 6);
     snprintf(nmx, sizeof nmx, "ldl_b%d_r", e); int_array(f, nmx, p->er[e], 6);
@@ -286,8 +467,12 @@ static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
     snprintf(nmx, sizeof nmx, "ldl_b%d_du", e); int_array(f, nmx, p->edu[e], 36);
     snprintf(nmx, sizeof nmx, "ldl_b%d_dx", e); int_array(f, nmx, p->edx + 6 * xs, 6L * nx);
     snprintf(nmx, sizeof nmx, "ldl_b%d_eu", e); int_array(f, nmx, p->eeu + 6 * ss, 6L * ns);
-    woff[e] = w;
-    w += block_work(p, e);
+  }
+  emit_inv6(f);
+  if (p->straight) {
+    emit_blocks_straight(f, L, p, woff);
+    free(woff);
+    return;
   }
   fprintf(f, "#define LDL_NBLOCK %d\n", p->nelim);
   fprintf(f, "static const ldl_block ldl_blocks[LDL_NBLOCK] = {\n");
@@ -296,82 +481,64 @@ static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
             p->exp_[e + 1] - p->exp_[e], p->esp[e + 1] - p->esp[e], p->ekrp[e], woff[e], e, e, e, e, e, e, e);
   fputs("};\n", f);
   free(woff);
-  fputs("/* K' positions of the corrected pairs (s, x), (x, s), block by block, s-major */\n", f);
-  int_array(f, "ldl_ekr", p->ekr, 2L * p->ekrp[p->nelim]);
-  fputs("/* K' (CSC, both triangles) from Kx: a Kx slot, or -1: 0, -2: 1 (eliminated column),\n"
-        " * -3: -1 (eliminated row) */\n", f);
-  fprintf(f, "#define LDL_NKR %d\n", p->nnzR);
-  int_array(f, "ldl_Krmap", p->Krmap, p->nnzR);
-  fputs("\n/* 6 x 6 LU with partial pivoting (A row-major, row swaps in piv); 1 if a pivot\n"
-        " * is below 1e-12 of the largest entry */\n"
-        "static int ldl_lu6(mb_real *A, mb_real *piv) {\n"
-        "  mb_real amax = 0;\n"
-        "  for (int i = 0; i < 36; i++) if (fabs(A[i]) > amax) amax = fabs(A[i]);\n"
-        "  for (int k = 0; k < 6; k++) {\n"
-        "    int pr = k;\n"
-        "    for (int i = k + 1; i < 6; i++) if (fabs(A[6 * i + k]) > fabs(A[6 * pr + k])) pr = i;\n"
-        "    piv[k] = pr;\n"
-        "    if (!(fabs(A[6 * pr + k]) > 1e-12 * amax)) return 1;\n"
-        "    if (pr != k)\n"
-        "      for (int j = 0; j < 6; j++) { mb_real t = A[6 * k + j]; A[6 * k + j] = A[6 * pr + j]; A[6 * pr + j] = t; }\n"
-        "    for (int i = k + 1; i < 6; i++) {\n"
-        "      mb_real l = A[6 * i + k] /= A[6 * k + k];\n"
-        "      for (int j = k + 1; j < 6; j++) A[6 * i + j] -= l * A[6 * k + j];\n"
-        "    }\n  }\n  return 0;\n}\n\n"
-        "/* b <- A^-1 b */\n"
-        "static void ldl_lu6_solve(const mb_real *A, const mb_real *piv, mb_real *b) {\n"
-        "  for (int k = 0; k < 6; k++) {\n"
-        "    int pr = (int)piv[k];\n"
-        "    if (pr != k) { mb_real t = b[k]; b[k] = b[pr]; b[pr] = t; }\n  }\n"
-        "  for (int k = 0; k < 6; k++) for (int j = 0; j < k; j++) b[k] -= A[6 * k + j] * b[j];\n"
-        "  for (int k = 5; k >= 0; k--) {\n"
-        "    for (int j = k + 1; j < 6; j++) b[k] -= A[6 * k + j] * b[j];\n"
-        "    b[k] /= A[6 * k + k];\n  }\n}\n\n"
-        "/* b <- A^-T b */\n"
-        "static void ldl_lu6_solve_t(const mb_real *A, const mb_real *piv, mb_real *b) {\n"
-        "  for (int k = 0; k < 6; k++) {\n"
-        "    for (int j = 0; j < k; j++) b[k] -= A[6 * j + k] * b[j];\n"
-        "    b[k] /= A[6 * k + k];\n  }\n"
-        "  for (int k = 5; k >= 0; k--) for (int j = k + 1; j < 6; j++) b[k] -= A[6 * j + k] * b[j];\n"
-        "  for (int k = 5; k >= 0; k--) {\n"
-        "    int pr = (int)piv[k];\n"
-        "    if (pr != k) { mb_real t = b[k]; b[k] = b[pr]; b[pr] = t; }\n  }\n}\n\n", f);
-  fputs("/* Kr = K' from Kx; returns 0, or 1 + a column of a virtual body whose Du is singular */\n"
+  /* Kc: the entries of K' the block pivots change (straight-line code; the
+     others are read from Kx), or all of K' (looped code) */
+  int nkc = 0, npair = p->ekrp[p->nelim];
+  int *src = malloc(sizeof(int) * (size_t)(p->nnzR + 1)), *ekc = malloc(sizeof(int) * (size_t)(2 * npair + 1));
+  if (!src || !ekc) { free(src); free(ekc); return; }
+  for (int q = 0; q < p->nnzR; q++)
+    if (kc_of[q] >= 0) src[kc_of[q]] = p->Krmap[q], nkc = kc_of[q] + 1 > nkc ? kc_of[q] + 1 : nkc;
+  for (int k = 0; k < 2 * npair; k++) ekc[k] = kc_of[p->ekr[k]];
+  fputs("/* Kc entries of the corrected pairs (s, x), (x, s), block by block, s-major */\n", f);
+  int_array(f, "ldl_ekc", ekc, 2L * npair);
+  fprintf(f, "/* Kc = %s from Kx: a Kx slot, or -1: 0, -2: 1 (eliminated column),\n"
+             " * -3: -1 (eliminated row) */\n",
+          p->straight ? "the entries of K' the block pivots set" : "K' (CSC, both triangles)");
+  fprintf(f, "#define LDL_NKC %d\n", nkc);
+  int_array(f, "ldl_Kcsrc", src, nkc);
+  free(src);
+  free(ekc);
+
+  fputs("/* Kc (the entries of K' above) from Kx; returns 0, or 1 + a column of a virtual\n"
+        " * body whose Du is singular */\n"
         "static int ldl_block_pivots(const mb_real *Kx, mb_real *work) {\n"
-        "  mb_real *Kr = work + LDL_KR;\n"
-        "  for (int q = 0; q < LDL_NKR; q++) {\n"
-        "    int s = ldl_Krmap[q];\n"
-        "    Kr[q] = s >= 0 ? Kx[s] : s == -2 ? 1 : s == -3 ? -1 : 0;\n  }\n"
+        "  mb_real *Kc = work + LDL_KR;\n"
+        "  for (int q = 0; q < LDL_NKC; q++) {\n"
+        "    int s = ldl_Kcsrc[q];\n"
+        "    Kc[q] = s >= 0 ? Kx[s] : s == -2 ? 1 : s == -3 ? -1 : 0;\n  }\n"
         "  for (int e = 0; e < LDL_NBLOCK; e++) {\n"
         "    const ldl_block *B = &ldl_blocks[e];\n"
-        "    mb_real *A = work + B->w, *piv = A + 36, *W = A + 42;\n"
+        "    mb_real A[36], *Di = work + B->w, *W = Di + 42;\n"
         "    int k = B->kr;\n"
         "    for (int i = 0; i < 36; i++) A[i] = B->du[i] >= 0 ? Kx[B->du[i]] : 0;\n"
-        "    if (ldl_lu6(A, piv)) return 1 + B->u[0];\n"
+        "    if (ldl_inv6(A, Di)) return 1 + B->u[0];\n"
         "    for (int si = 0; si < B->ns; si++) {\n"
-        "      mb_real *w = W + 6 * si; /* row s of W = Eu Du^-1: Du^T w = Eu(s, :)^T */\n"
-        "      for (int c = 0; c < 6; c++) w[c] = B->eu[6 * si + c] >= 0 ? Kx[B->eu[6 * si + c]] : 0;\n"
-        "      ldl_lu6_solve_t(A, piv, w);\n"
+        "      mb_real *w = W + 6 * si, e[6]; /* row s of W = Eu Du^-1 */\n"
+        "      for (int c = 0; c < 6; c++) e[c] = B->eu[6 * si + c] >= 0 ? Kx[B->eu[6 * si + c]] : 0;\n"
+        "      for (int i = 0; i < 6; i++) {\n"
+        "        w[i] = 0;\n"
+        "        for (int c = 0; c < 6; c++) w[i] += e[c] * Di[6 * c + i];\n      }\n"
         "      for (int xi = 0; xi < B->nx; xi++, k++) {\n"
         "        const int *dx = B->dx + 6 * xi;\n"
         "        mb_real v = 0;\n"
         "        for (int i = 0; i < 6; i++) if (dx[i] >= 0) v += w[i] * Kx[dx[i]];\n"
-        "        Kr[ldl_ekr[2 * k]] -= v;\n"
-        "        Kr[ldl_ekr[2 * k + 1]] -= v;\n"
+        "        Kc[ldl_ekc[2 * k]] -= v;\n"
+        "        Kc[ldl_ekc[2 * k + 1]] -= v;\n"
         "      }\n    }\n  }\n  return 0;\n}\n\n", f);
   fputs("/* rr = the right side of K' from r: g'_s = g_s - W g_r, f'_x = f_x - Dx^T Du^-T f_u */\n"
         "static void ldl_block_rhs(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *rr) {\n"
         "  for (int i = 0; i < LDL_N; i++) rr[i] = r[i];\n"
         "  for (int e = 0; e < LDL_NBLOCK; e++) {\n"
         "    const ldl_block *B = &ldl_blocks[e];\n"
-        "    const mb_real *A = work + B->w, *piv = A + 36, *W = A + 42;\n"
+        "    const mb_real *Di = work + B->w, *W = Di + 42;\n"
         "    mb_real z[6];\n"
         "    for (int si = 0; si < B->ns; si++) {\n"
         "      mb_real v = 0;\n"
         "      for (int c = 0; c < 6; c++) v += W[6 * si + c] * r[B->r[c]];\n"
         "      rr[B->s[si]] -= v;\n    }\n"
-        "    for (int c = 0; c < 6; c++) z[c] = r[B->u[c]];\n"
-        "    ldl_lu6_solve_t(A, piv, z);\n"
+        "    for (int i = 0; i < 6; i++) { /* z = Du^-T f_u */\n"
+        "      z[i] = 0;\n"
+        "      for (int c = 0; c < 6; c++) z[i] += Di[6 * c + i] * r[B->u[c]];\n    }\n"
         "    for (int xi = 0; xi < B->nx; xi++) {\n"
         "      const int *dx = B->dx + 6 * xi;\n"
         "      mb_real v = 0;\n"
@@ -383,18 +550,19 @@ static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
         "static void ldl_block_back(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *d) {\n"
         "  for (int e = 0; e < LDL_NBLOCK; e++) {\n"
         "    const ldl_block *B = &ldl_blocks[e];\n"
-        "    const mb_real *A = work + B->w, *piv = A + 36;\n"
+        "    const mb_real *Di = work + B->w;\n"
         "    mb_real y[6], z[6];\n"
         "    for (int i = 0; i < 6; i++) y[i] = r[B->r[i]];\n"
         "    for (int xi = 0; xi < B->nx; xi++) {\n"
         "      const int *dx = B->dx + 6 * xi;\n"
         "      for (int i = 0; i < 6; i++) if (dx[i] >= 0) y[i] -= Kx[dx[i]] * d[B->x[xi]];\n    }\n"
-        "    ldl_lu6_solve(A, piv, y);\n"
         "    for (int c = 0; c < 6; c++) z[c] = r[B->u[c]];\n"
         "    for (int si = 0; si < B->ns; si++)\n"
         "      for (int c = 0; c < 6; c++) if (B->eu[6 * si + c] >= 0) z[c] -= Kx[B->eu[6 * si + c]] * d[B->s[si]];\n"
-        "    ldl_lu6_solve_t(A, piv, z);\n"
-        "    for (int c = 0; c < 6; c++) { d[B->u[c]] = y[c]; d[B->r[c]] = z[c]; }\n  }\n}\n\n", f);
+        "    for (int c = 0; c < 6; c++) { /* a_u = Du^-1 y, lambda_r = Du^-T z */\n"
+        "      mb_real a = 0, l = 0;\n"
+        "      for (int i = 0; i < 6; i++) { a += Di[6 * c + i] * y[i]; l += Di[6 * i + c] * z[i]; }\n"
+        "      d[B->u[c]] = a;\n      d[B->r[c]] = l;\n    }\n  }\n}\n\n", f);
 }
 
 /* the public factorization: ||K||, the block pivots, then L D L^T of K_aug */
@@ -403,7 +571,8 @@ static void emit_factor_entry(FILE *f, const lmodel *L, const ldl_plan *p, const
   emit_knorm(f, L, p);
   if (p->nelim) {
     fputs("  int rc = ldl_block_pivots(Kx, work);\n  if (rc) return rc;\n", f);
-    fputs("  return ldl_factor_aug(work + LDL_KR, work);\n}\n\n", f);
+    fputs(p->straight ? "  return ldl_factor_aug(Kx, work + LDL_KR, work);\n}\n\n"
+                      : "  return ldl_factor_aug(work + LDL_KR, work);\n}\n\n", f);
   } else {
     fputs("  return ldl_factor_aug(Kx, work);\n}\n\n", f);
   }
@@ -416,7 +585,9 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
   int n = p->n, nv = p->nv;
   /* t = P [r_top + D^T W r_bot; r_bot] */
   fputs("/* t = P [r_top + D^T W r_bot; r_bot]: the right side of K_aug, permuted */\n", f);
-  fputs("static void ldl_aug(const mb_real *Kx, const mb_real *r, mb_real *t) {\n", f);
+  fprintf(f, "static void ldl_aug(const mb_real *Kx,%s const mb_real *r, mb_real *t) {\n",
+          p->nelim ? " const mb_real *Kc," : "");
+  if (p->nelim) fputs("  (void)Kc;\n", f);
   for (int k = 0; k < n; k++) {
     int u = p->perm[k];
     fprintf(f, "  t[%d] = r[%d]", k, u);
@@ -426,7 +597,9 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
           if (p->Dj[q] == u) {
             fputs(" + ", f);
             num(f, p->w[w]);
-            fprintf(f, " * Kx[%d] * r[%d]", p->Ds[q], nv + p->wrow[w]);
+            fputs(" * ", f);
+            kval(f, p->Ds[q]);
+            fprintf(f, " * r[%d]", nv + p->wrow[w]);
           }
     fputs(";\n", f);
   }
@@ -550,13 +723,20 @@ static void emit_solve(FILE *f, const ldl_plan *p, const char *nm) {
         "  if (residual) *residual = best;\n"
         "  return isfinite(best) ? MB_OK : MB_ERR_NONFINITE;\n}\n\n",
         p->nelim ? "  mb_real *rr = work + LDL_RR, *d = work + LDL_DD;\n" : "",
-        p->nelim ? "    /* the block pivots' right side, K_aug of K', their unknowns back, x += d */\n"
-                   "    ldl_block_rhs(Kx, work, r, rr);\n"
-                   "    ldl_aug(work + LDL_KR, rr, t);\n"
-                   "    ldl_lsolve(Lx, Dinv, t);\n"
-                   "    ldl_scatter(t, d);\n"
-                   "    ldl_block_back(Kx, work, r, d);\n"
-                   "    for (int i = 0; i < LDL_N; i++) x[i] += d[i];\n"
+        p->nelim ? (p->straight ? "    /* the block pivots' right side, K_aug of K', their unknowns back, x += d */\n"
+                                  "    ldl_block_rhs(Kx, work, r, rr);\n"
+                                  "    ldl_aug(Kx, work + LDL_KR, rr, t);\n"
+                                  "    ldl_lsolve(Lx, Dinv, t);\n"
+                                  "    ldl_scatter(t, d);\n"
+                                  "    ldl_block_back(Kx, work, r, d);\n"
+                                  "    for (int i = 0; i < LDL_N; i++) x[i] += d[i];\n"
+                                : "    /* the block pivots' right side, K_aug of K', their unknowns back, x += d */\n"
+                                  "    ldl_block_rhs(Kx, work, r, rr);\n"
+                                  "    ldl_aug(work + LDL_KR, rr, t);\n"
+                                  "    ldl_lsolve(Lx, Dinv, t);\n"
+                                  "    ldl_scatter(t, d);\n"
+                                  "    ldl_block_back(Kx, work, r, d);\n"
+                                  "    for (int i = 0; i < LDL_N; i++) x[i] += d[i];\n")
                  : "    ldl_aug(Kx, r, t);\n"
                    "    ldl_lsolve(Lx, Dinv, t);\n"
                    "    ldl_scatter_add(t, x);\n");
@@ -655,13 +835,28 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
     int_array(f, "ldl_Ki", m->Ki, m->nnz);
     fputc('\n', f);
   }
-  if (p.nelim) emit_blocks(f, L, &p);
+  int *kc = NULL;
+  if (p.nelim) {
+    kc = malloc(sizeof(int) * (size_t)(p.nnzR + 1));
+    if (!kc) { ldl_plan_free(&p); return 0; }
+    int nkc = 0;
+    for (int q = 0; q < p.nnzR; q++) kc[q] = p.straight ? -1 : nkc++;
+    if (p.straight) {
+      for (int k = 0; k < 2 * p.ekrp[p.nelim]; k++) kc[p.ekr[k]] = 0; /* mark */
+      for (int q = 0; q < p.nnzR; q++) kc[q] = kc[q] == 0 || p.Krmap[q] < 0 ? nkc++ : -1;
+    }
+    kc_of = kc;
+    kc_map = p.Krmap;
+    emit_blocks(f, L, &p);
+  }
   if (p.straight) emit_factor_straight(f, L, &p, nm);
   else emit_factor_looped(f, L, &p, nm);
   emit_factor_entry(f, L, &p, nm);
   if (p.straight) emit_solve_helpers_straight(f, L, &p);
   else emit_solve_helpers_looped(f, &p);
   emit_solve(f, &p, nm);
+  kc_of = kc_map = NULL;
+  free(kc);
   fputs("static int ldl_factor_m(const mb_model *m, const mb_real *Kx, mb_real *work) {\n", f);
   fprintf(f, "  (void)m;\n  return %s_ldl_factor(Kx, work);\n}\n", nm);
   fputs("static int ldl_solve_m(const mb_model *m, const mb_real *Kx, mb_real *work, mb_real *b,\n"
