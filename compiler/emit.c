@@ -4,6 +4,7 @@
  * Output is byte-reproducible: no timestamps, doubles printed with %.17g. */
 #define _POSIX_C_SOURCE 200809L
 #include <ctype.h>
+#include <math.h>
 #include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -70,13 +71,17 @@ static void loc_comment(FILE *f, const lmodel *L, ir_loc loc) {
 }
 
 static void emit_flex_tables(FILE *f, const lmodel *L, int b);
+static void emit_flex_contract(FILE *f, const lmodel *L, int b);
 
 /* the tables: bodies, markers, rows, forces, profiles, outputs */
 static void emit_tables(FILE *f, const lmodel *L) {
   const mb_model *m = &L->m;
   fprintf(f, "/* --- element tables (also used for outputs and energy) --- */\n");
   for (int b = 0; b < m->nbody; b++)
-    if (L->body[b].kind == MB_BODY_FLEXIBLE) emit_flex_tables(f, L, b);
+    if (L->body[b].kind == MB_BODY_FLEXIBLE) {
+      emit_flex_tables(f, L, b);
+      emit_flex_contract(f, L, b);
+    }
   if (L->nmodal_slot) int_array(f, "modal_slot", L->modal_slot, L->nmodal_slot);
   for (int k = 0; k < m->nprofile; k++) {
     const mb_profile *p = &L->profile[k];
@@ -231,8 +236,8 @@ static int emit_cols(FILE *f, const lmodel *L, int k, const char *P, const char 
   const mb_markerdef *d = &L->marker[k];
   const mb_body *B = &L->body[d->body];
   if (d->node >= 0) {
-    fprintf(f, "%smb_node_cols(&f[%d], &flex%d, %d, q + %d, %s, %s, %s, c);\n", indent, d->body,
-            d->body, d->node, B->qadr + 7, P, dV, dW);
+    fprintf(f, "%smb_node_cols_mk(&f[%d], &flex%d, %d, &k[%d], %s, %s, c);\n", indent, d->body,
+            d->body, d->node, k, dV, dW);
     return 6 + B->nm;
   }
   fprintf(f, "%smb_rigid_cols(&f[%d], %s, %s, %s, c);\n", indent, d->body, P, dV, dW);
@@ -284,6 +289,118 @@ static void emit_flex_tables(FILE *f, const lmodel *L, int b) {
           b, b, b, b, b, b, b, b, nn, b, b, b);
 }
 
+/* "c->name[k] = c0 + sum_t coef_t * v[idx_t];" with the nonzero terms only */
+static void emit_sum(FILE *f, const char *lhs, double c0, const double *coef, const int *idx, int nt,
+                     const char *v, long *nterm) {
+  fprintf(f, "  %s = ", lhs);
+  int any = 0;
+  if (c0 != 0 || nt == 0) { num(f, c0); any = 1; }
+  for (int t = 0; t < nt; t++) {
+    if (any) fputs(coef[t] < 0 ? " - " : " + ", f);
+    else if (coef[t] < 0) fputs("-", f);
+    num(f, fabs(coef[t]));
+    fprintf(f, " * %s[%d]", v, idx[t]);
+    any = 1;
+  }
+  fputs(";\n", f);
+  *nterm += nt;
+}
+
+/* a flexible body's per-step contractions (mb_flex_contract in
+ * runtime/mb_flex.h) straight-line: the invariants' nonzero entries as
+ * literal constants, zeros skipped (the tables are cleaned of rounding
+ * residue in compiler/flex.c, so the generic path sums the same terms) */
+static void emit_flex_contract(FILE *f, const lmodel *L, int b) {
+  const mb_body *B = &L->body[b];
+  const mb_flex *x = B->flex;
+  int nm = x->nm;
+  int lin = x->coupling != MB_COUPLING_CONSTANT, quad = x->coupling == MB_COUPLING_FULL;
+  double *coef = malloc(sizeof(double) * (size_t)(nm + 1));
+  int *idx = malloc(sizeof(int) * (size_t)(nm + 1));
+  if (!coef || !idx) { free(coef); free(idx); return; }
+  long nterm = 0;
+  char lhs[64];
+  fprintf(f, "\n/* flexible body '%s': the per-step contractions of its inertia invariants with\n"
+             " * w = q[%d..%d] and wd = v[%d..%d] (mb_flex_contract, runtime/mb_flex.h), nonzero terms only */\n",
+          B->name, B->qadr + 7, B->qadr + 7 + nm - 1, B->vadr + 6, B->vadr + 6 + nm - 1);
+  fprintf(f, "static void flex%d_contract(const mb_real *w, const mb_real *wd, mb_flex_step *c) {\n", b);
+  fputs("  (void)w;\n  (void)wd;\n", f);
+  for (int i = 0; i < 3; i++) { /* S = S0 + S1 w, S1wd = S1 wd, Cw = CPsi wd */
+    int nt = 0;
+    for (int j = 0; j < nm && lin; j++)
+      if (x->S1[3 * j + i] != 0) { coef[nt] = x->S1[3 * j + i]; idx[nt++] = j; }
+    snprintf(lhs, sizeof lhs, "c->S[%d]", i);
+    emit_sum(f, lhs, x->S0[i], coef, idx, nt, "w", &nterm);
+    nt = 0;
+    for (int j = 0; j < nm; j++)
+      if (x->S1[3 * j + i] != 0) { coef[nt] = x->S1[3 * j + i]; idx[nt++] = j; }
+    snprintf(lhs, sizeof lhs, "c->S1wd[%d]", i);
+    emit_sum(f, lhs, 0, coef, idx, nt, "wd", &nterm);
+    nt = 0;
+    for (int j = 0; j < nm; j++)
+      if (x->CPsi[3 * j + i] != 0) { coef[nt] = x->CPsi[3 * j + i]; idx[nt++] = j; }
+    snprintf(lhs, sizeof lhs, "c->Cw[%d]", i);
+    emit_sum(f, lhs, 0, coef, idx, nt, "wd", &nterm);
+  }
+  for (int j = 0; j < nm; j++) {
+    fprintf(f, "  /* mode %d: Fw = sum_a w_a F_%d,a; Gw = C0 + sum_a w_a G_a,%d; Gd = sum_a wd_a G_a,%d */\n",
+            j + 1, j, j, j);
+    for (int i = 0; i < 9; i++) {
+      int nt = 0;
+      for (int a = 0; a < nm && lin; a++) {
+        double v = x->F[9 * ((size_t)j * nm + a) + i];
+        if (v != 0) { coef[nt] = v; idx[nt++] = a; }
+      }
+      snprintf(lhs, sizeof lhs, "c->Fw[%d]", 9 * j + i);
+      emit_sum(f, lhs, 0, coef, idx, nt, "w", &nterm);
+    }
+    for (int i = 0; i < 3; i++) {
+      int nt = 0;
+      for (int a = 0; a < nm && lin; a++) {
+        double v = x->G[3 * ((size_t)a * nm + j) + i];
+        if (v != 0) { coef[nt] = v; idx[nt++] = a; }
+      }
+      snprintf(lhs, sizeof lhs, "c->Gw[%d]", 3 * j + i);
+      emit_sum(f, lhs, x->C0[3 * j + i], coef, idx, nt, "w", &nterm);
+      nt = 0;
+      for (int a = 0; a < nm; a++) {
+        double v = x->G[3 * ((size_t)a * nm + j) + i];
+        if (v != 0) { coef[nt] = v; idx[nt++] = a; }
+      }
+      snprintf(lhs, sizeof lhs, "c->Gd[%d]", 3 * j + i);
+      emit_sum(f, lhs, 0, coef, idx, nt, "wd", &nterm);
+    }
+  }
+  /* J = J0 + sum_j w_j (2 tr(E_j) I - E_j - E_j^T) [+ sum_j w_j (tr(Fw_j) I - (Fw_j + Fw_j^T) / 2)] */
+  fputs("  /* J = J0 + sum_j w_j J1_j", f);
+  if (quad) fputs(" + sum_j w_j (tr(Fw_j) I - (Fw_j + Fw_j^T) / 2)", f);
+  fputs(" */\n", f);
+  for (int i = 0; i < 3; i++)
+    for (int l = 0; l < 3; l++) {
+      int nt = 0;
+      for (int j = 0; j < nm && lin; j++) {
+        const double *E = x->E + 9 * j;
+        double v = 2 * (E[0] + E[4] + E[8]) * (i == l) - E[3 * i + l] - E[3 * l + i];
+        if (v != 0) { coef[nt] = v; idx[nt++] = j; }
+      }
+      snprintf(lhs, sizeof lhs, "c->J[%d]", 3 * i + l);
+      emit_sum(f, lhs, x->J0[3 * i + l], coef, idx, nt, "w", &nterm);
+    }
+  if (quad && lin) {
+    fputs("  for (int j = 0; j < ", f);
+    fprintf(f, "%d; j++) {\n", nm);
+    fputs("    const mb_real *Fw = c->Fw + 9 * j;\n"
+          "    mb_real tf = Fw[0] + Fw[4] + Fw[8];\n"
+          "    for (int i = 0; i < 3; i++)\n"
+          "      for (int l = 0; l < 3; l++) c->J[3 * i + l] += w[j] * (tf * (i == l) - 0.5 * (Fw[3 * i + l] + Fw[3 * l + i]));\n"
+          "  }\n", f);
+  }
+  fprintf(f, "  /* %ld multiply-adds with constants (the tables hold %ld entries) */\n}\n", nterm,
+          (long)(3 * nm + 3 * nm + 3 * nm + 9 * nm * nm + 6 * nm * nm + 9 * nm));
+  free(coef);
+  free(idx);
+}
+
 static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
   const mb_model *m = &L->m;
   fprintf(f,
@@ -325,7 +442,9 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
     fprintf(f, "  /* body '%s' */\n", B->name);
     if (B->kind == MB_BODY_FLEXIBLE) {
       int nbk = 6 + B->nm;
-      fprintf(f, "  {\n    mb_real Mb[%d];\n    mb_flex_body(&flex%d, &f[%d], q + %d, v + %d, (const mb_real[3])", nbk * nbk, b, b, B->qadr + 7, B->vadr + 6);
+      fprintf(f, "  {\n    mb_real Mb[%d];\n    mb_flex_step cs;\n    flex%d_contract(q + %d, v + %d, &cs);\n"
+                 "    mb_flex_assemble(&flex%d, &cs, &f[%d], q + %d, v + %d, (const mb_real[3])",
+              nbk * nbk, b, B->qadr + 7, B->vadr + 6, b, b, B->qadr + 7, B->vadr + 6);
       vec(f, m->gravity, 3);
       fprintf(f, ", Mb, rhs + %d);\n", B->vadr);
       for (int i = 0; i < nbk * nbk; i++)

@@ -11,8 +11,10 @@
  *     solves K x = b in place: x from the factors of K_aug with right side
  *     [b_top + D^T W b_bot; b_bot], then iterative refinement on the exact
  *     system (r = b - K x with the original Kx, correction from the same
- *     factors): one step, a second when ||r||_inf / (||K||_inf ||x||_inf +
- *     ||b||_inf) is still above 1e-12; *res gets that relative residual.
+ *     factors): none when the relative residual ||r||_inf / (||K||_inf
+ *     ||x||_inf + ||b||_inf) of the first solution is already at roundoff
+ *     level (<= LDL_REFINE_TOL = 1e-15), else one step, a second when it is
+ *     still above 1e-12; *res gets that relative residual.
  *     Returns MB_OK or MB_ERR_NONFINITE.
  *
  * Below the flop budget (LDL_FLOP_BUDGET, order.h) every operation is emitted
@@ -58,7 +60,17 @@ static void real_array(FILE *f, const char *name, const double *x, long n) {
   fprintf(f, "\n};\n");
 }
 
-static long work_size(const ldl_plan *p) { return p->nnzL + 5L * p->n + 1; }
+/* the block pivots' workspace: Du^-1 (36, then 6 unused), W = Eu Du^-1 (6 per S row) */
+static long block_work(const ldl_plan *p, int e) { return 42L + 6L * (p->esp[e + 1] - p->esp[e]); }
+
+static long work_size(const ldl_plan *p) {
+  long w = p->nnzL + 5L * p->n + 1;
+  if (p->nelim) {
+    w += p->nnzR + 2L * p->n;
+    for (int e = 0; e < p->nelim; e++) w += block_work(p, e);
+  }
+  return w;
+}
 
 void emit_ldl_header(FILE *f, const lmodel *L, const char *nm) {
   ldl_plan p;
@@ -87,14 +99,30 @@ void emit_ldl_fields(FILE *f, const char *nm, int emitted) {
 
 /* ---------------------------------------------------------------- helpers */
 
+/* Where the straight-line code reads the entry at position q of K' (the
+ * plan's slots): with block pivots, the entries they change (and the
+ * decoupled diagonals) are in Kc (the block pivots' output, kc_of[q] >= 0),
+ * all others straight from Kx (slot Krmap[q]); without, K' = K.  (The looped
+ * code gathers all of K' into Kc instead: kc_of[q] = q.) */
+static const int *kc_of, *kc_map;
+
+static void kval(FILE *f, int q) {
+  if (!kc_of) fprintf(f, "Kx[%d]", q);
+  else if (kc_of[q] >= 0) fprintf(f, "Kc[%d]", kc_of[q]);
+  else fprintf(f, "Kx[%d]", kc_map[q]);
+}
+
 /* the value of K_aug entry e (upper triangle, permuted) as a C expression */
 static void aug_value(FILE *f, const ldl_plan *p, int e) {
   int any = 0;
-  if (p->Us[e] >= 0) { fprintf(f, "Kx[%d]", p->Us[e]); any = 1; }
+  if (p->Us[e] >= 0) { kval(f, p->Us[e]); any = 1; }
   for (int t = p->Tp[e]; t < p->Tp[e + 1]; t++) {
     fputs(any ? " + " : "", f);
     num(f, p->w[p->Tw[t]]);
-    fprintf(f, " * Kx[%d] * Kx[%d]", p->Ta[t], p->Tb[t]);
+    fputs(" * ", f);
+    kval(f, p->Ta[t]);
+    fputs(" * ", f);
+    kval(f, p->Tb[t]);
     any = 1;
   }
   if (!any) fputs("0", f);
@@ -154,9 +182,9 @@ static void emit_factor_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
   for (int k = 0; k < n; k++) {
     if (k == 0 || chunk_flops > LDL_CHUNK_FLOPS) {
       if (k) fputs("  (void)t;\n  (void)l;\n  return 0;\n}\n\n", f);
-      fprintf(f, "static LDL_NOINLINE int ldl_factor_part%d(const mb_real *Kx, mb_real *Lx, mb_real *Dinv) {\n",
-              nchunk++);
-      fputs("  mb_real d, s, t = 0, l = 0;\n  (void)Kx;\n  (void)Lx;\n", f);
+      fprintf(f, "static LDL_NOINLINE int ldl_factor_part%d(const mb_real *Kx,%s mb_real *Lx, mb_real *Dinv) {\n",
+              nchunk++, p->nelim ? " const mb_real *Kc," : "");
+      fprintf(f, "  mb_real d, s, t = 0, l = 0;\n  (void)Kx;\n%s  (void)Lx;\n", p->nelim ? "  (void)Kc;\n" : "");
       chunk_flops = 0;
     }
     int u = p->perm[k];
@@ -196,21 +224,25 @@ static void emit_factor_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
     for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) slot_of[p->Rj[r]] = -1;
   }
   if (n) fputs("  (void)t;\n  (void)l;\n  return 0;\n}\n\n", f);
-  fprintf(f, "int %s_ldl_factor(const mb_real *Kx, mb_real *work) {\n", nm);
+  (void)L;
+  (void)nm;
+  fputs("/* L D L^T of K_aug, whose entries come from Kx (K, or K' after the block pivots) */\n", f);
+  fprintf(f, "static int ldl_factor_aug(const mb_real *Kx,%s mb_real *work) {\n", p->nelim ? " const mb_real *Kc," : "");
   fputs("  mb_real *Lx = work, *Dinv = work + LDL_DINV;\n  int rc;\n", f);
-  emit_knorm(f, L, p);
   fputs("  /* the pivots in order, in parts */\n", f);
   for (int c = 0; c < nchunk; c++)
-    fprintf(f, "  if ((rc = ldl_factor_part%d(Kx, Lx, Dinv)) != 0) return rc;\n", c);
+    fprintf(f, "  if ((rc = ldl_factor_part%d(Kx,%s Lx, Dinv)) != 0) return rc;\n", c, p->nelim ? " Kc," : "");
   fputs("  (void)Lx;\n  (void)Dinv;\n  (void)rc;\n  return 0;\n}\n\n", f);
   free(written);
   free(slot_of);
 }
 
 static void emit_factor_looped(FILE *f, const lmodel *L, const ldl_plan *p, const char *nm) {
-  fprintf(f, "int %s_ldl_factor(const mb_real *Kx, mb_real *work) {\n", nm);
+  (void)L;
+  (void)nm;
+  fputs("/* L D L^T of K_aug, whose entries come from Kx (K, or K' after the block pivots) */\n", f);
+  fputs("static int ldl_factor_aug(const mb_real *Kx, mb_real *work) {\n", f);
   fputs("  mb_real *Lx = work, *Dinv = work + LDL_DINV, *y = work + LDL_T;\n", f);
-  emit_knorm(f, L, p);
   fputs("  for (int i = 0; i < LDL_N; i++) y[i] = 0;\n", f);
   fputs("  for (int k = 0; k < LDL_N; k++) {\n", f);
   fputs("    /* column k of the upper triangle of K_aug, scattered into y */\n", f);
@@ -231,6 +263,321 @@ static void emit_factor_looped(FILE *f, const lmodel *L, const ldl_plan *p, cons
   fputs("    Dinv[k] = 1 / d;\n  }\n  return 0;\n}\n\n", f);
 }
 
+/* ----------------------------------------------------------- block pivots */
+
+/* ldl_inv6 of the generated code */
+static void emit_inv6(FILE *f) {
+  fputs("\n/* X = A^-1 for a 6 x 6 A (row-major: rows the weld rows, columns the body's\n"
+        " * unknowns), Gauss-Jordan with partial pivoting; 1 if a pivot is below 1e-12\n"
+        " * of the largest entry.  D_u is a rotation and the identity up to signs, so\n"
+        " * the explicit inverse is accurate, and every later use is a 6 x 6 product */\n"
+        "static int ldl_inv6(const mb_real *A0, mb_real *X) {\n"
+        "  mb_real A[36], amax = 0;\n"
+        "  for (int i = 0; i < 36; i++) {\n"
+        "    A[i] = A0[i];\n    X[i] = i % 7 == 0;\n"
+        "    if (fabs(A[i]) > amax) amax = fabs(A[i]);\n  }\n"
+        "  for (int k = 0; k < 6; k++) {\n"
+        "    int pr = k;\n"
+        "    for (int i = k + 1; i < 6; i++) if (fabs(A[6 * i + k]) > fabs(A[6 * pr + k])) pr = i;\n"
+        "    if (!(fabs(A[6 * pr + k]) > 1e-12 * amax)) return 1;\n"
+        "    if (pr != k)\n"
+        "      for (int j = 0; j < 6; j++) {\n"
+        "        mb_real t = A[6 * k + j]; A[6 * k + j] = A[6 * pr + j]; A[6 * pr + j] = t;\n"
+        "        t = X[6 * k + j]; X[6 * k + j] = X[6 * pr + j]; X[6 * pr + j] = t;\n      }\n"
+        "    mb_real d = 1 / A[6 * k + k];\n"
+        "    for (int j = 0; j < 6; j++) { A[6 * k + j] *= d; X[6 * k + j] *= d; }\n"
+        "    for (int i = 0; i < 6; i++) {\n"
+        "      mb_real l = A[6 * i + k];\n"
+        "      if (i == k || l == 0) continue;\n"
+        "      for (int j = 0; j < 6; j++) { A[6 * i + j] -= l * A[6 * k + j]; X[6 * i + j] -= l * X[6 * k + j]; }\n"
+        "    }\n  }\n  return 0;\n}\n\n", f);
+}
+
+/* "Kx[slot]" or "0" */
+static void kx_or_zero(FILE *f, int slot) {
+  if (slot >= 0) fprintf(f, "Kx[%d]", slot);
+  else fputs("0", f);
+}
+
+/* the block pivots straight-line (below the flop budget): every slot a
+ * constant, structural zeros of Du, Dx and Eu skipped */
+static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, const long *woff) {
+  char name[512];
+  int nkc = 0;
+  for (int q = 0; q < p->nnzR; q++)
+    if (kc_of[q] >= 0 && kc_of[q] + 1 > nkc) nkc = kc_of[q] + 1;
+  int *src = malloc(sizeof(int) * (size_t)(nkc + 1));
+  if (!src) return;
+  for (int q = 0; q < p->nnzR; q++)
+    if (kc_of[q] >= 0) src[kc_of[q]] = p->Krmap[q];
+  fputs("/* Kc (the entries of K' the block pivots set) from Kx; returns 0, or 1 + a column\n"
+        " * of a virtual body whose Du is singular */\n"
+        "static int ldl_block_pivots(const mb_real *Kx, mb_real *work) {\n"
+        "  mb_real *Kc = work + LDL_KR, A[36], *Di, *W, v;\n"
+        "  /* the entries of K' that the blocks change, and the decoupled diagonals */\n", f);
+  for (int k = 0; k < nkc; k++) {
+    fprintf(f, "  Kc[%d] = ", k);
+    if (src[k] >= 0) fprintf(f, "Kx[%d]", src[k]);
+    else fputs(src[k] == -2 ? "1" : src[k] == -3 ? "-1" : "0", f);
+    fputs(";\n", f);
+  }
+  free(src);
+  for (int e = 0; e < p->nelim; e++) {
+    int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
+    fprintf(f, "  /* block %d: Du^-1, W = Eu Du^-1, K'(s, x) -= (W Dx)(s, x) */\n", e);
+    fprintf(f, "  Di = work + %ld;\n  W = Di + 42;\n", woff[e]);
+    for (int i = 0; i < 36; i++) {
+      fprintf(f, "  A[%d] = ", i);
+      kx_or_zero(f, p->edu[e][i]);
+      fputs(";\n", f);
+    }
+    fprintf(f, "  if (ldl_inv6(A, Di)) return %d;\n", 1 + p->eu[e][0]);
+    int k = p->ekrp[e];
+    for (int si = 0; si < ns; si++) {
+      const int *eu = p->eeu + 6 * (ss + si);
+      ldl_unknown_name(L, p->es[ss + si], name, sizeof name);
+      fprintf(f, "  /* %s */\n", name);
+      for (int i = 0; i < 6; i++) {
+        fprintf(f, "  W[%d] = ", 6 * si + i);
+        int any = 0;
+        for (int c = 0; c < 6; c++)
+          if (eu[c] >= 0) { fprintf(f, "%sKx[%d] * Di[%d]", any ? " + " : "", eu[c], 6 * c + i); any = 1; }
+        if (!any) fputs("0", f);
+        fputs(";\n", f);
+      }
+      for (int xi = 0; xi < nx; xi++, k++) {
+        const int *dx = p->edx + 6 * (xs + xi);
+        int any = 0;
+        for (int i = 0; i < 6; i++)
+          if (dx[i] >= 0) {
+            fprintf(f, "%sW[%d] * Kx[%d]", any ? " + " : "  v = ", 6 * si + i, dx[i]);
+            any = 1;
+          }
+        if (!any) continue;
+        fprintf(f, ";\n  Kc[%d] -= v;\n  Kc[%d] -= v;\n", kc_of[p->ekr[2 * k]], kc_of[p->ekr[2 * k + 1]]);
+      }
+    }
+  }
+  fputs("  (void)v;\n  (void)W;\n  return 0;\n}\n\n", f);
+
+  fputs("/* rr = the right side of K' from r: g'_s = g_s - W g_r, f'_x = f_x - Dx^T Du^-T f_u */\n"
+        "static void ldl_block_rhs(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *rr) {\n"
+        "  const mb_real *Di, *W;\n  mb_real z[6];\n"
+        "  for (int i = 0; i < LDL_N; i++) rr[i] = r[i];\n", f);
+  for (int e = 0; e < p->nelim; e++) {
+    int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
+    fprintf(f, "  /* block %d */\n  Di = work + %ld;\n  W = Di + 42;\n", e, woff[e]);
+    for (int si = 0; si < ns; si++) {
+      fprintf(f, "  rr[%d] -= ", p->es[ss + si]);
+      for (int c = 0; c < 6; c++) fprintf(f, "%sW[%d] * r[%d]", c ? " + " : "", 6 * si + c, p->er[e][c]);
+      fputs(";\n", f);
+    }
+    for (int i = 0; i < 6; i++) {
+      fprintf(f, "  z[%d] = ", i);
+      for (int c = 0; c < 6; c++) fprintf(f, "%sDi[%d] * r[%d]", c ? " + " : "", 6 * c + i, p->eu[e][c]);
+      fputs(";\n", f);
+    }
+    for (int xi = 0; xi < nx; xi++) {
+      const int *dx = p->edx + 6 * (xs + xi);
+      int any = 0;
+      for (int i = 0; i < 6; i++)
+        if (dx[i] >= 0) {
+          if (!any) fprintf(f, "  rr[%d] -= ", p->ex[xs + xi]);
+          fprintf(f, "%sKx[%d] * z[%d]", any ? " + " : "", dx[i], i);
+          any = 1;
+        }
+      if (any) fputs(";\n", f);
+    }
+    for (int c = 0; c < 6; c++) fprintf(f, "  rr[%d] = rr[%d] = 0;\n", p->eu[e][c], p->er[e][c]);
+  }
+  fputs("  (void)Kx;\n  (void)W;\n}\n\n", f);
+
+  fputs("/* the eliminated unknowns of d from the others: a_u = Du^-1 (g_r - Dx a_x),\n"
+        " * lambda_r = Du^-T (f_u - Eu^T lambda_s) */\n"
+        "static void ldl_block_back(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *d) {\n"
+        "  const mb_real *Di;\n  mb_real y[6], z[6];\n", f);
+  for (int e = 0; e < p->nelim; e++) {
+    int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
+    fprintf(f, "  /* block %d */\n  Di = work + %ld;\n", e, woff[e]);
+    for (int i = 0; i < 6; i++) {
+      fprintf(f, "  y[%d] = r[%d]", i, p->er[e][i]);
+      for (int xi = 0; xi < nx; xi++) {
+        int sl = p->edx[6 * (xs + xi) + i];
+        if (sl >= 0) fprintf(f, " - Kx[%d] * d[%d]", sl, p->ex[xs + xi]);
+      }
+      fputs(";\n", f);
+    }
+    for (int c = 0; c < 6; c++) {
+      fprintf(f, "  z[%d] = r[%d]", c, p->eu[e][c]);
+      for (int si = 0; si < ns; si++) {
+        int sl = p->eeu[6 * (ss + si) + c];
+        if (sl >= 0) fprintf(f, " - Kx[%d] * d[%d]", sl, p->es[ss + si]);
+      }
+      fputs(";\n", f);
+    }
+    for (int c = 0; c < 6; c++) {
+      fprintf(f, "  d[%d] = ", p->eu[e][c]);
+      for (int i = 0; i < 6; i++) fprintf(f, "%sDi[%d] * y[%d]", i ? " + " : "", 6 * c + i, i);
+      fprintf(f, ";\n  d[%d] = ", p->er[e][c]);
+      for (int i = 0; i < 6; i++) fprintf(f, "%sDi[%d] * z[%d]", i ? " + " : "", 6 * i + c, i);
+      fputs(";\n", f);
+    }
+  }
+  fputs("  (void)Kx;\n}\n\n", f);
+}
+
+static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
+  const mb_model *m = &L->m;
+  char name[512];
+  fputs("/* block pivots: each virtual body welded to a massive body is eliminated with\n"
+        " * its 6 weld rows as one 12 x 12 pivot [0 Du^T; Du 0] before the LDL^T:\n"
+        " *   K'(s, x) = K(s, x) - (Eu Du^-1 Dx)(s, x)  (S: the other rows on its columns,\n"
+        " *   X: the columns of the body it is welded to); see docs/formulation.md. */\n", f);
+  if (!p->straight)
+  fputs("typedef struct {\n"
+        "  int nx, ns;      /* columns X, rows S */\n"
+        "  int kr, w;       /* first pair in ldl_ekc; workspace: Du^-1, W = Eu Du^-1 */\n"
+        "  const int *u, *r, *x, *s; /* its columns, weld rows, X, S (K indices) */\n"
+        "  const int *du, *dx, *eu;  /* Kx slots (-1: zero) of Du (6 x 6), Dx (6 per x), Eu (6 per s) */\n"
+        "} ldl_block;\n", f);
+  long w = (long)p->nnzL + 5L * p->n + 1 + p->nnzR + 2L * p->n;
+  long *woff = malloc(sizeof(long) * (size_t)(p->nelim + 1));
+  if (!woff) return;
+  for (int e = 0; e < p->nelim; e++) {
+    const mb_body *B = &m->body[p->eb[e]];
+    int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
+    fprintf(f, "/* block %d: virtual body '%s' (unknowns %d..%d) and its weld rows", e, B->name,
+            p->eu[e][0], p->eu[e][5]);
+    for (int i = 0; i < 6; i++) fprintf(f, "%s%d", i ? " " : " ", p->er[e][i]);
+    ldl_unknown_name(L, p->ex[xs], name, sizeof name);
+    fprintf(f, ";\n * X: %d columns from %s; S: %d rows:", nx, name, ns);
+    for (int k = 0; k < ns; k++) {
+      ldl_unknown_name(L, p->es[ss + k], name, sizeof name);
+      fprintf(f, "\n *   %s", name);
+    }
+    fputs(" */\n", f);
+    woff[e] = w;
+    w += block_work(p, e);
+    if (p->straight) continue;
+    char nmx[64];
+    snprintf(nmx, sizeof nmx, "ldl_b%d_u", e); int_array(f, nmx, p->eu[e], 6);
+    snprintf(nmx, sizeof nmx, "ldl_b%d_r", e); int_array(f, nmx, p->er[e], 6);
+    snprintf(nmx, sizeof nmx, "ldl_b%d_x", e); int_array(f, nmx, p->ex + xs, nx);
+    snprintf(nmx, sizeof nmx, "ldl_b%d_s", e); int_array(f, nmx, p->es + ss, ns);
+    snprintf(nmx, sizeof nmx, "ldl_b%d_du", e); int_array(f, nmx, p->edu[e], 36);
+    snprintf(nmx, sizeof nmx, "ldl_b%d_dx", e); int_array(f, nmx, p->edx + 6 * xs, 6L * nx);
+    snprintf(nmx, sizeof nmx, "ldl_b%d_eu", e); int_array(f, nmx, p->eeu + 6 * ss, 6L * ns);
+  }
+  emit_inv6(f);
+  if (p->straight) {
+    emit_blocks_straight(f, L, p, woff);
+    free(woff);
+    return;
+  }
+  fprintf(f, "#define LDL_NBLOCK %d\n", p->nelim);
+  fprintf(f, "static const ldl_block ldl_blocks[LDL_NBLOCK] = {\n");
+  for (int e = 0; e < p->nelim; e++)
+    fprintf(f, "  {%d, %d, %d, %ld, ldl_b%d_u, ldl_b%d_r, ldl_b%d_x, ldl_b%d_s, ldl_b%d_du, ldl_b%d_dx, ldl_b%d_eu},\n",
+            p->exp_[e + 1] - p->exp_[e], p->esp[e + 1] - p->esp[e], p->ekrp[e], woff[e], e, e, e, e, e, e, e);
+  fputs("};\n", f);
+  free(woff);
+  /* Kc: the entries of K' the block pivots change (straight-line code; the
+     others are read from Kx), or all of K' (looped code) */
+  int nkc = 0, npair = p->ekrp[p->nelim];
+  int *src = malloc(sizeof(int) * (size_t)(p->nnzR + 1)), *ekc = malloc(sizeof(int) * (size_t)(2 * npair + 1));
+  if (!src || !ekc) { free(src); free(ekc); return; }
+  for (int q = 0; q < p->nnzR; q++)
+    if (kc_of[q] >= 0) src[kc_of[q]] = p->Krmap[q], nkc = kc_of[q] + 1 > nkc ? kc_of[q] + 1 : nkc;
+  for (int k = 0; k < 2 * npair; k++) ekc[k] = kc_of[p->ekr[k]];
+  fputs("/* Kc entries of the corrected pairs (s, x), (x, s), block by block, s-major */\n", f);
+  int_array(f, "ldl_ekc", ekc, 2L * npair);
+  fprintf(f, "/* Kc = %s from Kx: a Kx slot, or -1: 0, -2: 1 (eliminated column),\n"
+             " * -3: -1 (eliminated row) */\n",
+          p->straight ? "the entries of K' the block pivots set" : "K' (CSC, both triangles)");
+  fprintf(f, "#define LDL_NKC %d\n", nkc);
+  int_array(f, "ldl_Kcsrc", src, nkc);
+  free(src);
+  free(ekc);
+
+  fputs("/* Kc (the entries of K' above) from Kx; returns 0, or 1 + a column of a virtual\n"
+        " * body whose Du is singular */\n"
+        "static int ldl_block_pivots(const mb_real *Kx, mb_real *work) {\n"
+        "  mb_real *Kc = work + LDL_KR;\n"
+        "  for (int q = 0; q < LDL_NKC; q++) {\n"
+        "    int s = ldl_Kcsrc[q];\n"
+        "    Kc[q] = s >= 0 ? Kx[s] : s == -2 ? 1 : s == -3 ? -1 : 0;\n  }\n"
+        "  for (int e = 0; e < LDL_NBLOCK; e++) {\n"
+        "    const ldl_block *B = &ldl_blocks[e];\n"
+        "    mb_real A[36], *Di = work + B->w, *W = Di + 42;\n"
+        "    int k = B->kr;\n"
+        "    for (int i = 0; i < 36; i++) A[i] = B->du[i] >= 0 ? Kx[B->du[i]] : 0;\n"
+        "    if (ldl_inv6(A, Di)) return 1 + B->u[0];\n"
+        "    for (int si = 0; si < B->ns; si++) {\n"
+        "      mb_real *w = W + 6 * si, e[6]; /* row s of W = Eu Du^-1 */\n"
+        "      for (int c = 0; c < 6; c++) e[c] = B->eu[6 * si + c] >= 0 ? Kx[B->eu[6 * si + c]] : 0;\n"
+        "      for (int i = 0; i < 6; i++) {\n"
+        "        w[i] = 0;\n"
+        "        for (int c = 0; c < 6; c++) w[i] += e[c] * Di[6 * c + i];\n      }\n"
+        "      for (int xi = 0; xi < B->nx; xi++, k++) {\n"
+        "        const int *dx = B->dx + 6 * xi;\n"
+        "        mb_real v = 0;\n"
+        "        for (int i = 0; i < 6; i++) if (dx[i] >= 0) v += w[i] * Kx[dx[i]];\n"
+        "        Kc[ldl_ekc[2 * k]] -= v;\n"
+        "        Kc[ldl_ekc[2 * k + 1]] -= v;\n"
+        "      }\n    }\n  }\n  return 0;\n}\n\n", f);
+  fputs("/* rr = the right side of K' from r: g'_s = g_s - W g_r, f'_x = f_x - Dx^T Du^-T f_u */\n"
+        "static void ldl_block_rhs(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *rr) {\n"
+        "  for (int i = 0; i < LDL_N; i++) rr[i] = r[i];\n"
+        "  for (int e = 0; e < LDL_NBLOCK; e++) {\n"
+        "    const ldl_block *B = &ldl_blocks[e];\n"
+        "    const mb_real *Di = work + B->w, *W = Di + 42;\n"
+        "    mb_real z[6];\n"
+        "    for (int si = 0; si < B->ns; si++) {\n"
+        "      mb_real v = 0;\n"
+        "      for (int c = 0; c < 6; c++) v += W[6 * si + c] * r[B->r[c]];\n"
+        "      rr[B->s[si]] -= v;\n    }\n"
+        "    for (int i = 0; i < 6; i++) { /* z = Du^-T f_u */\n"
+        "      z[i] = 0;\n"
+        "      for (int c = 0; c < 6; c++) z[i] += Di[6 * c + i] * r[B->u[c]];\n    }\n"
+        "    for (int xi = 0; xi < B->nx; xi++) {\n"
+        "      const int *dx = B->dx + 6 * xi;\n"
+        "      mb_real v = 0;\n"
+        "      for (int i = 0; i < 6; i++) if (dx[i] >= 0) v += Kx[dx[i]] * z[i];\n"
+        "      rr[B->x[xi]] -= v;\n    }\n"
+        "    for (int c = 0; c < 6; c++) rr[B->u[c]] = rr[B->r[c]] = 0;\n  }\n}\n\n", f);
+  fputs("/* the eliminated unknowns of d from the others: a_u = Du^-1 (g_r - Dx a_x),\n"
+        " * lambda_r = Du^-T (f_u - Eu^T lambda_s) */\n"
+        "static void ldl_block_back(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *d) {\n"
+        "  for (int e = 0; e < LDL_NBLOCK; e++) {\n"
+        "    const ldl_block *B = &ldl_blocks[e];\n"
+        "    const mb_real *Di = work + B->w;\n"
+        "    mb_real y[6], z[6];\n"
+        "    for (int i = 0; i < 6; i++) y[i] = r[B->r[i]];\n"
+        "    for (int xi = 0; xi < B->nx; xi++) {\n"
+        "      const int *dx = B->dx + 6 * xi;\n"
+        "      for (int i = 0; i < 6; i++) if (dx[i] >= 0) y[i] -= Kx[dx[i]] * d[B->x[xi]];\n    }\n"
+        "    for (int c = 0; c < 6; c++) z[c] = r[B->u[c]];\n"
+        "    for (int si = 0; si < B->ns; si++)\n"
+        "      for (int c = 0; c < 6; c++) if (B->eu[6 * si + c] >= 0) z[c] -= Kx[B->eu[6 * si + c]] * d[B->s[si]];\n"
+        "    for (int c = 0; c < 6; c++) { /* a_u = Du^-1 y, lambda_r = Du^-T z */\n"
+        "      mb_real a = 0, l = 0;\n"
+        "      for (int i = 0; i < 6; i++) { a += Di[6 * c + i] * y[i]; l += Di[6 * i + c] * z[i]; }\n"
+        "      d[B->u[c]] = a;\n      d[B->r[c]] = l;\n    }\n  }\n}\n\n", f);
+}
+
+/* the public factorization: ||K||, the block pivots, then L D L^T of K_aug */
+static void emit_factor_entry(FILE *f, const lmodel *L, const ldl_plan *p, const char *nm) {
+  fprintf(f, "int %s_ldl_factor(const mb_real *Kx, mb_real *work) {\n", nm);
+  emit_knorm(f, L, p);
+  if (p->nelim) {
+    fputs("  int rc = ldl_block_pivots(Kx, work);\n  if (rc) return rc;\n", f);
+    fputs(p->straight ? "  return ldl_factor_aug(Kx, work + LDL_KR, work);\n}\n\n"
+                      : "  return ldl_factor_aug(work + LDL_KR, work);\n}\n\n", f);
+  } else {
+    fputs("  return ldl_factor_aug(Kx, work);\n}\n\n", f);
+  }
+}
+
 /* ------------------------------------------------------------------ solve */
 
 static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan *p) {
@@ -238,7 +585,9 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
   int n = p->n, nv = p->nv;
   /* t = P [r_top + D^T W r_bot; r_bot] */
   fputs("/* t = P [r_top + D^T W r_bot; r_bot]: the right side of K_aug, permuted */\n", f);
-  fputs("static void ldl_aug(const mb_real *Kx, const mb_real *r, mb_real *t) {\n", f);
+  fprintf(f, "static void ldl_aug(const mb_real *Kx,%s const mb_real *r, mb_real *t) {\n",
+          p->nelim ? " const mb_real *Kc," : "");
+  if (p->nelim) fputs("  (void)Kc;\n", f);
   for (int k = 0; k < n; k++) {
     int u = p->perm[k];
     fprintf(f, "  t[%d] = r[%d]", k, u);
@@ -248,7 +597,9 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
           if (p->Dj[q] == u) {
             fputs(" + ", f);
             num(f, p->w[w]);
-            fprintf(f, " * Kx[%d] * r[%d]", p->Ds[q], nv + p->wrow[w]);
+            fputs(" * ", f);
+            kval(f, p->Ds[q]);
+            fprintf(f, " * r[%d]", nv + p->wrow[w]);
           }
     fputs(";\n", f);
   }
@@ -274,10 +625,17 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
   if (p->nnzL == 0) fputs("  (void)Lx;\n", f);
   fputs("}\n\n", f);
 
-  fputs("/* x += P^T t */\n", f);
-  fputs("static void ldl_scatter_add(const mb_real *t, mb_real *x) {\n", f);
-  for (int k = 0; k < n; k++) fprintf(f, "  x[%d] += t[%d];\n", p->perm[k], k);
-  fputs("}\n\n", f);
+  if (p->nelim) {
+    fputs("/* x = P^T t */\n", f);
+    fputs("static void ldl_scatter(const mb_real *t, mb_real *x) {\n", f);
+    for (int k = 0; k < n; k++) fprintf(f, "  x[%d] = t[%d];\n", p->perm[k], k);
+    fputs("}\n\n", f);
+  } else {
+    fputs("/* x += P^T t */\n", f);
+    fputs("static void ldl_scatter_add(const mb_real *t, mb_real *x) {\n", f);
+    for (int k = 0; k < n; k++) fprintf(f, "  x[%d] += t[%d];\n", p->perm[k], k);
+    fputs("}\n\n", f);
+  }
 
   /* r = b - K x by rows */
   fputs("/* r = b - K x (the exact system, original Kx) */\n", f);
@@ -322,9 +680,14 @@ static void emit_solve_helpers_looped(FILE *f, const ldl_plan *p) {
         "    mb_real s = t[j];\n"
         "    for (int q = ldl_Lp[j]; q < ldl_Lp[j + 1]; q++) s -= Lx[q] * t[ldl_Li[q]];\n"
         "    t[j] = s;\n  }\n}\n\n", f);
-  fputs("/* x += P^T t */\n", f);
-  fputs("static void ldl_scatter_add(const mb_real *t, mb_real *x) {\n"
-        "  for (int k = 0; k < LDL_N; k++) x[ldl_perm[k]] += t[k];\n}\n\n", f);
+  if (p->nelim)
+    fputs("/* x = P^T t */\n"
+          "static void ldl_scatter(const mb_real *t, mb_real *x) {\n"
+          "  for (int k = 0; k < LDL_N; k++) x[ldl_perm[k]] = t[k];\n}\n\n", f);
+  else
+    fputs("/* x += P^T t */\n"
+          "static void ldl_scatter_add(const mb_real *t, mb_real *x) {\n"
+          "  for (int k = 0; k < LDL_N; k++) x[ldl_perm[k]] += t[k];\n}\n\n", f);
   fputs("/* r = b - K x (the exact system, original Kx) */\n", f);
   fputs("static void ldl_residual(const mb_real *Kx, const mb_real *x, const mb_real *b, mb_real *r) {\n"
         "  for (int i = 0; i < LDL_N; i++) r[i] = b[i];\n"
@@ -333,19 +696,17 @@ static void emit_solve_helpers_looped(FILE *f, const ldl_plan *p) {
         "    for (int q = ldl_Kp[j]; q < ldl_Kp[j + 1]; q++) r[ldl_Ki[q]] -= Kx[q] * xj;\n  }\n}\n\n", f);
 }
 
-static void emit_solve(FILE *f, const char *nm) {
+static void emit_solve(FILE *f, const ldl_plan *p, const char *nm) {
   fprintf(f, "int %s_ldl_solve(const mb_real *Kx, mb_real *work, mb_real *b, mb_real *residual) {\n", nm);
-  fputs("  const mb_real *Lx = work, *Dinv = work + LDL_DINV;\n"
-        "  mb_real *x = work + LDL_X, *r = work + LDL_R, *t = work + LDL_T, *xb = work + LDL_XB;\n"
+  fprintf(f, "  const mb_real *Lx = work, *Dinv = work + LDL_DINV;\n"
+        "  mb_real *x = work + LDL_X, *r = work + LDL_R, *t = work + LDL_T, *xb = work + LDL_XB;\n%s"
         "  mb_real knorm = work[LDL_KNORM], bn = 0, best = 0;\n"
         "  for (int i = 0; i < LDL_N; i++) {\n"
         "    x[i] = 0;\n    r[i] = b[i];\n    if (fabs(b[i]) > bn) bn = fabs(b[i]);\n  }\n"
         "  /* pass 0: the solve; pass 1: refinement; pass 2: a second one if still above 1e-12 */\n"
         "  for (int it = 0; it < 3; it++) {\n"
         "    mb_real rn = 0, xn = 0, den, rel;\n"
-        "    ldl_aug(Kx, r, t);\n"
-        "    ldl_lsolve(Lx, Dinv, t);\n"
-        "    ldl_scatter_add(t, x);\n"
+        "%s"
         "    ldl_residual(Kx, x, b, r);\n"
         "    for (int i = 0; i < LDL_N; i++) {\n"
         "      if (!(fabs(r[i]) <= rn)) rn = fabs(r[i]);\n"
@@ -354,11 +715,31 @@ static void emit_solve(FILE *f, const char *nm) {
         "    rel = den > 0 ? rn / den : rn;\n"
         "    if (it > 0 && !(rel < best)) break; /* no longer improving: keep the best */\n"
         "    best = rel;\n"
+        "    if (rel <= LDL_REFINE_TOL) break; /* at roundoff level: x is kept as it is */\n"
         "    for (int i = 0; i < LDL_N; i++) xb[i] = x[i];\n"
         "    if (it > 0 && rel <= 1e-12) break;\n  }\n"
-        "  for (int i = 0; i < LDL_N; i++) b[i] = xb[i];\n"
+        "  if (best <= LDL_REFINE_TOL) for (int i = 0; i < LDL_N; i++) b[i] = x[i];\n"
+        "  else for (int i = 0; i < LDL_N; i++) b[i] = xb[i];\n"
         "  if (residual) *residual = best;\n"
-        "  return isfinite(best) ? MB_OK : MB_ERR_NONFINITE;\n}\n\n", f);
+        "  return isfinite(best) ? MB_OK : MB_ERR_NONFINITE;\n}\n\n",
+        p->nelim ? "  mb_real *rr = work + LDL_RR, *d = work + LDL_DD;\n" : "",
+        p->nelim ? (p->straight ? "    /* the block pivots' right side, K_aug of K', their unknowns back, x += d */\n"
+                                  "    ldl_block_rhs(Kx, work, r, rr);\n"
+                                  "    ldl_aug(Kx, work + LDL_KR, rr, t);\n"
+                                  "    ldl_lsolve(Lx, Dinv, t);\n"
+                                  "    ldl_scatter(t, d);\n"
+                                  "    ldl_block_back(Kx, work, r, d);\n"
+                                  "    for (int i = 0; i < LDL_N; i++) x[i] += d[i];\n"
+                                : "    /* the block pivots' right side, K_aug of K', their unknowns back, x += d */\n"
+                                  "    ldl_block_rhs(Kx, work, r, rr);\n"
+                                  "    ldl_aug(work + LDL_KR, rr, t);\n"
+                                  "    ldl_lsolve(Lx, Dinv, t);\n"
+                                  "    ldl_scatter(t, d);\n"
+                                  "    ldl_block_back(Kx, work, r, d);\n"
+                                  "    for (int i = 0; i < LDL_N; i++) x[i] += d[i];\n")
+                 : "    ldl_aug(Kx, r, t);\n"
+                   "    ldl_lsolve(Lx, Dinv, t);\n"
+                   "    ldl_scatter_add(t, x);\n");
 }
 
 int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
@@ -394,8 +775,11 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
   fprintf(f, "#define LDL_N %d\n#define LDL_DINV %s_LDL_NNZL\n#define LDL_KNORM (LDL_DINV + LDL_N)\n"
              "#define LDL_X (LDL_KNORM + 1)\n#define LDL_R (LDL_X + LDL_N)\n#define LDL_T (LDL_R + LDL_N)\n"
              "#define LDL_XB (LDL_T + LDL_N)\n#define LDL_PIVTOL 1e-14\n"
+             "#define LDL_KR (LDL_XB + LDL_N)\n#define LDL_RR (LDL_KR + %d)\n#define LDL_DD (LDL_RR + LDL_N)\n"
+             "/* a solve whose relative residual is already this small is not refined */\n"
+             "#define LDL_REFINE_TOL 1e-15\n"
              "#if defined(__GNUC__)\n#define LDL_NOINLINE __attribute__((noinline))\n#else\n#define LDL_NOINLINE\n#endif\n",
-          n, U);
+          n, U, p.nelim ? p.nnzR : 0);
   /* pivot order as a comment (straight) or a table (looped) */
   if (p.straight) {
     fputs("/* pivot order: ", f);
@@ -451,11 +835,28 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
     int_array(f, "ldl_Ki", m->Ki, m->nnz);
     fputc('\n', f);
   }
+  int *kc = NULL;
+  if (p.nelim) {
+    kc = malloc(sizeof(int) * (size_t)(p.nnzR + 1));
+    if (!kc) { ldl_plan_free(&p); return 0; }
+    int nkc = 0;
+    for (int q = 0; q < p.nnzR; q++) kc[q] = p.straight ? -1 : nkc++;
+    if (p.straight) {
+      for (int k = 0; k < 2 * p.ekrp[p.nelim]; k++) kc[p.ekr[k]] = 0; /* mark */
+      for (int q = 0; q < p.nnzR; q++) kc[q] = kc[q] == 0 || p.Krmap[q] < 0 ? nkc++ : -1;
+    }
+    kc_of = kc;
+    kc_map = p.Krmap;
+    emit_blocks(f, L, &p);
+  }
   if (p.straight) emit_factor_straight(f, L, &p, nm);
   else emit_factor_looped(f, L, &p, nm);
+  emit_factor_entry(f, L, &p, nm);
   if (p.straight) emit_solve_helpers_straight(f, L, &p);
   else emit_solve_helpers_looped(f, &p);
-  emit_solve(f, nm);
+  emit_solve(f, &p, nm);
+  kc_of = kc_map = NULL;
+  free(kc);
   fputs("static int ldl_factor_m(const mb_model *m, const mb_real *Kx, mb_real *work) {\n", f);
   fprintf(f, "  (void)m;\n  return %s_ldl_factor(Kx, work);\n}\n", nm);
   fputs("static int ldl_solve_m(const mb_model *m, const mb_real *Kx, mb_real *work, mb_real *b,\n"

@@ -10,6 +10,14 @@
 #include "flex.h"
 
 /* modal damping ratio of a mode of frequency f (Hz) */
+/* entries of a table below 1e-10 of its largest (in magnitude) become 0 */
+static void clean_table(double *t, size_t n) {
+  double mx = 0;
+  for (size_t i = 0; i < n; i++) mx = fmax(mx, fabs(t[i]));
+  for (size_t i = 0; i < n; i++)
+    if (fabs(t[i]) <= 1e-10 * mx) t[i] = 0;
+}
+
 static double damping_ratio(const ir_flex *fx, int j, double f) {
   switch (fx->damping) {
   case DAMPING_RATIO: return fx->ratio;
@@ -100,6 +108,19 @@ int flex_build(const ir_flex *fx, const fe_modes *fm, flex_data *out, char *err,
       }
     }
   }
+  /* exact zeros: sums over the nodes of products of shapes that are
+     structurally orthogonal (bending in y against bending in z, axial against
+     either, ...) leave a rounding residue of about 1e-13 of the table's
+     largest entry, where the smallest true entries are above 1e-7 of it in
+     the shipped models; entries below 1e-10 of the largest are set to zero,
+     so that both paths use the same tables and the generated code can drop
+     them (compiler/emit.c, the flexible body's contractions) */
+  clean_table(out->S1, 3 * (size_t)nm);
+  clean_table(out->E, 9 * (size_t)nm);
+  clean_table(out->F, 9 * (size_t)nm * (size_t)nm);
+  clean_table(out->G, 3 * (size_t)nm * (size_t)nm);
+  clean_table(out->C0, 3 * (size_t)nm);
+  clean_table(out->CPsi, 3 * (size_t)nm);
   for (int j = 0; j < nm; j++) {
     double om = 2 * MB_PI * fm->freq_hz[j];
     /* mass-normalized modes: X^T K X = diag(omega^2); the damping ratio

@@ -27,6 +27,9 @@ void ldl_plan_free(ldl_plan *p) {
   free(p->Tp); free(p->Tw); free(p->Ta); free(p->Tb);
   free(p->parent); free(p->Lp); free(p->Li);
   free(p->Rp); free(p->Rj); free(p->Rpos);
+  free(p->eb); free(p->eu); free(p->er); free(p->exp_); free(p->ex); free(p->esp); free(p->es);
+  free(p->edu); free(p->edx); free(p->eeu); free(p->ekr); free(p->ekrp);
+  free(p->Krp); free(p->Kri); free(p->Krmap);
   memset(p, 0, sizeof *p);
 }
 
@@ -94,10 +97,317 @@ static double *kx_at_start(const mb_model *m) {
   return Kx;
 }
 
+/* the body whose velocity columns include column j, or -1 */
+static int body_of_column(const mb_model *m, int j) {
+  for (int b = 0; b < m->nbody; b++) {
+    const mb_body *B = &m->body[b];
+    int nb = 6 + (B->kind == MB_BODY_FLEXIBLE ? B->nm : 0);
+    if (j >= B->vadr && j < B->vadr + nb) return b;
+  }
+  return -1;
+}
+
+/* whether every velocity column of body b (-1: the ground) is massive */
+static int body_massive(const mb_model *m, int b, const char *massive) {
+  if (b < 0) return 1;
+  const mb_body *B = &m->body[b];
+  int nb = 6 + (B->kind == MB_BODY_FLEXIBLE ? B->nm : 0);
+  for (int c = 0; c < nb; c++)
+    if (!massive[B->vadr + c]) return 0;
+  return 1;
+}
+
+/* constraint row r is a row of the rigid joint (weld) of virtual body b to a
+ * massive body (lower.c: no source joint or driver, marker 1 on the virtual
+ * body): returns b, else -1 */
+static int row_weld_body(const mb_model *m, int r, const char *massive) {
+  if (m->nrow != m->nc || r >= m->nrow) return -1;
+  const mb_rowdef *R = &m->row[r];
+  if (R->joint >= 0 || R->driver >= 0) return -1;
+  int b1 = m->marker[R->m1].body, b0 = m->marker[R->m0].body;
+  if (b1 < 0 || m->body[b1].kind != MB_BODY_VIRTUAL || b0 == b1) return -1;
+  if (R->kind != MB_PRIM_SPH && R->kind != MB_PRIM_DOT1) return -1;
+  return body_massive(m, b0, massive) ? b1 : -1;
+}
+
+/* per body: the number of weld rows when it is a virtual body held by exactly
+ * the 6 rows of one rigid joint to a massive body (3 coincidence, 3
+ * orientation), else -1 */
+static int *welded_rows(const mb_model *m, const char *massive) {
+  int *cnt = malloc(sizeof(int) * (size_t)(m->nbody + 1));
+  int *sph = calloc((size_t)m->nbody + 1, sizeof(int)), *other = calloc((size_t)m->nbody + 1, sizeof(int));
+  if (!cnt || !sph || !other) { free(cnt); free(sph); free(other); return NULL; }
+  for (int r = 0; r < m->nc && m->nrow == m->nc; r++) {
+    int b = row_weld_body(m, r, massive);
+    if (b < 0) continue;
+    const mb_rowdef *R = &m->row[r];
+    if (R->kind == MB_PRIM_SPH) sph[b] |= 1 << R->a;
+    else other[b] |= 1 << R->a;
+  }
+  for (int b = 0; b < m->nbody; b++) cnt[b] = sph[b] == 7 && other[b] == 7 ? 6 : -1;
+  free(sph); free(other);
+  return cnt;
+}
+
+/* ------------------------------------------------------------ block pivots */
+
+/* 6 x 6 LU with partial pivoting (row-major A, row swaps in piv); -1 when a
+ * pivot is below 1e-12 of the largest entry (the same as the emitted one) */
+static int lu6(double *A, int *piv) {
+  double amax = 0;
+  for (int i = 0; i < 36; i++) amax = fmax(amax, fabs(A[i]));
+  for (int k = 0; k < 6; k++) {
+    int pr = k;
+    for (int i = k + 1; i < 6; i++)
+      if (fabs(A[6 * i + k]) > fabs(A[6 * pr + k])) pr = i;
+    piv[k] = pr;
+    if (!(fabs(A[6 * pr + k]) > 1e-12 * amax)) return -1;
+    if (pr != k)
+      for (int j = 0; j < 6; j++) { double t = A[6 * k + j]; A[6 * k + j] = A[6 * pr + j]; A[6 * pr + j] = t; }
+    for (int i = k + 1; i < 6; i++) {
+      double l = A[6 * i + k] /= A[6 * k + k];
+      for (int j = k + 1; j < 6; j++) A[6 * i + j] -= l * A[6 * k + j];
+    }
+  }
+  return 0;
+}
+
+/* b <- A^-T b with the factors of lu6 (A^T = U^T L^T P) */
+static void lu6_solve_t(const double *A, const int *piv, double *b) {
+  for (int k = 0; k < 6; k++) {
+    for (int j = 0; j < k; j++) b[k] -= A[6 * j + k] * b[j];
+    b[k] /= A[6 * k + k];
+  }
+  for (int k = 5; k >= 0; k--)
+    for (int j = k + 1; j < 6; j++) b[k] -= A[6 * j + k] * b[j];
+  for (int k = 5; k >= 0; k--)
+    if (piv[k] != k) { double t = b[k]; b[k] = b[piv[k]]; b[piv[k]] = t; }
+}
+
+static int in_list(const int *a, int n, int x) {
+  for (int i = 0; i < n; i++)
+    if (a[i] == x) return 1;
+  return 0;
+}
+
+/* the welded virtual bodies to eliminate and their data (order.h); 0 or -1 */
+static int find_elims(const mb_model *m, const double *Kx, ldl_plan *p) {
+  int nv = m->nv, nc = m->nc, nb = m->nbody;
+  char *massive = calloc((size_t)nv + 1, 1);
+  int *weld = NULL;
+  if (!massive) return -1;
+  for (int j = 0; j < nv; j++)
+    for (int q = m->Kp[j]; q < m->Kp[j + 1]; q++)
+      if (m->Ki[q] < nv && Kx[q] != 0) massive[j] = 1;
+  weld = welded_rows(m, massive);
+  p->eb = malloc(sizeof(int) * (size_t)(nb + 1));
+  p->eu = malloc(sizeof *p->eu * (size_t)(nb + 1));
+  p->er = malloc(sizeof *p->er * (size_t)(nb + 1));
+  p->edu = malloc(sizeof *p->edu * (size_t)(nb + 1));
+  p->exp_ = calloc((size_t)nb + 1, sizeof(int));
+  p->esp = calloc((size_t)nb + 1, sizeof(int));
+  p->ekrp = calloc((size_t)nb + 1, sizeof(int));
+  int capx = nb * 80 + 1, caps = nc + 1;
+  p->ex = malloc(sizeof(int) * (size_t)capx);
+  p->es = malloc(sizeof(int) * (size_t)caps * (size_t)(nb + 1));
+  if (!weld || !p->eb || !p->eu || !p->er || !p->edu || !p->exp_ || !p->esp || !p->ekrp || !p->ex || !p->es) {
+    free(massive); free(weld);
+    return -1;
+  }
+  int ne = 0, nx = 0, ns = 0;
+  for (int b = 0; b < nb; b++) {
+    if (weld[b] != 6 || m->body[b].kind != MB_BODY_VIRTUAL) continue;
+    const mb_body *B = &m->body[b];
+    int ok = 1, k = 0, b0 = -2;
+    for (int c = 0; c < 6; c++) ok &= !massive[B->vadr + c];
+    for (int r = 0; r < nc && ok; r++)
+      if (row_weld_body(m, r, massive) == b) {
+        if (k < 6) p->er[ne][k] = nv + r;
+        k++;
+        int o = m->marker[m->row[r].m0].body;
+        if (b0 == -2) b0 = o;
+        else if (b0 != o) ok = 0;
+      }
+    if (!ok || k != 6 || b0 < 0) continue;
+    for (int c = 0; c < 6; c++) p->eu[ne][c] = B->vadr + c;
+    /* X: the columns of the weld rows other than U */
+    int x0 = nx, s0 = ns;
+    for (int i = 0; i < 6 && ok; i++) {
+      int row = p->er[ne][i];
+      for (int q = m->Kp[row]; q < m->Kp[row + 1]; q++) {
+        int j = m->Ki[q];
+        if (j >= nv) { ok = 0; break; }
+        if (in_list(p->eu[ne], 6, j) || in_list(p->ex + x0, nx - x0, j)) continue;
+        if (nx + 1 >= capx) { ok = 0; break; }
+        p->ex[nx++] = j;
+      }
+    }
+    /* S: the other rows on U; U may hold no other entries (massless) */
+    for (int c = 0; c < 6 && ok; c++) {
+      int u = p->eu[ne][c];
+      for (int q = m->Kp[u]; q < m->Kp[u + 1]; q++) {
+        int i = m->Ki[q];
+        if (i < nv) {
+          if (!in_list(p->eu[ne], 6, i) || Kx[q] != 0) ok = 0;
+          continue;
+        }
+        if (in_list(p->er[ne], 6, i) || in_list(p->es + s0, ns - s0, i)) continue;
+        p->es[ns++] = i;
+      }
+    }
+    /* the S rows may not be weld rows of another eliminated body, nor X
+       columns be eliminated (X is massive, so they are not) */
+    for (int e = 0; e < ne && ok; e++)
+      for (int i = 0; i < 6; i++)
+        if (in_list(p->es + s0, ns - s0, p->er[e][i])) ok = 0;
+    if (!ok) { nx = x0; ns = s0; continue; }
+    for (int i = 0; i < 6; i++)
+      for (int c = 0; c < 6; c++) p->edu[ne][6 * i + c] = kslot(m, p->er[ne][i], p->eu[ne][c]);
+    p->eb[ne] = b;
+    p->exp_[ne + 1] = nx;
+    p->esp[ne + 1] = ns;
+    ne++;
+  }
+  p->nelim = ne;
+  /* a weld row of one body may not be an S row of an earlier one either */
+  for (int e = 0; e < ne; e++)
+    for (int f = 0; f < ne; f++)
+      for (int i = 0; i < 6; i++)
+        if (in_list(p->es + p->esp[f], p->esp[f + 1] - p->esp[f], p->er[e][i])) p->nelim = 0;
+  ne = p->nelim;
+  p->edx = malloc(sizeof(int) * (size_t)(6 * p->exp_[ne] + 1));
+  p->eeu = malloc(sizeof(int) * (size_t)(6 * p->esp[ne] + 1));
+  if (!p->edx || !p->eeu) { free(massive); free(weld); return -1; }
+  for (int e = 0; e < ne; e++) {
+    for (int xi = p->exp_[e]; xi < p->exp_[e + 1]; xi++)
+      for (int i = 0; i < 6; i++) p->edx[6 * xi + i] = kslot(m, p->er[e][i], p->ex[xi]);
+    for (int si = p->esp[e]; si < p->esp[e + 1]; si++)
+      for (int c = 0; c < 6; c++) p->eeu[6 * si + c] = kslot(m, p->es[si], p->eu[e][c]);
+  }
+  free(massive); free(weld);
+  return 0;
+}
+
+/* eliminated unknown (U or weld row): 1 body column, 2 row, else 0 */
+static int elim_kind(const ldl_plan *p, int i) {
+  for (int e = 0; e < p->nelim; e++) {
+    if (in_list(p->eu[e], 6, i)) return 1;
+    if (in_list(p->er[e], 6, i)) return 2;
+  }
+  return 0;
+}
+
+/* the pattern of K' (both triangles, rows sorted), its gather map from Kx
+ * and the positions of the corrected entries; 0 or -1 */
+static int elim_pattern(const mb_model *m, ldl_plan *p) {
+  int n = m->n, ne = p->nelim;
+  char *kind = malloc((size_t)n + 1);
+  int *mark = malloc(sizeof(int) * (size_t)(n + 1));
+  p->Krp = calloc((size_t)n + 1, sizeof(int));
+  if (!kind || !mark || !p->Krp) { free(kind); free(mark); return -1; }
+  for (int i = 0; i < n; i++) { kind[i] = (char)elim_kind(p, i); mark[i] = -1; }
+  for (int pass = 0; pass < 2; pass++) {
+    int nz = 0;
+    for (int i = 0; i < n; i++) mark[i] = -1;
+    for (int j = 0; j < n; j++) {
+      int start = nz;
+#define ADD(ii)                                      \
+  do {                                               \
+    int i_ = (ii);                                   \
+    if (mark[i_] != j) {                             \
+      mark[i_] = j;                                  \
+      if (pass) p->Kri[nz] = i_;                     \
+      nz++;                                          \
+    }                                                \
+  } while (0)
+      if (kind[j]) {
+        ADD(j);
+      } else {
+        for (int q = m->Kp[j]; q < m->Kp[j + 1]; q++)
+          if (!kind[m->Ki[q]]) ADD(m->Ki[q]);
+        for (int e = 0; e < ne; e++) {
+          int xs = p->exp_[e], xe = p->exp_[e + 1], ss = p->esp[e], se = p->esp[e + 1];
+          if (in_list(p->ex + xs, xe - xs, j))
+            for (int k = ss; k < se; k++) ADD(p->es[k]);
+          if (in_list(p->es + ss, se - ss, j))
+            for (int k = xs; k < xe; k++) ADD(p->ex[k]);
+        }
+      }
+#undef ADD
+      if (pass) qsort(p->Kri + start, (size_t)(nz - start), sizeof(int), int_cmp);
+      else p->Krp[j + 1] = nz;
+    }
+    if (!pass) {
+      p->nnzR = nz;
+      p->Kri = malloc(sizeof(int) * (size_t)(nz + 1));
+      p->Krmap = malloc(sizeof(int) * (size_t)(nz + 1));
+      if (!p->Kri || !p->Krmap) { free(kind); free(mark); return -1; }
+    }
+  }
+  for (int j = 0; j < n; j++)
+    for (int q = p->Krp[j]; q < p->Krp[j + 1]; q++) {
+      int i = p->Kri[q];
+      p->Krmap[q] = kind[j] ? (kind[j] == 1 ? -2 : -3) : kslot(m, i, j);
+      if (p->Krmap[q] < 0 && !kind[j]) p->Krmap[q] = -1;
+    }
+  /* the corrected pairs */
+  int npair = 0;
+  for (int e = 0; e < ne; e++) npair += (p->exp_[e + 1] - p->exp_[e]) * (p->esp[e + 1] - p->esp[e]);
+  p->ekr = malloc(sizeof(int) * (size_t)(2 * npair + 1));
+  if (!p->ekr) { free(kind); free(mark); return -1; }
+  mb_model mr = *m;
+  mr.Kp = p->Krp;
+  mr.Ki = p->Kri;
+  mr.nnz = p->nnzR;
+  int k = 0;
+  for (int e = 0; e < ne; e++) {
+    p->ekrp[e] = k;
+    for (int si = p->esp[e]; si < p->esp[e + 1]; si++)
+      for (int xi = p->exp_[e]; xi < p->exp_[e + 1]; xi++) {
+        p->ekr[2 * k] = kslot(&mr, p->es[si], p->ex[xi]);
+        p->ekr[2 * k + 1] = kslot(&mr, p->ex[xi], p->es[si]);
+        k++;
+      }
+  }
+  p->ekrp[ne] = k;
+  free(kind); free(mark);
+  return 0;
+}
+
+/* Kr = the values of K' from Kx (what the emitted factorization does); 0 or
+ * -1 when a Du is singular */
+static int elim_values(const ldl_plan *p, const double *Kx, double *Kr) {
+  for (int q = 0; q < p->nnzR; q++) {
+    int s = p->Krmap[q];
+    Kr[q] = s >= 0 ? Kx[s] : s == -2 ? 1 : s == -3 ? -1 : 0;
+  }
+  for (int e = 0; e < p->nelim; e++) {
+    double A[36], w[6];
+    int piv[6];
+    for (int i = 0; i < 36; i++) A[i] = p->edu[e][i] >= 0 ? Kx[p->edu[e][i]] : 0;
+    if (lu6(A, piv)) return -1;
+    int nx = p->exp_[e + 1] - p->exp_[e], k = p->ekrp[e];
+    for (int si = p->esp[e]; si < p->esp[e + 1]; si++) {
+      for (int c = 0; c < 6; c++) w[c] = p->eeu[6 * si + c] >= 0 ? Kx[p->eeu[6 * si + c]] : 0;
+      lu6_solve_t(A, piv, w);
+      for (int xi = 0; xi < nx; xi++, k++) {
+        const int *dx = p->edx + 6 * (p->exp_[e] + xi);
+        double v = 0;
+        for (int i = 0; i < 6; i++) v += w[i] * (dx[i] >= 0 ? Kx[dx[i]] : 0);
+        Kr[p->ekr[2 * k]] -= v;
+        if (p->ekr[2 * k + 1] != p->ekr[2 * k]) Kr[p->ekr[2 * k + 1]] -= v;
+      }
+    }
+  }
+  return 0;
+}
+
 /* weights: rows touching a massless column get w_r = mref / |D_r|^2 with
  * mref the geometric mean of the nonzero M diagonals of the row's other
  * columns (or of all of M when it has none): D_r^T w_r D_r then adds to the
- * massless columns the scale of the masses (inertias) it couples them to. */
+ * massless columns the scale of the masses (inertias) it couples them to.
+ * The columns of a virtual body welded to a massive body are covered by the
+ * 6 rows of the weld alone (see below). */
 static int choose_weights(const mb_model *m, const double *Kx, ldl_plan *p) {
   int nv = m->nv, nc = m->nc;
   char *massive = calloc((size_t)nv + 1, 1), *wmark = calloc((size_t)nc + 1, 1);
@@ -113,13 +423,28 @@ static int choose_weights(const mb_model *m, const double *Kx, ldl_plan *p) {
     if (massive[j] && mdiag[j] > 0) { glog += log(mdiag[j]); gcount++; }
   }
   double gmean = gcount ? exp(glog / gcount) : 1.0;
+  /* a massless body welded to a massive one (a virtual body inserted for a
+     joint on a flexible node: the 6 rows of its rigid joint) needs only those
+     6 rows weighted: their block on its own 6 columns is nonsingular in every
+     configuration the constraints allow, so M + D_W^T W D_W is positive
+     definite on its columns without weighting the rows of the joint it
+     carries (which would join the bodies on both sides into one dense block) */
+  int *weld = welded_rows(m, massive);
+  if (!weld) { free(massive); free(wmark); free(mdiag); return -1; }
   p->nmassless = 0;
   for (int j = 0; j < nv; j++) {
     if (massive[j]) continue;
     p->nmassless++;
+    int b = body_of_column(m, j);
+    if (b >= 0 && weld[b] >= 0) {
+      for (int r = 0; r < nc; r++)
+        if (row_weld_body(m, r, massive) == b) wmark[r] = 1;
+      continue;
+    }
     for (int q = m->Kp[j]; q < m->Kp[j + 1]; q++)
       if (m->Ki[q] >= nv) wmark[m->Ki[q] - nv] = 1;
   }
+  free(weld);
   p->nw = 0;
   for (int r = 0; r < nc; r++) p->nw += wmark[r];
   p->wrow = malloc(sizeof(int) * (size_t)(p->nw + 1));
@@ -500,8 +825,24 @@ int ldl_plan_build(const lmodel *L, ldl_plan *p) {
   p->budget = env && *env ? atof(env) : LDL_FLOP_BUDGET;
   const char *ord = getenv("MBCC_LDL_ORDER"); /* "bodies-first" or "tree": force one */
   int *Ap = NULL, *Ai = NULL, *C2 = NULL, *Ct = NULL;
-  double *Kx = kx_at_start(m);
+  double *Kx = kx_at_start(m), *Kr = NULL;
   if (!Kx) goto fail;
+  /* block pivots (MBCC_LDL_BLOCK=0: none, the weld rows are weighted instead);
+     from here on m is K' (pattern Krp/Kri, values Kr) */
+  const char *blk = getenv("MBCC_LDL_BLOCK");
+  if (find_elims(m, Kx, p)) goto fail;
+  if (blk && !strcmp(blk, "0")) p->nelim = 0;
+  if (elim_pattern(m, p)) goto fail;
+  Kr = malloc(sizeof(double) * (size_t)(p->nnzR + 1));
+  if (!Kr || elim_values(p, Kx, Kr)) goto fail;
+  mb_model mr = *m;
+  mr.Kp = p->Krp;
+  mr.Ki = p->Kri;
+  mr.nnz = p->nnzR;
+  m = &mr;
+  free(Kx);
+  Kx = Kr;
+  Kr = NULL;
   if (choose_weights(m, Kx, p)) goto fail;
   if (aug_pattern(m, p, &Ap, &Ai)) goto fail;
   C2 = malloc(sizeof(int) * (size_t)(n + 1));
@@ -531,10 +872,20 @@ int ldl_plan_build(const lmodel *L, ldl_plan *p) {
   }
   if (!p->perm) goto fail;
   p->straight = p->flops <= p->budget;
+  /* the block pivots' own work (looped code in any case): LU of Du, a
+     transposed solve per S row and the product with Dx; per solve the right
+     side (W g_r, Dx^T Du^-T f_u) and the recovery (two 6 x 6 solves) */
+  p->flops_block = 0;
+  p->flops_block_solve = 0;
+  for (int e = 0; e < p->nelim; e++) {
+    double nxe = p->exp_[e + 1] - p->exp_[e], nse = p->esp[e + 1] - p->esp[e];
+    p->flops_block += 150 + nse * (72 + 12 * nxe);
+    p->flops_block_solve += 4 * 72 + 24 * (nxe + nse);
+  }
   free(Kx); free(Ap); free(Ai); free(C2); free(Ct);
   return 0;
 fail:
-  free(Kx); free(Ap); free(Ai); free(C2); free(Ct);
+  free(Kx); free(Kr); free(Ap); free(Ai); free(C2); free(Ct);
   ldl_plan_free(p);
   return -1;
 }
@@ -553,6 +904,9 @@ void ldl_plan_report(const lmodel *L, FILE *out) {
   if (p.nmassless)
     fprintf(out, "  zero mass         %d massless unknowns: %d rows weighted (K_aug = [M + D^T W D, D^T; D, 0])\n",
             p.nmassless, p.nw);
+  if (p.nelim)
+    fprintf(out, "  block pivots      %d welded virtual bodies eliminated with their weld rows "
+                 "(%.0f flops per factorization, %.0f per solve)\n", p.nelim, p.flops_block, p.flops_block_solve);
   fprintf(out, "  nnz(L)            %ld (strictly lower; L + D + L^T has %ld)\n", p.nnzL, 2 * p.nnzL + p.n);
   fprintf(out, "  LDL^T flops       %.0f per factorization, %.0f per solve\n", p.flops, p.flops_solve);
   fprintf(out, "  LDL^T code        %s (flop budget %.0f)\n", p.straight ? "straight-line" : "looped", p.budget);

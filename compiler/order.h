@@ -15,7 +15,11 @@
  *  - elimination tree, column counts, the pattern of L (strictly lower, CSC,
  *    rows sorted), nnz(L) and the flop count of the numeric factorization.
  * Everything here is in the numbering of the permuted matrix P K_aug P^T
- * unless said otherwise ("original" = the unknowns of K). */
+ * unless said otherwise ("original" = the unknowns of K).
+ *  - block pivots: a virtual body welded to a massive body (inserted for a
+ *    joint on a flexible node) is eliminated together with its 6 weld rows
+ *    before all of this (see nelim below): no weights, no fill beyond the
+ *    joint rows it carries moving onto the node's columns. */
 #ifndef MBCC_ORDER_H
 #define MBCC_ORDER_H
 
@@ -39,6 +43,33 @@ typedef struct {
   double *w;         /* nw: weights */
   int *Dp, *Dj, *Ds; /* weighted row k: velocity columns Dj[Dp[k]..Dp[k+1]) and the Kx slot
                         of each D entry (row nv + wrow[k], column Dj) */
+
+  /* block pivots (original numbering): each virtual body welded to a massive
+   * body is eliminated with the 6 rows of its weld before the LDL^T, as one
+   * 12 x 12 pivot [0 Du^T; Du 0] (Du: the weld rows on its own 6 columns).
+   * With Eu the other rows S on its columns and Dx the weld rows on the
+   * columns X of the body it is welded to, what remains is K' (same size as
+   * K; the eliminated unknowns decoupled with diagonal 1 / -1):
+   *   K'(s, x) = K(s, x) - (Eu Du^-1 Dx)(s, x),  right side
+   *   g'_s = g_s - Eu Du^-1 g_r,  f'_x = f_x - Dx^T Du^-T f_u,
+   * then a_u = Du^-1 (g_r - Dx a_x), lambda_r = Du^-T (f_u - Eu^T lambda_s).
+   * Everything below (weights, K_aug, ordering, L) is of K', whose values
+   * Kr (nnzR, in the CSC order Krp/Kri) are gathered from Kx by Krmap
+   * (>= 0: a Kx slot, -1: 0, -2: 1, -3: -1) and then corrected. */
+  int nelim;         /* eliminated (welded virtual) bodies */
+  int *eb;           /* nelim: the body */
+  int (*eu)[6];      /* its 6 velocity columns */
+  int (*er)[6];      /* its 6 weld rows (K indices nv + r) */
+  int *exp_, *ex;    /* X: columns ex[exp_[e]..exp_[e+1]) */
+  int *esp, *es;     /* S: K indices of the other rows on its columns */
+  int (*edu)[36];    /* Kx slots of Du (row-major, -1: structurally zero) */
+  int *edx;          /* Kx slots of Dx: 6 per column of X, at 6 exp_[e] */
+  int *eeu;          /* Kx slots of Eu: 6 per row of S, at 6 esp[e] */
+  int *ekr;          /* Kr positions of K'(s, x) and K'(x, s): 2 per pair, at 2 (sum ns nx) */
+  int *ekrp;         /* nelim + 1: start of body e in ekr (pairs) */
+  int nnzR;
+  int *Krp, *Kri, *Krmap;
+  double flops_block, flops_block_solve; /* the block pivots' flops (not in flops) */
 
   /* K_aug in the permuted numbering, upper triangle with the diagonal, CSC
    * with rows sorted: column k holds Ui[Up[k]..Up[k+1]) (last one may be k).

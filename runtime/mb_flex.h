@@ -98,6 +98,7 @@ static inline void mb_marker_node(const mb_frame *f, const mb_flex *fx, int k, c
   mb_modal3(Psi, nm, wd, thd);
   mb_modal3(X, nm, wd, Xwd);
   mb_so3_jl(th, thd, Jl, Jld);
+  for (int i = 0; i < 9; i++) m->Jl[i] = Jl[i];
   mb_so3_exp(th, Ex);
   mb_matmul3(f->A, Ex, AE);
   mb_matmul3(AE, C, m->R);
@@ -139,41 +140,86 @@ static inline void mb_node_cols(const mb_frame *f, const mb_flex *fx, int k, con
   for (int j = 0; j < nm; j++) c[6 + j] = mb_dot3(X + 3 * j, lV) + mb_dot3(Psi + 3 * j, JtW);
 }
 
-/* The flexible body's mass matrix Mb ((6+nm)^2, row-major, coordinates
- * [rd; w'; wd]) and its forces fb (6+nm): gravity g (global), quadratic-velocity
- * terms, modal stiffness and damping.  Returns nothing; see the header comment. */
-static inline void mb_flex_body(const mb_flex *fx, const mb_frame *f, const mb_real *w,
-                                const mb_real *wd, const mb_real g[3], mb_real *Mb,
-                                mb_real *fb) {
-  int nm = fx->nm, n = 6 + nm;
+/* mb_node_cols at the marker mk of node k as set by mb_marker_node (its point
+ * and the left Jacobian it computed): the same columns without evaluating
+ * the node's rotation again for every row and force on the marker */
+static inline void mb_node_cols_mk(const mb_frame *f, const mb_flex *fx, int k, const mb_marker *mk,
+                                   const mb_real dV[3], const mb_real dW[3], mb_real *c) {
+  int nm = fx->nm;
+  const mb_real *X = fx->node_X + 3 * k * nm, *Psi = fx->node_Psi + 3 * k * nm;
+  mb_real lV[3], lW[3], JtW[3];
+  mb_rigid_cols(f, mk->P, dV, dW, c);
+  mb_mul3t(f->A, dV, lV);
+  mb_mul3t(f->A, dW, lW);
+  mb_mul3t(mk->Jl, lW, JtW);
+  for (int j = 0; j < nm; j++) c[6 + j] = mb_dot3(X + 3 * j, lV) + mb_dot3(Psi + 3 * j, JtW);
+}
+
+/* The per-step contractions of the inertia invariants with the modal
+ * coordinates w and velocities wd (everything of mb_flex_body that is
+ * quadratic in the number of modes):
+ *   S = S0 + S1 w,  J = J0 + sum_j w_j J1_j + sum_ij w_i w_j J2_ij,
+ *   Fw_j = sum_a w_a F_ja,  Gw_j = C0_j + sum_a w_a G_aj,  Gd_j = sum_a wd_a G_aj,
+ *   S1wd = S1 wd,  Cw = CPsi wd.
+ * mb_flex_contract computes them with loops over the tables (the generic
+ * path); the generated code computes the same sums straight-line with the
+ * invariants' nonzero entries as literal constants (compiler/emit.c). */
+typedef struct {
+  mb_real S[3], J[9], S1wd[3], Cw[3];
+  mb_real Fw[9 * MB_MAX_MODES]; /* Fw_j at Fw + 9 j (zero unless coupling is partial or full) */
+  mb_real Gw[3 * MB_MAX_MODES]; /* Gw_j at Gw + 3 j: column j of M_thf */
+  mb_real Gd[3 * MB_MAX_MODES]; /* Gd_j at Gd + 3 j */
+} mb_flex_step;
+
+static inline void mb_flex_contract(const mb_flex *fx, const mb_real *w, const mb_real *wd,
+                                    mb_flex_step *c) {
+  int nm = fx->nm;
   int lin = fx->coupling != MB_COUPLING_CONSTANT, quad = fx->coupling == MB_COUPLING_FULL;
-  const mb_real *wl = f->wl;
-  mb_real S[3], J[9], B[9], h = 0, H[9] = {0}, t[3], t2[3], Ag[3];
-  /* S(w), J(w) */
-  for (int i = 0; i < 3; i++) S[i] = fx->S0[i];
-  for (int i = 0; i < 9; i++) J[i] = fx->J0[i];
-  if (lin) {
-    for (int j = 0; j < nm; j++) {
-      const mb_real *E = fx->E + 9 * j;
-      mb_real tr = E[0] + E[4] + E[8];
-      for (int i = 0; i < 3; i++) S[i] += fx->S1[3 * j + i] * w[j];
-      for (int i = 0; i < 3; i++)
-        for (int l = 0; l < 3; l++)
-          J[3 * i + l] += w[j] * (2 * tr * (i == l) - E[3 * i + l] - E[3 * l + i]);
+  for (int i = 0; i < 3; i++) c->S[i] = fx->S0[i];
+  for (int i = 0; i < 9; i++) c->J[i] = fx->J0[i];
+  mb_modal3(fx->S1, nm, wd, c->S1wd);
+  mb_modal3(fx->CPsi, nm, wd, c->Cw);
+  for (int j = 0; j < nm; j++) {
+    mb_real *Fw = c->Fw + 9 * j, *Gw = c->Gw + 3 * j, *Gd = c->Gd + 3 * j;
+    for (int i = 0; i < 9; i++) Fw[i] = 0;
+    for (int i = 0; i < 3; i++) { Gw[i] = fx->C0[3 * j + i]; Gd[i] = 0; }
+    for (int a = 0; a < nm; a++) {
+      const mb_real *G = fx->G + 3 * (a * nm + j);
+      for (int i = 0; i < 3; i++) Gd[i] += wd[a] * G[i];
+      if (!lin) continue;
+      const mb_real *F = fx->F + 9 * (j * nm + a);
+      for (int i = 0; i < 9; i++) Fw[i] += w[a] * F[i];
+      for (int i = 0; i < 3; i++) Gw[i] += w[a] * G[i];
     }
   }
-  if (quad) {
-    for (int a = 0; a < nm; a++)
-      for (int b = 0; b < nm; b++) {
-        const mb_real *F = fx->F + 9 * (a * nm + b);
-        mb_real ww = w[a] * w[b], tr = F[0] + F[4] + F[8];
-        for (int i = 0; i < 3; i++)
-          for (int l = 0; l < 3; l++)
-            J[3 * i + l] += ww * (tr * (i == l) - 0.5 * (F[3 * i + l] + F[3 * l + i]));
-      }
-  }
+  if (lin)
+    for (int j = 0; j < nm; j++) {
+      const mb_real *E = fx->E + 9 * j, *Fw = c->Fw + 9 * j;
+      mb_real tr = E[0] + E[4] + E[8], tf = Fw[0] + Fw[4] + Fw[8];
+      for (int i = 0; i < 3; i++) c->S[i] += fx->S1[3 * j + i] * w[j];
+      /* J1_j = 2 tr(E_j) I - E_j - E_j^T; with the full coupling also
+         sum_a w_a J2_ja = tr(Fw_j) I - (Fw_j + Fw_j^T) / 2 */
+      for (int i = 0; i < 3; i++)
+        for (int l = 0; l < 3; l++) {
+          mb_real t = 2 * tr * (i == l) - E[3 * i + l] - E[3 * l + i];
+          if (quad) t += tf * (i == l) - 0.5 * (Fw[3 * i + l] + Fw[3 * l + i]);
+          c->J[3 * i + l] += w[j] * t;
+        }
+    }
+}
+
+/* The flexible body's mass matrix Mb ((6+nm)^2, row-major, coordinates
+ * [rd; w'; wd]) and its forces fb (6+nm): gravity g (global), quadratic-velocity
+ * terms, modal stiffness and damping, from the contractions c of
+ * mb_flex_contract.  See the header comment. */
+static inline void mb_flex_assemble(const mb_flex *fx, const mb_flex_step *c, const mb_frame *f,
+                                    const mb_real *w, const mb_real *wd, const mb_real g[3],
+                                    mb_real *Mb, mb_real *fb) {
+  int nm = fx->nm, n = 6 + nm;
+  const mb_real *wl = f->wl, *S = c->S, *J = c->J;
+  mb_real h = 0, H[9] = {0}, t[3], t2[3], Ag[3];
   for (int i = 0; i < n * n; i++) Mb[i] = 0;
-  /* M_rr = m I, M_rth = -A S~, M_rf = A S1 */
+  /* M_rr = m I, M_rth = -A S~, M_rf = A S1, M_thth = J, M_thf = [Gw_j] */
   mb_real AS[9], Sx[9] = {0, -S[2], S[1], S[2], 0, -S[0], -S[1], S[0], 0};
   mb_matmul3(f->A, Sx, AS);
   for (int i = 0; i < 3; i++) {
@@ -185,12 +231,9 @@ static inline void mb_flex_body(const mb_flex *fx, const mb_frame *f, const mb_r
     }
   }
   for (int j = 0; j < nm; j++) {
-    mb_real col[3], thf[3];
+    mb_real col[3];
+    const mb_real *thf = c->Gw + 3 * j;
     mb_mul3(f->A, fx->S1 + 3 * j, col);
-    for (int i = 0; i < 3; i++) thf[i] = fx->C0[3 * j + i];
-    if (lin)
-      for (int a = 0; a < nm; a++)
-        for (int i = 0; i < 3; i++) thf[i] += w[a] * fx->G[3 * (a * nm + j) + i];
     for (int i = 0; i < 3; i++) {
       Mb[n * i + 6 + j] = Mb[n * (6 + j) + i] = col[i];
       Mb[n * (3 + i) + 6 + j] = Mb[n * (6 + j) + 3 + i] = thf[i];
@@ -199,50 +242,47 @@ static inline void mb_flex_body(const mb_flex *fx, const mb_frame *f, const mb_r
   }
 
   /* forces: rigid-frame part */
-  mb_real S1wd[3], wS[3];
-  mb_modal3(fx->S1, nm, wd, S1wd);
+  mb_real wS[3];
   mb_wwa(wl, S, t);
-  mb_cross3(wl, S1wd, t2);
+  mb_cross3(wl, c->S1wd, t2);
   for (int i = 0; i < 3; i++) t[i] += 2 * t2[i];
   mb_mul3(f->A, t, t2);
   mb_mul3t(f->A, g, Ag);
   for (int i = 0; i < 3; i++) fb[i] = fx->mass * g[i] - t2[i];
-  /* h = sum_k m_k (X_k^T b_k) . wd and H = sum_k m_k (X_k wd) b_k^T */
+  /* B_j = E_j + Fw_j; h = sum_k m_k (X_k^T b_k) . wd = sum_j wd_j tr B_j and
+     H = sum_k m_k (X_k wd) b_k^T = sum_j wd_j B_j */
   for (int j = 0; j < nm; j++) {
-    const mb_real *E = fx->E + 9 * j;
-    mb_real hj = E[0] + E[4] + E[8];
-    for (int i = 0; i < 9; i++) H[i] += wd[j] * E[i];
-    if (lin)
-      for (int a = 0; a < nm; a++) {
-        const mb_real *F = fx->F + 9 * (j * nm + a);
-        hj += w[a] * (F[0] + F[4] + F[8]);
-        for (int i = 0; i < 9; i++) H[i] += wd[j] * w[a] * F[i];
-      }
-    h += hj * wd[j];
+    const mb_real *E = fx->E + 9 * j, *Fw = c->Fw + 9 * j;
+    for (int i = 0; i < 9; i++) H[i] += wd[j] * (E[i] + Fw[i]);
+    h += wd[j] * (E[0] + E[4] + E[8] + Fw[0] + Fw[4] + Fw[8]);
   }
   /* s_th = -w' x (J w') - 2 (w' h - H w') - w' x (CPsi wd) + S x (A^T g) */
-  mb_real Jw[3], Hw[3], Cw[3];
+  mb_real Jw[3], Hw[3];
   mb_mul3(J, wl, Jw);
   mb_mul3(H, wl, Hw);
-  mb_modal3(fx->CPsi, nm, wd, Cw);
-  for (int i = 0; i < 3; i++) Jw[i] += Cw[i];
+  for (int i = 0; i < 3; i++) Jw[i] += c->Cw[i];
   mb_cross3(wl, Jw, t);
   mb_cross3(S, Ag, wS);
   for (int i = 0; i < 3; i++) fb[3 + i] = -t[i] - 2 * (wl[i] * h - Hw[i]) + wS[i];
-  /* s_f(j) = -(w'^T B_j w' - |w'|^2 tr B_j) - 2 sum_i wd_i w'.G_ij + S1_j . A^T g - k w - c wd,
-     B_j = E_j + sum_a w_a F_ja */
+  /* s_f(j) = -(w'^T B_j w' - |w'|^2 tr B_j) - 2 w'.Gd_j + S1_j . A^T g - k w - c wd */
   mb_real ww = mb_dot3(wl, wl);
   for (int j = 0; j < nm; j++) {
-    for (int i = 0; i < 9; i++) B[i] = fx->E[9 * j + i];
-    if (lin)
-      for (int a = 0; a < nm; a++)
-        for (int i = 0; i < 9; i++) B[i] += w[a] * fx->F[9 * (j * nm + a) + i];
-    mb_real Bw[3], gsum = 0;
+    const mb_real *E = fx->E + 9 * j, *Fw = c->Fw + 9 * j;
+    mb_real B[9], Bw[3];
+    for (int i = 0; i < 9; i++) B[i] = E[i] + Fw[i];
     mb_mul3(B, wl, Bw);
-    for (int a = 0; a < nm; a++) gsum += wd[a] * mb_dot3(wl, fx->G + 3 * (a * nm + j));
-    fb[6 + j] = -(mb_dot3(wl, Bw) - ww * (B[0] + B[4] + B[8])) - 2 * gsum +
+    fb[6 + j] = -(mb_dot3(wl, Bw) - ww * (B[0] + B[4] + B[8])) - 2 * mb_dot3(wl, c->Gd + 3 * j) +
                 mb_dot3(fx->S1 + 3 * j, Ag) - fx->stiffness[j] * w[j] - fx->damping[j] * wd[j];
   }
+}
+
+/* mb_flex_assemble of mb_flex_contract (the generic path's one call) */
+static inline void mb_flex_body(const mb_flex *fx, const mb_frame *f, const mb_real *w,
+                                const mb_real *wd, const mb_real g[3], mb_real *Mb,
+                                mb_real *fb) {
+  mb_flex_step c;
+  mb_flex_contract(fx, w, wd, &c);
+  mb_flex_assemble(fx, &c, f, w, wd, g, Mb, fb);
 }
 
 /* kinetic energy 1/2 v^T M v of a flexible body, elastic energy 1/2 w^T K w */

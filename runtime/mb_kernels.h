@@ -119,6 +119,8 @@ typedef struct {
   mb_real P[3], R[9]; /* point and axes (columns), global */
   mb_real V[3], W[3]; /* point velocity, angular velocity, global */
   mb_real aP[3], aW[3]; /* velocity-dependent parts of the accelerations */
+  mb_real Jl[9];      /* flexible node markers: left Jacobian of the node's rotation
+                         (mb_marker_node; for mb_node_cols_mk); else unset */
 } mb_marker;
 
 /* marker fixed on the ground: s and C are its global point and axes */

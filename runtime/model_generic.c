@@ -84,9 +84,10 @@ static void frames_and_markers(const mb_model *m, const mb_real *q, const mb_rea
 static int marker_cols(const mb_model *m, const mb_frame *F, const mb_marker *MK, int k,
                        const mb_real *q, const mb_real dV[3], const mb_real dW[3], mb_real *c) {
   const mb_markerdef *d = &m->marker[k];
+  (void)q;
   const mb_body *B = &m->body[d->body];
   if (d->node >= 0) {
-    mb_node_cols(&F[d->body], B->flex, d->node, q + B->qadr + 7, MK[k].P, dV, dW, c);
+    mb_node_cols_mk(&F[d->body], B->flex, d->node, &MK[k], dV, dW, c);
     return 6 + B->nm;
   }
   mb_rigid_cols(&F[d->body], MK[k].P, dV, dW, c);
