@@ -301,6 +301,16 @@ static void kx_or_zero(FILE *f, int slot) {
 
 /* the block pivots straight-line (below the flop budget): every slot a
  * constant, structural zeros of Du, Dx and Eu skipped */
+/* "  v[i] = r[row] - Kx[slot] * d[col] ...;": row of a block's right side less
+ * the known unknowns cols[0..n) through the Kx slots slots[6 k + i] (-1: none) */
+static void emit_reduced_rhs(FILE *f, const char *v, int i, int row, const int *slots,
+                             const int *cols, int n) {
+  fprintf(f, "  %s[%d] = r[%d]", v, i, row);
+  for (int k = 0; k < n; k++)
+    if (slots[6 * k + i] >= 0) fprintf(f, " - Kx[%d] * d[%d]", slots[6 * k + i], cols[k]);
+  fputs(";\n", f);
+}
+
 static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, const long *woff) {
   char name[512];
   int nkc = 0;
@@ -399,22 +409,8 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
   for (int e = 0; e < p->nelim; e++) {
     int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
     fprintf(f, "  /* block %d */\n  Di = work + %ld;\n", e, woff[e]);
-    for (int i = 0; i < 6; i++) {
-      fprintf(f, "  y[%d] = r[%d]", i, p->er[e][i]);
-      for (int xi = 0; xi < nx; xi++) {
-        int sl = p->edx[6 * (xs + xi) + i];
-        if (sl >= 0) fprintf(f, " - Kx[%d] * d[%d]", sl, p->ex[xs + xi]);
-      }
-      fputs(";\n", f);
-    }
-    for (int c = 0; c < 6; c++) {
-      fprintf(f, "  z[%d] = r[%d]", c, p->eu[e][c]);
-      for (int si = 0; si < ns; si++) {
-        int sl = p->eeu[6 * (ss + si) + c];
-        if (sl >= 0) fprintf(f, " - Kx[%d] * d[%d]", sl, p->es[ss + si]);
-      }
-      fputs(";\n", f);
-    }
+    for (int i = 0; i < 6; i++) emit_reduced_rhs(f, "y", i, p->er[e][i], p->edx + 6 * xs, p->ex + xs, nx);
+    for (int c = 0; c < 6; c++) emit_reduced_rhs(f, "z", c, p->eu[e][c], p->eeu + 6 * ss, p->es + ss, ns);
     for (int c = 0; c < 6; c++) {
       fprintf(f, "  d[%d] = ", p->eu[e][c]);
       for (int i = 0; i < 6; i++) fprintf(f, "%sDi[%d] * y[%d]", i ? " + " : "", 6 * c + i, i);

@@ -288,6 +288,15 @@ static int find_elims(const mb_model *m, const double *Kx, ldl_plan *p) {
   return 0;
 }
 
+/* Row i in column j of a pattern built in two passes (count, then fill):
+ * once per column (mark), stored when rows is not NULL. */
+static void add_entry(int i, int j, int *mark, int *rows, int *nz) {
+  if (mark[i] == j) return;
+  mark[i] = j;
+  if (rows) rows[*nz] = i;
+  (*nz)++;
+}
+
 /* eliminated unknown (U or weld row): 1 body column, 2 row, else 0 */
 static int elim_kind(const ldl_plan *p, int i) {
   for (int e = 0; e < p->nelim; e++) {
@@ -311,15 +320,7 @@ static int elim_pattern(const mb_model *m, ldl_plan *p) {
     for (int i = 0; i < n; i++) mark[i] = -1;
     for (int j = 0; j < n; j++) {
       int start = nz;
-#define ADD(ii)                                      \
-  do {                                               \
-    int i_ = (ii);                                   \
-    if (mark[i_] != j) {                             \
-      mark[i_] = j;                                  \
-      if (pass) p->Kri[nz] = i_;                     \
-      nz++;                                          \
-    }                                                \
-  } while (0)
+#define ADD(ii) add_entry((ii), j, mark, pass ? p->Kri : NULL, &nz)
       if (kind[j]) {
         ADD(j);
       } else {
@@ -513,15 +514,7 @@ static int aug_pattern(const mb_model *m, const ldl_plan *p, int **Apo, int **Ai
     int nz = 0;
     for (int j = 0; j < n; j++) {
       int start = nz;
-#define ADD(ii)                                   \
-  do {                                            \
-    int i_ = (ii);                                \
-    if (mark[i_] != j) {                          \
-      mark[i_] = j;                               \
-      if (pass) Ai[nz] = i_;                      \
-      nz++;                                       \
-    }                                             \
-  } while (0)
+#define ADD(ii) add_entry((ii), j, mark, pass ? Ai : NULL, &nz)
       ADD(j);
       for (int q = m->Kp[j]; q < m->Kp[j + 1]; q++) ADD(m->Ki[q]);
       if (j < nv)

@@ -363,15 +363,6 @@ static void restore_stderr(int saved) {
   if (saved >= 0) { dup2(saved, 2); close(saved); }
 }
 
-/* the single-precision simulator: the generated code (emitted with
- * real_float) against the float runtime library, libmbrt_float.a */
-static int build_float_simulator(const char *dir, const char *name, const char *main_src,
-                                 const char *exe, char *why, size_t nwhy) {
-  int rc = compile_generated(dir, name, main_src, exe, NULL, 1, 1);
-  if (rc) textf(why, nwhy, "the single-precision build failed");
-  return rc;
-}
-
 /* read, apply, lower, assemble, emit and compile a variant into workdir/label;
  * messages go to workdir/label.log.  Sets v->ok, or v->why. */
 static void build_variant(const trade_options *o, const char *workdir, variant *v) {
@@ -404,8 +395,9 @@ static void build_variant(const trade_options *o, const char *workdir, variant *
     char main_src[4300];
     snprintf(main_src, sizeof main_src, "%s/main.c", dir);
     snprintf(v->exe, sizeof v->exe, "%s/%s_sim", dir, L->m.name);
-    int rc = v->real_float ? build_float_simulator(dir, L->m.name, main_src, v->exe, v->why, sizeof v->why)
-                           : compile_generated(dir, L->m.name, main_src, v->exe, NULL, 0, 0);
+    /* single precision: the code emitted with real_float against libmbrt_float.a */
+    int rc = compile_generated(dir, L->m.name, main_src, v->exe, NULL, v->real_float, v->real_float);
+    if (rc && v->real_float) textf(v->why, sizeof v->why, "the single-precision build failed");
     v->ok = !rc;
   }
   restore_stderr(saved);

@@ -123,26 +123,10 @@ static inline void mb_marker_node(const mb_frame *f, const mb_flex *fx, int k, c
   mb_mul3(f->A, t1, m->aW);
 }
 
-/* Map (dV, dW) at a node marker to the body's 6 + nm velocity coordinates:
+/* Map (dV, dW) at the marker mk of node k (as set by mb_marker_node: its
+ * point and the left Jacobian of the node rotation) to the body's 6 + nm
+ * velocity coordinates:
  * [dV; A^T(u x dV + dW); X^T A^T dV + (Jl Psi)^T A^T dW], u = P - r. */
-static inline void mb_node_cols(const mb_frame *f, const mb_flex *fx, int k, const mb_real *w,
-                                const mb_real P[3], const mb_real dV[3], const mb_real dW[3],
-                                mb_real *c) {
-  int nm = fx->nm;
-  const mb_real *X = fx->node_X + 3 * k * nm, *Psi = fx->node_Psi + 3 * k * nm;
-  mb_real th[3], zero[3] = {0, 0, 0}, Jl[9], Jld[9], lV[3], lW[3], JtW[3];
-  mb_rigid_cols(f, P, dV, dW, c);
-  mb_modal3(Psi, nm, w, th);
-  mb_so3_jl(th, zero, Jl, Jld);
-  mb_mul3t(f->A, dV, lV);
-  mb_mul3t(f->A, dW, lW);
-  mb_mul3t(Jl, lW, JtW);
-  for (int j = 0; j < nm; j++) c[6 + j] = mb_dot3(X + 3 * j, lV) + mb_dot3(Psi + 3 * j, JtW);
-}
-
-/* mb_node_cols at the marker mk of node k as set by mb_marker_node (its point
- * and the left Jacobian it computed): the same columns without evaluating
- * the node's rotation again for every row and force on the marker */
 static inline void mb_node_cols_mk(const mb_frame *f, const mb_flex *fx, int k, const mb_marker *mk,
                                    const mb_real dV[3], const mb_real dW[3], mb_real *c) {
   int nm = fx->nm;
