@@ -230,12 +230,24 @@ static void emit_tables(FILE *f, const lmodel *L) {
   }
 }
 
+/* a node whose mode shapes all vanish there (the reference node of the body
+ * frame, or Craig-Bampton interface nodes held by it): its marker is a rigid
+ * marker at the node's position, the same numbers without the modal sums,
+ * the rotation exponential and the zero modal columns (known at compile time) */
+static int node_static(const mb_body *B, int node) {
+  const mb_flex *fx = B->flex;
+  if (!fx || node < 0) return 0;
+  for (int i = 0; i < 3 * fx->nm; i++)
+    if (fx->node_X[3 * node * fx->nm + i] != 0 || fx->node_Psi[3 * node * fx->nm + i] != 0) return 0;
+  return 1;
+}
+
 /* c = the body columns of (dV, dW) at marker k; returns how many (6 or 6 + nm) */
 static int emit_cols(FILE *f, const lmodel *L, int k, const char *P, const char *dV, const char *dW,
                      const char *indent) {
   const mb_markerdef *d = &L->marker[k];
   const mb_body *B = &L->body[d->body];
-  if (d->node >= 0) {
+  if (d->node >= 0 && !node_static(B, d->node)) {
     fprintf(f, "%smb_node_cols_mk(&f[%d], &flex%d, %d, &k[%d], %s, %s, c);\n", indent, d->body,
             d->body, d->node, k, dV, dW);
     return 6 + B->nm;
@@ -422,6 +434,14 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
     fprintf(f, "  /* %s */\n", L->marker_desc[k]);
     if (d->body < 0) {
       fprintf(f, "  mb_marker_ground(markers[%d].s, markers[%d].C, &k[%d]);\n", k, k, k);
+    } else if (d->node >= 0 && node_static(&L->body[d->body], d->node)) {
+      const mb_flex *fx = L->body[d->body].flex;
+      fprintf(f, "  /* node %d: its mode shapes vanish: a rigid marker */\n", d->node);
+      fprintf(f, "  mb_marker_rigid(&f[%d], (const mb_real[3])", d->body);
+      vec(f, fx->node_x + 3 * d->node, 3);
+      fputs(",\n      (const mb_real[9])", f);
+      vec(f, d->C, 9);
+      fprintf(f, ", &k[%d]);\n", k);
     } else if (d->node >= 0) {
       const mb_body *B = &L->body[d->body];
       fprintf(f, "  mb_marker_node(&f[%d], &flex%d, %d, q + %d, v + %d, (const mb_real[9])", d->body,
@@ -577,10 +597,11 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
         if (R->slot[s][j] >= 0 && !R->constant[s][j])
           fprintf(f, "  Kx[%d] = Kx[%d] = c[%d];\n", R->slot[s][j], R->slotT[s][j], j);
       if (R->mslot[s] >= 0) {
-        int nmb = L->body[b].nm;
+        int nmb = L->body[b].nm, stat = node_static(&L->body[b], L->marker[mk].node);
         const int *ms = L->modal_slot + R->mslot[s];
         for (int j = 0; j < nmb; j++)
-          if (ms[j] >= 0) fprintf(f, "  Kx[%d] = Kx[%d] = c[%d];\n", ms[j], ms[nmb + j], 6 + j);
+          if (ms[j] >= 0 && stat) fprintf(f, "  Kx[%d] = Kx[%d] = 0;\n", ms[j], ms[nmb + j]);
+          else if (ms[j] >= 0) fprintf(f, "  Kx[%d] = Kx[%d] = c[%d];\n", ms[j], ms[nmb + j], 6 + j);
       }
     }
   }

@@ -63,11 +63,40 @@ static void real_array(FILE *f, const char *name, const double *x, long n) {
 /* the block pivots' workspace: Du^-1 (36, then 6 unused), W = Eu Du^-1 (6 per S row) */
 static long block_work(const ldl_plan *p, int e) { return 42L + 6L * (p->esp[e + 1] - p->esp[e]); }
 
-static long work_size(const ldl_plan *p) {
+/* the massless bodies' workspace: pi (r), Du^-1 (36), W = D_SU Du^-1 (6 per slot) */
+static long ml_work(const ldl_plan *p, int e) {
+  long r = p->mlrp[e + 1] - p->mlrp[e];
+  return r + 36 + 6 * (r - 6);
+}
+
+/* largest r and r x ny over the massless bodies (their scratch) */
+static void ml_max(const ldl_plan *p, int *rmax, long *dmax) {
+  *rmax = 6;
+  *dmax = 1;
+  for (int e = 0; e < p->nml; e++) {
+    int r = p->mlrp[e + 1] - p->mlrp[e];
+    long d = (long)r * (p->mlyp[e + 1] - p->mlyp[e]);
+    if (r > *rmax) *rmax = r;
+    if (d > *dmax) *dmax = d;
+  }
+}
+
+/* offset of the massless bodies' part of the workspace: K1, r1, D scratch, blocks */
+static long ml_base(const ldl_plan *p) {
   long w = p->nnzL + 5L * p->n + 1;
-  if (p->nelim) {
-    w += p->nnzR + 2L * p->n;
-    for (int e = 0; e < p->nelim; e++) w += block_work(p, e);
+  if (p->nelim || p->nml) w += p->nnzR + 2L * p->n;
+  for (int e = 0; e < p->nelim; e++) w += block_work(p, e);
+  return w;
+}
+
+static long work_size(const ldl_plan *p) {
+  long w = ml_base(p);
+  if (p->nml) {
+    int rmax;
+    long dmax;
+    ml_max(p, &rmax, &dmax);
+    w += p->nnz1 + p->n + dmax;
+    for (int e = 0; e < p->nml; e++) w += ml_work(p, e);
   }
   return w;
 }
@@ -171,60 +200,74 @@ static void emit_knorm(FILE *f, const lmodel *L, const ldl_plan *p) {
 static void emit_factor_straight(FILE *f, const lmodel *L, const ldl_plan *p, const char *nm) {
   int n = p->n;
   char name[512];
-  /* has the L slot been written in this factorization yet (else: fill, first
-   * update becomes an assignment) */
-  char *written = calloc((size_t)p->nnzL + 1, 1);
-  int *slot_of = malloc(sizeof(int) * (size_t)(n + 1)); /* row k: column j -> Lx position */
-  if (!written || !slot_of) { free(written); free(slot_of); return; }
-  for (int j = 0; j < n; j++) slot_of[j] = -1;
+  /* row k of L is formed in dot-product form: for j in the row (ascending)
+   *   y_j = K_aug(j, k) - sum_{i in row k, i < j} L(j, i) y_i,  L(k, j) = y_j / d_j,
+   *   d_k = K_aug(k, k) - sum_j L(k, j) y_j,
+   * each y_j one expression over earlier values kept in locals: no
+   * read-modify-write chains through memory, and the same flops as the
+   * column (axpy) form */
+  int *inrow = malloc(sizeof(int) * (size_t)(n + 1)); /* column j in row k: 1 */
+  int *kent = malloc(sizeof(int) * (size_t)(n + 1));  /* row i of column k of K_aug: entry e */
+  if (!inrow || !kent) { free(inrow); free(kent); return; }
+  for (int j = 0; j < n; j++) inrow[j] = 0, kent[j] = -1;
   int nchunk = 0;
   double chunk_flops = 0;
   for (int k = 0; k < n; k++) {
     if (k == 0 || chunk_flops > LDL_CHUNK_FLOPS) {
-      if (k) fputs("  (void)t;\n  (void)l;\n  return 0;\n}\n\n", f);
-      fprintf(f, "static LDL_NOINLINE int ldl_factor_part%d(const mb_real *Kx,%s mb_real *Lx, mb_real *Dinv) {\n",
-              nchunk++, p->nelim ? " const mb_real *Kc," : "");
-      fprintf(f, "  mb_real d, s, t = 0, l = 0;\n  (void)Kx;\n%s  (void)Lx;\n", p->nelim ? "  (void)Kc;\n" : "");
+      if (k) fputs("  return 0;\n}\n\n", f);
+      fprintf(f, "static LDL_NOINLINE int ldl_factor_part%d(const mb_real *restrict Kx,%s mb_real *restrict Lx, "
+                 "mb_real *restrict Dinv) {\n",
+              nchunk++, p->nelim ? " const mb_real *restrict Kc," : "");
+      fprintf(f, "  (void)Kx;\n%s  (void)Lx;\n", p->nelim ? "  (void)Kc;\n" : "");
       chunk_flops = 0;
     }
     int u = p->perm[k];
     ldl_unknown_name(L, u, name, sizeof name);
     fprintf(f, "  /* pivot %d: unknown %d, %s; row %d of L: %d entries */\n", k, u, name, k,
             p->Rp[k + 1] - p->Rp[k]);
-    for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) slot_of[p->Rj[r]] = p->Rpos[r];
-    /* column k of the upper triangle of K_aug into row k of L (then y) */
+    for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) inrow[p->Rj[r]] = 1;
     int diag = -1;
     for (int e = p->Up[k]; e < p->Up[k + 1]; e++) {
-      int i = p->Ui[e];
-      if (i == k) { diag = e; continue; }
-      fprintf(f, "  Lx[%d] = ", slot_of[i]);
-      aug_value(f, p, e);
-      fputs(";\n", f);
-      written[slot_of[i]] = 1;
+      if (p->Ui[e] == k) diag = e;
+      else kent[p->Ui[e]] = e;
     }
-    fputs("  d = ", f);
+    fputs("  {\n", f);
+    if (p->Rp[k + 1] > p->Rp[k]) {
+      fputs("    mb_real", f);
+      for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) fprintf(f, "%s y%d", r > p->Rp[k] ? "," : "", p->Rj[r]);
+      fputs(";\n", f);
+    }
+    fputs("    mb_real d, s;\n", f);
+    for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) {
+      int j = p->Rj[r], any = 0;
+      fprintf(f, "    y%d = ", j);
+      if (kent[j] >= 0) { aug_value(f, p, kent[j]); any = 1; }
+      for (int rr = p->Rp[j]; rr < p->Rp[j + 1]; rr++)
+        if (inrow[p->Rj[rr]]) {
+          fprintf(f, "%sLx[%d] * y%d", any ? " - " : "-", p->Rpos[rr], p->Rj[rr]);
+          any = 1;
+        }
+      if (!any) fputs("0", f);
+      fprintf(f, ";\n    Lx[%d] = y%d * Dinv[%d];\n", p->Rpos[r], j, j);
+      chunk_flops += 2.0 * (p->Rpos[r] - p->Lp[j]) + 3;
+    }
+    fputs("    d = ", f);
     if (diag >= 0) aug_value(f, p, diag);
     else fputs("0", f);
-    fputs(";\n  s = fabs(d);\n", f);
-    /* y_j for j ascending: update the later entries of the row, scale, pivot */
+    fputs(";\n    s = fabs(d);\n", f);
     for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) {
-      int j = p->Rj[r], pkj = p->Rpos[r];
-      fprintf(f, "  t = Lx[%d];", pkj);
-      for (int q = p->Lp[j]; q < pkj; q++) {
-        int i = p->Li[q], pki = slot_of[i];
-        if (written[pki]) fprintf(f, " Lx[%d] -= Lx[%d] * t;", pki, q);
-        else { fprintf(f, " Lx[%d] = -(Lx[%d] * t);", pki, q); written[pki] = 1; }
-      }
-      fprintf(f, " l = Lx[%d] = t * Dinv[%d]; d -= l * t; s += fabs(l * t);\n", pkj, j);
-      chunk_flops += 2.0 * (pkj - p->Lp[j]) + 3;
+      int j = p->Rj[r];
+      fprintf(f, "    d -= Lx[%d] * y%d;\n    s += fabs(Lx[%d] * y%d);\n", p->Rpos[r], j, p->Rpos[r], j);
     }
-    fprintf(f, "  if (!(fabs(d) > LDL_PIVTOL * s) || !isfinite(s)) return %d;\n", u + 1);
-    fprintf(f, "  Dinv[%d] = 1 / d;\n", k);
+    fprintf(f, "    if (!(fabs(d) > LDL_PIVTOL * s) || !isfinite(s)) return %d;\n", u + 1);
+    fprintf(f, "    Dinv[%d] = 1 / d;\n  }\n", k);
     chunk_flops += 1 + (p->Up[k + 1] - p->Up[k]);
-    for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) slot_of[p->Rj[r]] = -1;
+    for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) inrow[p->Rj[r]] = 0;
+    for (int e = p->Up[k]; e < p->Up[k + 1]; e++) kent[p->Ui[e]] = -1;
   }
-  if (n) fputs("  (void)t;\n  (void)l;\n  return 0;\n}\n\n", f);
-  (void)L;
+  free(inrow);
+  free(kent);
+  if (n) fputs("  return 0;\n}\n\n", f);
   (void)nm;
   fputs("/* L D L^T of K_aug, whose entries come from Kx (K, or K' after the block pivots) */\n", f);
   fprintf(f, "static int ldl_factor_aug(const mb_real *Kx,%s mb_real *work) {\n", p->nelim ? " const mb_real *Kc," : "");
@@ -233,8 +276,6 @@ static void emit_factor_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
   for (int c = 0; c < nchunk; c++)
     fprintf(f, "  if ((rc = ldl_factor_part%d(Kx,%s Lx, Dinv)) != 0) return rc;\n", c, p->nelim ? " Kc," : "");
   fputs("  (void)Lx;\n  (void)Dinv;\n  (void)rc;\n  return 0;\n}\n\n", f);
-  free(written);
-  free(slot_of);
 }
 
 static void emit_factor_looped(FILE *f, const lmodel *L, const ldl_plan *p, const char *nm) {
@@ -265,8 +306,11 @@ static void emit_factor_looped(FILE *f, const lmodel *L, const ldl_plan *p, cons
 
 /* ----------------------------------------------------------- block pivots */
 
-/* ldl_inv6 of the generated code */
+/* ldl_inv6 of the generated code (once per file) */
+static int inv6_emitted;
 static void emit_inv6(FILE *f) {
+  if (inv6_emitted) return;
+  inv6_emitted = 1;
   fputs("\n/* X = A^-1 for a 6 x 6 A (row-major: rows the weld rows, columns the body's\n"
         " * unknowns), Gauss-Jordan with partial pivoting; 1 if a pivot is below 1e-12\n"
         " * of the largest entry.  D_u is a rotation and the identity up to signs, so\n"
@@ -561,16 +605,182 @@ static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
         "      d[B->u[c]] = a;\n      d[B->r[c]] = l;\n    }\n  }\n}\n\n", f);
 }
 
+
+/* ------------------------------------------------------- massless bodies */
+
+/* stage 1: the massless bodies that are not welded (see order.h): tables,
+ * the elimination, its right side and the recovery of their unknowns */
+static void emit_massless(FILE *f, const lmodel *L, const ldl_plan *p) {
+  const mb_model *m = &L->m;
+  char nmx[64], name[512];
+  int rmax;
+  long dmax;
+  ml_max(p, &rmax, &dmax);
+  long w = ml_base(p) + p->nnz1 + p->n + dmax;
+  fputs("/* massless bodies: each virtual body that is not welded (a massless slider) is\n"
+        " * eliminated with 6 of its r rows R, chosen at run time by partial pivoting on\n"
+        " * D_RU (P, Du = D_PU); the other r - 6 (S, W = D_SU Du^-1) become new rows\n"
+        " *   K1(t_i, y) = D(s_i, y) - (W D_PY)(i, y)\n"
+        " * in the compile-time slots t_i (rows of R), whatever the choice; U and the other\n"
+        " * rows of R are decoupled (diagonals 1 and -1).  K1 is then factorized as K\n"
+        " * would be; see docs/formulation.md. */\n", f);
+  fprintf(f, "#define LDL_K1 %ld\n#define LDL_R1 (LDL_K1 + %d)\n#define LDL_MLD (LDL_R1 + LDL_N)\n#define LDL_MLR %d\n",
+          ml_base(p), p->nnz1, rmax);
+  fputs("typedef struct {\n"
+        "  int r, ny;        /* rows R, columns Y */\n"
+        "  int k;            /* first (slot, y) pair in its K1 positions */\n"
+        "  long w;           /* workspace: pi (r), Du^-1 (36), W (6 per slot) */\n"
+        "  const int *u, *R, *T, *Y; /* its columns, rows, slots, the rows' other columns */\n"
+        "  const int *du, *dy;       /* Kx slots (-1: zero) of D_RU (6 per row), D_RY (ny per row) */\n"
+        "  const int *k1;            /* K1 positions of (t, y), (y, t): 2 per pair, slot-major */\n"
+        "} ldl_mlb;\n", f);
+  for (int e = 0; e < p->nml; e++) {
+    int r0 = p->mlrp[e], r = p->mlrp[e + 1] - r0, y0 = p->mlyp[e], ny = p->mlyp[e + 1] - y0;
+    fprintf(f, "/* massless body %d: '%s' (unknowns %d..%d), %d rows:", e, m->body[p->mlb[e]].name,
+            p->mlu[e][0], p->mlu[e][5], r);
+    for (int k = 0; k < r; k++) {
+      ldl_unknown_name(L, p->mlR[r0 + k], name, sizeof name);
+      fprintf(f, "\n *   %s", name);
+    }
+    fprintf(f, "\n * Y: %d columns */\n", ny);
+    snprintf(nmx, sizeof nmx, "ldl_ml%d_u", e); int_array(f, nmx, p->mlu[e], 6);
+    snprintf(nmx, sizeof nmx, "ldl_ml%d_R", e); int_array(f, nmx, p->mlR + r0, r);
+    snprintf(nmx, sizeof nmx, "ldl_ml%d_T", e); int_array(f, nmx, p->mlT + r0 - 6 * e, r - 6);
+    snprintf(nmx, sizeof nmx, "ldl_ml%d_Y", e); int_array(f, nmx, p->mlY + y0, ny);
+    snprintf(nmx, sizeof nmx, "ldl_ml%d_du", e); int_array(f, nmx, p->mldu + 6 * r0, 6L * r);
+    snprintf(nmx, sizeof nmx, "ldl_ml%d_dy", e); int_array(f, nmx, p->mldy + p->mldyp[e], (long)r * ny);
+    snprintf(nmx, sizeof nmx, "ldl_ml%d_k1", e);
+    int_array(f, nmx, p->mlk + 2 * p->mlkp[e], 2L * (p->mlkp[e + 1] - p->mlkp[e]));
+  }
+  fprintf(f, "#define LDL_NML %d\nstatic const ldl_mlb ldl_ml[LDL_NML] = {\n", p->nml);
+  for (int e = 0; e < p->nml; e++) {
+    fprintf(f, "  {%d, %d, %d, %ldL, ldl_ml%d_u, ldl_ml%d_R, ldl_ml%d_T, ldl_ml%d_Y, ldl_ml%d_du, ldl_ml%d_dy, ldl_ml%d_k1},\n",
+            p->mlrp[e + 1] - p->mlrp[e], p->mlyp[e + 1] - p->mlyp[e], p->mlkp[e], w, e, e, e, e, e, e, e);
+    w += ml_work(p, e);
+  }
+  fputs("};\n", f);
+  fputs("/* K1 from Kx: a Kx slot, or -1: 0, -2: 1 (eliminated column), -3: -1 (decoupled row),\n"
+        " * -4: computed below */\n", f);
+  fprintf(f, "#define LDL_NK1 %d\n", p->nnz1);
+  int_array(f, "ldl_K1src", p->K1map, p->nnz1);
+  emit_inv6(f);
+  fputs("/* K1 (work + LDL_K1) from Kx; returns 0, or 1 + a column of a massless body whose\n"
+        " * rows have lost rank 6 on it */\n"
+        "static int ldl_massless(const mb_real *Kx, mb_real *work) {\n"
+        "  mb_real *K1 = work + LDL_K1, *D = work + LDL_MLD;\n"
+        "  for (int q = 0; q < LDL_NK1; q++) {\n"
+        "    int s = ldl_K1src[q];\n"
+        "    K1[q] = s >= 0 ? Kx[s] : s == -2 ? 1 : s == -3 ? -1 : 0;\n  }\n"
+        "  for (int e = 0; e < LDL_NML; e++) {\n"
+        "    const ldl_mlb *B = &ldl_ml[e];\n"
+        "    int r = B->r, ny = B->ny, pi[LDL_MLR];\n"
+        "    mb_real A[6 * LDL_MLR], G[6 * LDL_MLR], Du[36], amax = 0;\n"
+        "    mb_real *ws = work + B->w, *Di = ws + r, *W = Di + 36;\n"
+        "    for (int i = 0; i < 6 * r; i++) {\n"
+        "      A[i] = G[i] = B->du[i] >= 0 ? Kx[B->du[i]] : 0;\n"
+        "      if (fabs(A[i]) > amax) amax = fabs(A[i]);\n    }\n"
+        "    for (int i = 0; i < r * ny; i++) D[i] = B->dy[i] >= 0 ? Kx[B->dy[i]] : 0;\n"
+        "    /* P: partial pivoting on D_RU chooses 6 independent rows */\n"
+        "    for (int i = 0; i < r; i++) pi[i] = i;\n"
+        "    for (int k = 0; k < 6; k++) {\n"
+        "      int pr = k;\n"
+        "      for (int i = k + 1; i < r; i++) if (fabs(G[6 * i + k]) > fabs(G[6 * pr + k])) pr = i;\n"
+        "      if (!(fabs(G[6 * pr + k]) > 1e-12 * amax)) return 1 + B->u[0];\n"
+        "      if (pr != k) {\n"
+        "        int t = pi[k]; pi[k] = pi[pr]; pi[pr] = t;\n"
+        "        for (int j = 0; j < 6; j++) { mb_real g = G[6 * k + j]; G[6 * k + j] = G[6 * pr + j]; G[6 * pr + j] = g; }\n"
+        "      }\n"
+        "      for (int i = k + 1; i < r; i++) {\n"
+        "        mb_real l = G[6 * i + k] / G[6 * k + k];\n"
+        "        for (int j = k; j < 6; j++) G[6 * i + j] -= l * G[6 * k + j];\n      }\n    }\n"
+        "    for (int i = 0; i < r; i++) ws[i] = (mb_real)pi[i];\n"
+        "    for (int i = 0; i < 6; i++)\n"
+        "      for (int c = 0; c < 6; c++) Du[6 * i + c] = A[6 * pi[i] + c];\n"
+        "    if (ldl_inv6(Du, Di)) return 1 + B->u[0];\n"
+        "    /* slot i: row pi[6 + i] less W times the P rows */\n"
+        "    for (int i = 0; i < r - 6; i++) {\n"
+        "      const mb_real *a = A + 6 * pi[6 + i];\n"
+        "      const int *k1 = B->k1 + 2 * ny * i;\n"
+        "      for (int c = 0; c < 6; c++) {\n"
+        "        mb_real v = 0;\n"
+        "        for (int k = 0; k < 6; k++) v += a[k] * Di[6 * k + c];\n"
+        "        W[6 * i + c] = v;\n      }\n"
+        "      for (int y = 0; y < ny; y++) {\n"
+        "        mb_real v = D[ny * pi[6 + i] + y];\n"
+        "        for (int c = 0; c < 6; c++) v -= W[6 * i + c] * D[ny * pi[c] + y];\n"
+        "        K1[k1[2 * y]] = K1[k1[2 * y + 1]] = v;\n      }\n    }\n  }\n  return 0;\n}\n\n", f);
+  fputs("/* r1 = the right side of K1 from r: g1_t = g_s - W g_p, f1_y = f_y - D_PY^T Du^-T f_u */\n"
+        "static void ldl_ml_rhs(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *r1) {\n"
+        "  for (int i = 0; i < LDL_N; i++) r1[i] = r[i];\n"
+        "  for (int e = 0; e < LDL_NML; e++) {\n"
+        "    const ldl_mlb *B = &ldl_ml[e];\n"
+        "    const mb_real *ws = work + B->w, *Di = ws + B->r, *W = Di + 36;\n"
+        "    int nr = B->r, ny = B->ny, pi[LDL_MLR];\n"
+        "    mb_real z[6];\n"
+        "    for (int i = 0; i < nr; i++) { pi[i] = (int)ws[i]; r1[B->R[i]] = 0; }\n"
+        "    for (int i = 0; i < nr - 6; i++) {\n"
+        "      mb_real v = r[B->R[pi[6 + i]]];\n"
+        "      for (int c = 0; c < 6; c++) v -= W[6 * i + c] * r[B->R[pi[c]]];\n"
+        "      r1[B->T[i]] = v;\n    }\n"
+        "    for (int c = 0; c < 6; c++) {\n"
+        "      z[c] = 0;\n"
+        "      for (int k = 0; k < 6; k++) z[c] += Di[6 * k + c] * r[B->u[k]];\n    }\n"
+        "    for (int y = 0; y < ny; y++) {\n"
+        "      mb_real v = 0;\n"
+        "      for (int c = 0; c < 6; c++) {\n"
+        "        int s = B->dy[ny * pi[c] + y];\n"
+        "        if (s >= 0) v += Kx[s] * z[c];\n      }\n"
+        "      r1[B->Y[y]] -= v;\n    }\n"
+        "    for (int c = 0; c < 6; c++) r1[B->u[c]] = 0;\n  }\n}\n\n", f);
+  fputs("/* d (the solution of K1) into the solution of K: a_u = Du^-1 (g_p - D_PY a_y),\n"
+        " * lambda_s = mu, lambda_p = Du^-T (f_u - D_SU^T mu) */\n"
+        "static void ldl_ml_back(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *d) {\n"
+        "  for (int e = 0; e < LDL_NML; e++) {\n"
+        "    const ldl_mlb *B = &ldl_ml[e];\n"
+        "    const mb_real *ws = work + B->w, *Di = ws + B->r;\n"
+        "    int nr = B->r, ny = B->ny, pi[LDL_MLR];\n"
+        "    mb_real mu[LDL_MLR], y[6], z[6];\n"
+        "    for (int i = 0; i < nr; i++) pi[i] = (int)ws[i];\n"
+        "    for (int i = 0; i < nr - 6; i++) mu[i] = d[B->T[i]];\n"
+        "    for (int c = 0; c < 6; c++) {\n"
+        "      mb_real v = r[B->R[pi[c]]];\n"
+        "      for (int t = 0; t < ny; t++) {\n"
+        "        int s = B->dy[ny * pi[c] + t];\n"
+        "        if (s >= 0) v -= Kx[s] * d[B->Y[t]];\n      }\n"
+        "      y[c] = v;\n    }\n"
+        "    for (int k = 0; k < 6; k++) {\n"
+        "      mb_real v = r[B->u[k]];\n"
+        "      for (int i = 0; i < nr - 6; i++) {\n"
+        "        int s = B->du[6 * pi[6 + i] + k];\n"
+        "        if (s >= 0) v -= Kx[s] * mu[i];\n      }\n"
+        "      z[k] = v;\n    }\n"
+        "    for (int k = 0; k < 6; k++) {\n"
+        "      mb_real a = 0;\n"
+        "      for (int c = 0; c < 6; c++) a += Di[6 * k + c] * y[c];\n"
+        "      d[B->u[k]] = a;\n    }\n"
+        "    for (int c = 0; c < 6; c++) {\n"
+        "      mb_real l = 0;\n"
+        "      for (int k = 0; k < 6; k++) l += Di[6 * k + c] * z[k];\n"
+        "      d[B->R[pi[c]]] = l;\n    }\n"
+        "    for (int i = 0; i < nr - 6; i++) d[B->R[pi[6 + i]]] = mu[i];\n  }\n}\n\n", f);
+}
+
 /* the public factorization: ||K||, the block pivots, then L D L^T of K_aug */
 static void emit_factor_entry(FILE *f, const lmodel *L, const ldl_plan *p, const char *nm) {
   fprintf(f, "int %s_ldl_factor(const mb_real *Kx, mb_real *work) {\n", nm);
   emit_knorm(f, L, p);
+  /* Kp: the matrix the rest works on (K, or K1 after the massless bodies) */
+  if (p->nml)
+    fputs("  int rc1 = ldl_massless(Kx, work);\n  if (rc1) return rc1;\n"
+          "  const mb_real *Kp = work + LDL_K1;\n", f);
+  else
+    fputs("  const mb_real *Kp = Kx;\n", f);
   if (p->nelim) {
-    fputs("  int rc = ldl_block_pivots(Kx, work);\n  if (rc) return rc;\n", f);
-    fputs(p->straight ? "  return ldl_factor_aug(Kx, work + LDL_KR, work);\n}\n\n"
+    fputs("  int rc = ldl_block_pivots(Kp, work);\n  if (rc) return rc;\n", f);
+    fputs(p->straight ? "  return ldl_factor_aug(Kp, work + LDL_KR, work);\n}\n\n"
                       : "  return ldl_factor_aug(work + LDL_KR, work);\n}\n\n", f);
   } else {
-    fputs("  return ldl_factor_aug(Kx, work);\n}\n\n", f);
+    fputs("  return ldl_factor_aug(Kp, work);\n}\n\n", f);
   }
 }
 
@@ -603,7 +813,7 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
   fputs("}\n\n", f);
 
   fputs("/* t <- (L D L^T)^-1 t */\n", f);
-  fputs("static void ldl_lsolve(const mb_real *Lx, const mb_real *Dinv, mb_real *t) {\n", f);
+  fputs("static void ldl_lsolve(const mb_real *restrict Lx, const mb_real *restrict Dinv, mb_real *restrict t) {\n", f);
   fputs("  /* forward: L y = t */\n", f);
   for (int j = 0; j < n; j++)
     for (int q = p->Lp[j]; q < p->Lp[j + 1]; q++)
@@ -621,7 +831,7 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
   if (p->nnzL == 0) fputs("  (void)Lx;\n", f);
   fputs("}\n\n", f);
 
-  if (p->nelim) {
+  if (p->nelim || p->nml) {
     fputs("/* x = P^T t */\n", f);
     fputs("static void ldl_scatter(const mb_real *t, mb_real *x) {\n", f);
     for (int k = 0; k < n; k++) fprintf(f, "  x[%d] = t[%d];\n", p->perm[k], k);
@@ -676,7 +886,7 @@ static void emit_solve_helpers_looped(FILE *f, const ldl_plan *p) {
         "    mb_real s = t[j];\n"
         "    for (int q = ldl_Lp[j]; q < ldl_Lp[j + 1]; q++) s -= Lx[q] * t[ldl_Li[q]];\n"
         "    t[j] = s;\n  }\n}\n\n", f);
-  if (p->nelim)
+  if (p->nelim || p->nml)
     fputs("/* x = P^T t */\n"
           "static void ldl_scatter(const mb_real *t, mb_real *x) {\n"
           "  for (int k = 0; k < LDL_N; k++) x[ldl_perm[k]] = t[k];\n}\n\n", f);
@@ -693,17 +903,38 @@ static void emit_solve_helpers_looped(FILE *f, const ldl_plan *p) {
 }
 
 static void emit_solve(FILE *f, const ldl_plan *p, const char *nm) {
+  int staged = p->nelim || p->nml;
   fprintf(f, "int %s_ldl_solve(const mb_real *Kx, mb_real *work, mb_real *b, mb_real *residual) {\n", nm);
-  fprintf(f, "  const mb_real *Lx = work, *Dinv = work + LDL_DINV;\n"
-        "  mb_real *x = work + LDL_X, *r = work + LDL_R, *t = work + LDL_T, *xb = work + LDL_XB;\n%s"
-        "  mb_real knorm = work[LDL_KNORM], bn = 0, best = 0;\n"
+  fputs("  const mb_real *Lx = work, *Dinv = work + LDL_DINV;\n"
+        "  mb_real *x = work + LDL_X, *r = work + LDL_R, *t = work + LDL_T, *xb = work + LDL_XB;\n", f);
+  if (p->nelim) fputs("  mb_real *rr = work + LDL_RR;\n", f);
+  if (staged) fputs("  mb_real *d = work + LDL_DD;\n", f);
+  if (p->nml) fputs("  mb_real *r1 = work + LDL_R1;\n  const mb_real *Kp = work + LDL_K1;\n", f);
+  else fputs("  const mb_real *Kp = Kx, *r1 = r;\n", f);
+  fputs("  mb_real knorm = work[LDL_KNORM], bn = 0, best = 0;\n"
         "  for (int i = 0; i < LDL_N; i++) {\n"
         "    x[i] = 0;\n    r[i] = b[i];\n    if (fabs(b[i]) > bn) bn = fabs(b[i]);\n  }\n"
         "  /* pass 0: the solve; pass 1: refinement; pass 2: a second one if still above 1e-12 */\n"
         "  for (int it = 0; it < 3; it++) {\n"
-        "    mb_real rn = 0, xn = 0, den, rel;\n"
-        "%s"
-        "    ldl_residual(Kx, x, b, r);\n"
+        "    mb_real rn = 0, xn = 0, den, rel;\n", f);
+  if (p->nml) fputs("    ldl_ml_rhs(Kx, work, r, r1); /* the massless bodies' right side: K1 */\n", f);
+  const char *kc = p->straight ? " work + LDL_KR," : "";
+  if (p->nelim) {
+    fputs("    ldl_block_rhs(Kp, work, r1, rr); /* the block pivots' right side: K' */\n", f);
+    fprintf(f, "    ldl_aug(%s,%s rr, t);\n", p->straight ? "Kp" : "work + LDL_KR", kc);
+  } else {
+    fputs("    ldl_aug(Kp, r1, t);\n", f);
+  }
+  fputs("    ldl_lsolve(Lx, Dinv, t);\n", f);
+  if (staged) {
+    fputs("    ldl_scatter(t, d);\n", f);
+    if (p->nelim) fputs("    ldl_block_back(Kp, work, r1, d); /* the block pivots' unknowns */\n", f);
+    if (p->nml) fputs("    ldl_ml_back(Kx, work, r, d); /* the massless bodies' unknowns */\n", f);
+    fputs("    for (int i = 0; i < LDL_N; i++) x[i] += d[i];\n", f);
+  } else {
+    fputs("    ldl_scatter_add(t, x);\n", f);
+  }
+  fputs("    ldl_residual(Kx, x, b, r);\n"
         "    for (int i = 0; i < LDL_N; i++) {\n"
         "      if (!(fabs(r[i]) <= rn)) rn = fabs(r[i]);\n"
         "      if (!(fabs(x[i]) <= xn)) xn = fabs(x[i]);\n    }\n"
@@ -717,25 +948,8 @@ static void emit_solve(FILE *f, const ldl_plan *p, const char *nm) {
         "  if (best <= LDL_REFINE_TOL) for (int i = 0; i < LDL_N; i++) b[i] = x[i];\n"
         "  else for (int i = 0; i < LDL_N; i++) b[i] = xb[i];\n"
         "  if (residual) *residual = best;\n"
-        "  return isfinite(best) ? MB_OK : MB_ERR_NONFINITE;\n}\n\n",
-        p->nelim ? "  mb_real *rr = work + LDL_RR, *d = work + LDL_DD;\n" : "",
-        p->nelim ? (p->straight ? "    /* the block pivots' right side, K_aug of K', their unknowns back, x += d */\n"
-                                  "    ldl_block_rhs(Kx, work, r, rr);\n"
-                                  "    ldl_aug(Kx, work + LDL_KR, rr, t);\n"
-                                  "    ldl_lsolve(Lx, Dinv, t);\n"
-                                  "    ldl_scatter(t, d);\n"
-                                  "    ldl_block_back(Kx, work, r, d);\n"
-                                  "    for (int i = 0; i < LDL_N; i++) x[i] += d[i];\n"
-                                : "    /* the block pivots' right side, K_aug of K', their unknowns back, x += d */\n"
-                                  "    ldl_block_rhs(Kx, work, r, rr);\n"
-                                  "    ldl_aug(work + LDL_KR, rr, t);\n"
-                                  "    ldl_lsolve(Lx, Dinv, t);\n"
-                                  "    ldl_scatter(t, d);\n"
-                                  "    ldl_block_back(Kx, work, r, d);\n"
-                                  "    for (int i = 0; i < LDL_N; i++) x[i] += d[i];\n")
-                 : "    ldl_aug(Kx, r, t);\n"
-                   "    ldl_lsolve(Lx, Dinv, t);\n"
-                   "    ldl_scatter_add(t, x);\n");
+        "  (void)Kp;\n  (void)r1;\n"
+        "  return isfinite(best) ? MB_OK : MB_ERR_NONFINITE;\n}\n\n", f);
 }
 
 int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
@@ -832,6 +1046,8 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
     fputc('\n', f);
   }
   int *kc = NULL;
+  inv6_emitted = 0;
+  if (p.nml) emit_massless(f, L, &p);
   if (p.nelim) {
     kc = malloc(sizeof(int) * (size_t)(p.nnzR + 1));
     if (!kc) { ldl_plan_free(&p); return 0; }

@@ -30,6 +30,9 @@ void ldl_plan_free(ldl_plan *p) {
   free(p->eb); free(p->eu); free(p->er); free(p->exp_); free(p->ex); free(p->esp); free(p->es);
   free(p->edu); free(p->edx); free(p->eeu); free(p->ekr); free(p->ekrp);
   free(p->Krp); free(p->Kri); free(p->Krmap);
+  free(p->mlb); free(p->mlu); free(p->mlrp); free(p->mlR); free(p->mlT); free(p->mlyp); free(p->mlY);
+  free(p->mldu); free(p->mldy); free(p->mldyp); free(p->mlk); free(p->mlkp);
+  free(p->K1p); free(p->K1i); free(p->K1map);
   memset(p, 0, sizeof *p);
 }
 
@@ -285,6 +288,295 @@ static int find_elims(const mb_model *m, const double *Kx, ldl_plan *p) {
       for (int c = 0; c < 6; c++) p->eeu[6 * si + c] = kslot(m, p->es[si], p->eu[e][c]);
   }
   free(massive); free(weld);
+  return 0;
+}
+
+/* ------------------------------------------------------- massless bodies */
+
+/* X = A^-1 (6 x 6, row-major), Gauss-Jordan with partial pivoting; -1 when a
+ * pivot is below 1e-12 of the largest entry (the emitted ldl_inv6) */
+static int inv6(const double *A0, double *X) {
+  double A[36], amax = 0;
+  for (int i = 0; i < 36; i++) { A[i] = A0[i]; X[i] = i % 7 == 0; amax = fmax(amax, fabs(A[i])); }
+  for (int k = 0; k < 6; k++) {
+    int pr = k;
+    for (int i = k + 1; i < 6; i++) if (fabs(A[6 * i + k]) > fabs(A[6 * pr + k])) pr = i;
+    if (!(fabs(A[6 * pr + k]) > 1e-12 * amax)) return -1;
+    if (pr != k)
+      for (int j = 0; j < 6; j++) {
+        double t = A[6 * k + j]; A[6 * k + j] = A[6 * pr + j]; A[6 * pr + j] = t;
+        t = X[6 * k + j]; X[6 * k + j] = X[6 * pr + j]; X[6 * pr + j] = t;
+      }
+    double d = 1 / A[6 * k + k];
+    for (int j = 0; j < 6; j++) { A[6 * k + j] *= d; X[6 * k + j] *= d; }
+    for (int i = 0; i < 6; i++) {
+      double l = A[6 * i + k];
+      if (i == k || l == 0) continue;
+      for (int j = 0; j < 6; j++) { A[6 * i + j] -= l * A[6 * k + j]; X[6 * i + j] -= l * X[6 * k + j]; }
+    }
+  }
+  return 0;
+}
+
+/* The elimination of one massless body (order.h), the same arithmetic as the
+ * emitted ldl_ml_factor: A = D_RU (r x 6, row-major), D = D_RY (r x ny).
+ * pi: the rows in pivot order (partial pivoting on A: the first 6 are P),
+ * Di = Du^-1 (row-major), W = D_SU Du^-1 ((r-6) x 6), V = D_SY - W D_PY.
+ * Returns -1 when D_RU has a pivot below 1e-12 of its largest entry. */
+static int ml_eliminate(const double *A, const double *D, int r, int ny, int *pi, double *Di,
+                        double *W, double *V) {
+  double *B = malloc(sizeof(double) * (size_t)(6 * r + 1)), amax = 0, Du[36];
+  int rc = -1;
+  if (!B) return -1;
+  for (int i = 0; i < 6 * r; i++) { B[i] = A[i]; amax = fmax(amax, fabs(A[i])); }
+  for (int i = 0; i < r; i++) pi[i] = i;
+  for (int k = 0; k < 6; k++) {
+    int pr = k;
+    for (int i = k + 1; i < r; i++)
+      if (fabs(B[6 * i + k]) > fabs(B[6 * pr + k])) pr = i;
+    if (!(fabs(B[6 * pr + k]) > 1e-12 * amax)) goto done;
+    if (pr != k) {
+      for (int j = 0; j < 6; j++) { double t = B[6 * k + j]; B[6 * k + j] = B[6 * pr + j]; B[6 * pr + j] = t; }
+      int t = pi[k]; pi[k] = pi[pr]; pi[pr] = t;
+    }
+    for (int i = k + 1; i < r; i++) {
+      double l = B[6 * i + k] / B[6 * k + k];
+      for (int j = k; j < 6; j++) B[6 * i + j] -= l * B[6 * k + j];
+    }
+  }
+  /* Di = Du^-1 (rows pi[0..5]), Gauss-Jordan with partial pivoting */
+  for (int i = 0; i < 6; i++)
+    for (int c = 0; c < 6; c++) Du[6 * i + c] = A[6 * pi[i] + c];
+  if (inv6(Du, Di)) goto done;
+  for (int i = 0; i < r - 6; i++) {
+    for (int c = 0; c < 6; c++) {
+      double w = 0;
+      for (int k = 0; k < 6; k++) w += A[6 * pi[6 + i] + k] * Di[6 * k + c];
+      W[6 * i + c] = w;
+    }
+    for (int y = 0; y < ny; y++) {
+      double v = D[ny * pi[6 + i] + y];
+      for (int c = 0; c < 6; c++) v -= W[6 * i + c] * D[ny * pi[c] + y];
+      V[ny * i + y] = v;
+    }
+  }
+  rc = 0;
+done:
+  free(B);
+  return rc;
+}
+
+/* the non-welded massless bodies to eliminate first (order.h); 0 or -1 */
+static int find_massless(const mb_model *m, const double *Kx, ldl_plan *p) {
+  int nv = m->nv, n = m->n, nb = m->nbody;
+  char *massive = calloc((size_t)nv + 1, 1), *used = calloc((size_t)n + 1, 1);
+  int *weld = NULL, *rows = malloc(sizeof(int) * (size_t)(n + 1)), *cols = malloc(sizeof(int) * (size_t)(n + 1));
+  const char *env = getenv("MBCC_LDL_MASSLESS");
+  int rc = -1;
+  if (!massive || !used || !rows || !cols) goto done;
+  for (int j = 0; j < nv; j++)
+    for (int q = m->Kp[j]; q < m->Kp[j + 1]; q++)
+      if (m->Ki[q] < nv && Kx[q] != 0) massive[j] = 1;
+  weld = welded_rows(m, massive);
+  p->mlb = malloc(sizeof(int) * (size_t)(nb + 1));
+  p->mlu = malloc(sizeof *p->mlu * (size_t)(nb + 1));
+  p->mlrp = calloc((size_t)nb + 2, sizeof(int));
+  p->mlyp = calloc((size_t)nb + 2, sizeof(int));
+  p->mldyp = calloc((size_t)nb + 2, sizeof(int));
+  p->mlR = malloc(sizeof(int) * (size_t)(m->nc + 1));
+  p->mlT = malloc(sizeof(int) * (size_t)(m->nc + 1));
+  p->mlY = malloc(sizeof(int) * (size_t)(nb * 0 + nv * (nb + 1) + 1));
+  if (!weld || !p->mlb || !p->mlu || !p->mlrp || !p->mlyp || !p->mldyp || !p->mlR || !p->mlT || !p->mlY) goto done;
+  int ne = 0, nr = 0, ny = 0, nt = 0;
+  for (int b = 0; b < nb && !(env && !strcmp(env, "0")); b++) {
+    const mb_body *B = &m->body[b];
+    if (B->kind != MB_BODY_VIRTUAL || weld[b] == 6) continue;
+    int ok = 1, r = 0, y = 0;
+    for (int c = 0; c < 6; c++) ok &= !massive[B->vadr + c] && !used[B->vadr + c];
+    /* R: the rows on U; U may hold no other entries */
+    for (int c = 0; c < 6 && ok; c++)
+      for (int q = m->Kp[B->vadr + c]; q < m->Kp[B->vadr + c + 1]; q++) {
+        int i = m->Ki[q];
+        if (i < nv) { if (i < B->vadr || i >= B->vadr + 6 || Kx[q] != 0) ok = 0; continue; }
+        if (used[i]) { ok = 0; break; }
+        int seen = 0;
+        for (int k = 0; k < r; k++) seen |= rows[k] == i;
+        if (!seen) rows[r++] = i;
+      }
+    if (!ok || r < 6) continue;
+    /* Y: the other columns of R (velocity columns, none of an eliminated body) */
+    for (int k = 0; k < r && ok; k++)
+      for (int q = m->Kp[rows[k]]; q < m->Kp[rows[k] + 1]; q++) {
+        int j = m->Ki[q];
+        if (j >= B->vadr && j < B->vadr + 6) continue;
+        if (j >= nv || used[j]) { ok = 0; break; }
+        int seen = 0;
+        for (int t = 0; t < y; t++) seen |= cols[t] == j;
+        if (!seen) cols[y++] = j;
+      }
+    if (!ok) continue;
+    qsort(rows, (size_t)r, sizeof(int), int_cmp);
+    qsort(cols, (size_t)y, sizeof(int), int_cmp);
+    /* rank 6 at t = 0; the slots T: the rows partial pivoting leaves out there */
+    double *A = calloc((size_t)(6 * r + 1), sizeof(double)), *D = calloc((size_t)(r * y + 1), sizeof(double));
+    double *W = malloc(sizeof(double) * (size_t)(6 * r + 1)), *V = malloc(sizeof(double) * (size_t)(r * y + 1)), Di[36];
+    int *pi = malloc(sizeof(int) * (size_t)(r + 1));
+    if (!A || !D || !W || !V || !pi) { free(A); free(D); free(W); free(V); free(pi); goto done; }
+    for (int k = 0; k < r; k++) {
+      for (int c = 0; c < 6; c++) { int s = kslot(m, rows[k], B->vadr + c); A[6 * k + c] = s >= 0 ? Kx[s] : 0; }
+      for (int t = 0; t < y; t++) { int s = kslot(m, rows[k], cols[t]); D[y * k + t] = s >= 0 ? Kx[s] : 0; }
+    }
+    ok = !ml_eliminate(A, D, r, y, pi, Di, W, V);
+    if (ok) {
+      for (int k = 0; k < r; k++) p->mlR[nr + k] = rows[k];
+      for (int k = 6; k < r; k++) p->mlT[nt++] = rows[pi[k]];
+      qsort(p->mlT + nt - (r - 6), (size_t)(r - 6), sizeof(int), int_cmp);
+      for (int t = 0; t < y; t++) p->mlY[ny + t] = cols[t];
+      for (int c = 0; c < 6; c++) { p->mlu[ne][c] = B->vadr + c; used[B->vadr + c] = 1; }
+      for (int k = 0; k < r; k++) used[rows[k]] = 1;
+      for (int t = 0; t < y; t++) used[cols[t]] = 1;
+      nr += r;
+      ny += y;
+      p->mlb[ne] = b;
+      p->mlrp[ne + 1] = nr;
+      p->mlyp[ne + 1] = ny;
+      p->mldyp[ne + 1] = p->mldyp[ne] + r * y;
+      ne++;
+    }
+    free(A); free(D); free(W); free(V); free(pi);
+  }
+  p->nml = ne;
+  p->mldu = malloc(sizeof(int) * (size_t)(6 * nr + 1));
+  p->mldy = malloc(sizeof(int) * (size_t)(p->mldyp[ne] + 1));
+  if (!p->mldu || !p->mldy) goto done;
+  for (int e = 0; e < ne; e++) {
+    int y0 = p->mlyp[e], y = p->mlyp[e + 1] - y0;
+    for (int k = p->mlrp[e]; k < p->mlrp[e + 1]; k++) {
+      for (int c = 0; c < 6; c++) p->mldu[6 * k + c] = kslot(m, p->mlR[k], p->mlu[e][c]);
+      for (int t = 0; t < y; t++)
+        p->mldy[p->mldyp[e] + y * (k - p->mlrp[e]) + t] = kslot(m, p->mlR[k], p->mlY[y0 + t]);
+    }
+  }
+  rc = 0;
+done:
+  free(massive); free(used); free(weld); free(rows); free(cols);
+  return rc;
+}
+
+/* K1 index kinds: 1 eliminated column, 2 decoupled row, 3 slot row (block e in *blk), 0 else */
+static int ml_kind(const ldl_plan *p, int i, int *blk) {
+  for (int e = 0; e < p->nml; e++) {
+    if (in_list(p->mlu[e], 6, i)) return 1;
+    int t0 = p->mlrp[e] - 6 * e, nt = p->mlrp[e + 1] - p->mlrp[e] - 6;
+    if (in_list(p->mlT + t0, nt, i)) { if (blk) *blk = e; return 3; }
+    if (in_list(p->mlR + p->mlrp[e], p->mlrp[e + 1] - p->mlrp[e], i)) return 2;
+  }
+  return 0;
+}
+
+static void add_entry(int i, int j, int *mark, int *rows, int *nz);
+
+/* the pattern of K1 and its gather map; 0 or -1 */
+static int ml_pattern(const mb_model *m, ldl_plan *p) {
+  int n = m->n, ne = p->nml;
+  char *kind = malloc((size_t)n + 1);
+  int *blk = malloc(sizeof(int) * (size_t)(n + 1)), *mark = malloc(sizeof(int) * (size_t)(n + 1));
+  p->K1p = calloc((size_t)n + 1, sizeof(int));
+  if (!kind || !blk || !mark || !p->K1p) { free(kind); free(blk); free(mark); return -1; }
+  for (int i = 0; i < n; i++) { blk[i] = -1; kind[i] = (char)ml_kind(p, i, &blk[i]); }
+  for (int pass = 0; pass < 2; pass++) {
+    int nz = 0;
+    for (int i = 0; i < n; i++) mark[i] = -1;
+    for (int j = 0; j < n; j++) {
+      int start = nz;
+#define ADD(ii) add_entry((ii), j, mark, pass ? p->K1i : NULL, &nz)
+      if (kind[j] == 1 || kind[j] == 2) {
+        ADD(j);
+      } else if (kind[j] == 3) {
+        int e = blk[j];
+        for (int t = p->mlyp[e]; t < p->mlyp[e + 1]; t++) ADD(p->mlY[t]);
+      } else {
+        for (int q = m->Kp[j]; q < m->Kp[j + 1]; q++)
+          if (!kind[m->Ki[q]]) ADD(m->Ki[q]);
+        for (int e = 0; e < ne; e++)
+          if (in_list(p->mlY + p->mlyp[e], p->mlyp[e + 1] - p->mlyp[e], j))
+            for (int t = p->mlrp[e] - 6 * e; t < p->mlrp[e + 1] - 6 * (e + 1); t++) ADD(p->mlT[t]);
+      }
+#undef ADD
+      if (pass) qsort(p->K1i + start, (size_t)(nz - start), sizeof(int), int_cmp);
+      else p->K1p[j + 1] = nz;
+    }
+    if (!pass) {
+      p->nnz1 = nz;
+      p->K1i = malloc(sizeof(int) * (size_t)(nz + 1));
+      p->K1map = malloc(sizeof(int) * (size_t)(nz + 1));
+      if (!p->K1i || !p->K1map) { free(kind); free(blk); free(mark); return -1; }
+    }
+  }
+  for (int j = 0; j < n; j++)
+    for (int q = p->K1p[j]; q < p->K1p[j + 1]; q++) {
+      int i = p->K1i[q];
+      if (kind[j] == 1) p->K1map[q] = -2;
+      else if (kind[j] == 2) p->K1map[q] = -3;
+      else if (kind[j] == 3 || kind[i] == 3) p->K1map[q] = -4;
+      else p->K1map[q] = kslot(m, i, j) >= 0 ? kslot(m, i, j) : -1;
+    }
+  /* positions of the computed pairs (t, y), (y, t): slot-major */
+  int npair = 0;
+  for (int e = 0; e < ne; e++) npair += (p->mlrp[e + 1] - p->mlrp[e] - 6) * (p->mlyp[e + 1] - p->mlyp[e]);
+  p->mlk = malloc(sizeof(int) * (size_t)(2 * npair + 1));
+  p->mlkp = calloc((size_t)ne + 1, sizeof(int));
+  if (!p->mlk || !p->mlkp) { free(kind); free(blk); free(mark); return -1; }
+  mb_model m1 = *m;
+  m1.Kp = p->K1p;
+  m1.Ki = p->K1i;
+  m1.nnz = p->nnz1;
+  int k = 0;
+  for (int e = 0; e < ne; e++) {
+    p->mlkp[e] = k;
+    for (int t = p->mlrp[e] - 6 * e; t < p->mlrp[e + 1] - 6 * (e + 1); t++)
+      for (int y = p->mlyp[e]; y < p->mlyp[e + 1]; y++, k++) {
+        p->mlk[2 * k] = kslot(&m1, p->mlT[t], p->mlY[y]);
+        p->mlk[2 * k + 1] = kslot(&m1, p->mlY[y], p->mlT[t]);
+      }
+  }
+  p->mlkp[ne] = k;
+  free(kind); free(blk); free(mark);
+  return 0;
+}
+
+/* K1 from Kx (what the emitted ldl_massless does); 0 or -1 */
+static int ml_values(const ldl_plan *p, const double *Kx, double *K1) {
+  for (int q = 0; q < p->nnz1; q++) {
+    int s = p->K1map[q];
+    K1[q] = s >= 0 ? Kx[s] : s == -2 ? 1 : s == -3 ? -1 : 0;
+  }
+  for (int e = 0; e < p->nml; e++) {
+    int r = p->mlrp[e + 1] - p->mlrp[e], y = p->mlyp[e + 1] - p->mlyp[e], r0 = p->mlrp[e];
+    double *A = calloc((size_t)(6 * r + 1), sizeof(double)), *D = calloc((size_t)(r * y + 1), sizeof(double));
+    double *W = malloc(sizeof(double) * (size_t)(6 * r + 1)), *V = malloc(sizeof(double) * (size_t)(r * y + 1)), Di[36];
+    int *pi = malloc(sizeof(int) * (size_t)(r + 1)), rc = -1;
+    if (A && D && W && V && pi) {
+      for (int k = 0; k < r; k++) {
+        for (int c = 0; c < 6; c++) A[6 * k + c] = p->mldu[6 * (r0 + k) + c] >= 0 ? Kx[p->mldu[6 * (r0 + k) + c]] : 0;
+        for (int t = 0; t < y; t++) {
+          int s = p->mldy[p->mldyp[e] + y * k + t];
+          D[y * k + t] = s >= 0 ? Kx[s] : 0;
+        }
+      }
+      rc = ml_eliminate(A, D, r, y, pi, Di, W, V);
+      /* slot i (row T[i] of K1) holds the i-th row of V: which physical
+         row it stands for is pi[6 + i], known at run time only */
+      if (!rc)
+        for (int i = 0; i < r - 6; i++)
+          for (int t = 0; t < y; t++) {
+            int k = p->mlkp[e] + i * y + t;
+            K1[p->mlk[2 * k]] = K1[p->mlk[2 * k + 1]] = V[y * i + t];
+          }
+    }
+    free(A); free(D); free(W); free(V); free(pi);
+    if (rc) return -1;
+  }
   return 0;
 }
 
@@ -819,7 +1111,20 @@ int ldl_plan_build(const lmodel *L, ldl_plan *p) {
   const char *ord = getenv("MBCC_LDL_ORDER"); /* "bodies-first" or "tree": force one */
   int *Ap = NULL, *Ai = NULL, *C2 = NULL, *Ct = NULL;
   double *Kx = kx_at_start(m), *Kr = NULL;
+  mb_model m1;
   if (!Kx) goto fail;
+  /* massless bodies (MBCC_LDL_MASSLESS=0: none); from here on m is K1 */
+  if (find_massless(m, Kx, p) || ml_pattern(m, p)) goto fail;
+  Kr = malloc(sizeof(double) * (size_t)(p->nnz1 + 1));
+  if (!Kr || ml_values(p, Kx, Kr)) goto fail;
+  m1 = *m;
+  m1.Kp = p->K1p;
+  m1.Ki = p->K1i;
+  m1.nnz = p->nnz1;
+  m = &m1;
+  free(Kx);
+  Kx = Kr;
+  Kr = NULL;
   /* block pivots (MBCC_LDL_BLOCK=0: none, the weld rows are weighted instead);
      from here on m is K' (pattern Krp/Kri, values Kr) */
   const char *blk = getenv("MBCC_LDL_BLOCK");
@@ -870,6 +1175,13 @@ int ldl_plan_build(const lmodel *L, ldl_plan *p) {
      side (W g_r, Dx^T Du^-T f_u) and the recovery (two 6 x 6 solves) */
   p->flops_block = 0;
   p->flops_block_solve = 0;
+  p->flops_ml = 0;
+  p->flops_ml_solve = 0;
+  for (int e = 0; e < p->nml; e++) {
+    double r = p->mlrp[e + 1] - p->mlrp[e], ny = p->mlyp[e + 1] - p->mlyp[e];
+    p->flops_ml += 12 * r + 2 * 6 * 6 * 6 + (r - 6) * (72 + 12 * ny);
+    p->flops_ml_solve += 2 * (72 + 12 * ny + 12 * (r - 6)) + 12 * (r - 6);
+  }
   for (int e = 0; e < p->nelim; e++) {
     double nxe = p->exp_[e + 1] - p->exp_[e], nse = p->esp[e + 1] - p->esp[e];
     p->flops_block += 150 + nse * (72 + 12 * nxe);
@@ -897,6 +1209,9 @@ void ldl_plan_report(const lmodel *L, FILE *out) {
   if (p.nmassless)
     fprintf(out, "  zero mass         %d massless unknowns: %d rows weighted (K_aug = [M + D^T W D, D^T; D, 0])\n",
             p.nmassless, p.nw);
+  if (p.nml)
+    fprintf(out, "  massless bodies   %d eliminated with 6 of their rows each, chosen by pivoting "
+                 "(%.0f flops per factorization, %.0f per solve)\n", p.nml, p.flops_ml, p.flops_ml_solve);
   if (p.nelim)
     fprintf(out, "  block pivots      %d welded virtual bodies eliminated with their weld rows "
                  "(%.0f flops per factorization, %.0f per solve)\n", p.nelim, p.flops_block, p.flops_block_solve);

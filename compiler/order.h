@@ -56,6 +56,35 @@ typedef struct {
    * Everything below (weights, K_aug, ordering, L) is of K', whose values
    * Kr (nnzR, in the CSC order Krp/Kri) are gathered from Kx by Krmap
    * (>= 0: a Kx slot, -1: 0, -2: 1, -3: -1) and then corrected. */
+  /* massless bodies (stage 1, before the block pivots): a virtual body that is
+   * not welded, with r >= 6 rows R on its 6 columns U (D_RU of rank 6, e.g. a
+   * massless slider: prismatic + spherical), is eliminated with 6 of those
+   * rows chosen at run time by partial pivoting (P, Du = D_PU); the other
+   * r - 6 (S, W = D_SU Du^-1) become the new rows
+   *   D1(s, y) = D(s, y) - (W D_PY)(s, y)   for the columns Y of R outside U,
+   * stored in the compile-time slots T (r - 6 rows of R): a null-space
+   * elimination D1 = N^T D_RY with N^T D_RU = 0, whose pattern (T x Y) does
+   * not depend on the choice.  U and R \ T are decoupled (diagonals 1, -1).
+   * Right side: g1_t = g_s - W g_p, f1_y = f_y - D_PY^T Du^-T f_u; back:
+   * a_u = Du^-1 (g_p - D_PY a_y), lambda_s = mu_t, lambda_p = Du^-T (f_u - D_SU^T mu).
+   * What follows (block pivots, weights, ordering, L) is of K1 (pattern
+   * K1p/K1i, values gathered by K1map: >= 0 a Kx slot, -1: 0, -2: 1, -3: -1,
+   * -4: computed). */
+  int nml;           /* massless bodies eliminated */
+  int *mlb;          /* nml: the body */
+  int (*mlu)[6];     /* its 6 velocity columns */
+  int *mlrp, *mlR;   /* rows R (K indices) of body b: mlR[mlrp[b]..mlrp[b+1]) */
+  int *mlT;          /* slots: r - 6 per body, at mlrp[b] - 6 b */
+  int *mlyp, *mlY;   /* columns Y: mlY[mlyp[b]..mlyp[b+1]) */
+  int *mldu;         /* Kx slots of D_RU: 6 per row of R (-1: zero) */
+  int *mldy;         /* Kx slots of D_RY: ny per row of R, at mldyp[b] */
+  int *mldyp;
+  int *mlk;          /* K1 positions of (t, y) and (y, t): 2 per pair, at mlkp[b] */
+  int *mlkp;
+  int nnz1;
+  int *K1p, *K1i, *K1map;
+  double flops_ml, flops_ml_solve;
+
   int nelim;         /* eliminated (welded virtual) bodies */
   int *eb;           /* nelim: the body */
   int (*eu)[6];      /* its 6 velocity columns */

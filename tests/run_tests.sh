@@ -20,16 +20,21 @@ model_path() {
 }
 
 declare -A compiled
-# "model" or "model@scene"; the generated code is named model or model_scene
-gen_name() { if [[ $1 == *@* ]]; then echo "${1%@*}_${1#*@}"; else echo "$1"; fi; }
+# "model" or "model@scene", optionally with "+looped" (the emitted LDL^T as
+# loops over tables whatever its size: MBCC_LDL_BUDGET=0); the generated code
+# is named model or model_scene, in $B/gen/<that name>[_looped]
+gen_name() { local m=${1%+looped}; if [[ $m == *@* ]]; then echo "${m%@*}_${m#*@}"; else echo "$m"; fi; }
+gen_dir() { if [[ $1 == *+looped ]]; then echo "$B/gen/$(gen_name "$1")_looped"; else echo "$B/gen/$(gen_name "$1")"; fi; }
 compile_model() {
-  local m=$1 base=${1%@*} g
-  g=$(gen_name "$m")
-  [ -n "${compiled[$g]:-}" ] && return 0
+  local m=${1%+looped} base d budget=()
+  base=${m%@*}
+  d=$(gen_dir "$1")
+  [ -n "${compiled[$d]:-}" ] && return 0
   local scene=()
   [[ $m == *@* ]] && scene=(--scene "${m#*@}")
-  "$B/mbcc" compile "$(model_path "$base")" "${scene[@]}" -o "$B/gen/$g" >/dev/null || return 1
-  compiled[$g]=1
+  [[ $1 == *+looped ]] && budget=(env MBCC_LDL_BUDGET=0)
+  "${budget[@]}" "$B/mbcc" compile "$(model_path "$base")" "${scene[@]}" -o "$d" >/dev/null || return 1
+  compiled[$d]=1
 }
 
 for t in tests/test_*.c; do
@@ -39,8 +44,8 @@ for t in tests/test_*.c; do
   ok=1
   for m in $models; do
     if ! compile_model "$m"; then echo "FAIL $name: mbcc could not compile model $m"; ok=0; fi
-    g=$(gen_name "$m")
-    srcs+=("$B/gen/$g/$g.c"); incs+=("-I$B/gen/$g")
+    g=$(gen_name "$m"); d=$(gen_dir "$m")
+    srcs+=("$d/$g.c"); incs+=("-I$d")
   done
   if [ $ok = 1 ] && ! $CC -std=c11 -Wall -Wextra -Werror $CFLAGS -Iruntime -Icompiler -Itests "${incs[@]}" \
         "$t" "${srcs[@]}" tests/support.c "$B/libmbrt.a" $LIBS -o "$B/tests/$name" 2> "$B/tests/$name.build.log"; then
