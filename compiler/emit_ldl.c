@@ -662,15 +662,24 @@ static void emit_massless(FILE *f, const lmodel *L, const ldl_plan *p) {
   fputs("/* K1 from Kx: a Kx slot, or -1: 0, -2: 1 (eliminated column), -3: -1 (decoupled row),\n"
         " * -4: computed below */\n", f);
   fprintf(f, "#define LDL_NK1 %d\n", p->nnz1);
-  int_array(f, "ldl_K1src", p->K1map, p->nnz1);
+  if (!p->straight) int_array(f, "ldl_K1src", p->K1map, p->nnz1);
   emit_inv6(f);
   fputs("/* K1 (work + LDL_K1) from Kx; returns 0, or 1 + a column of a massless body whose\n"
         " * rows have lost rank 6 on it */\n"
         "static int ldl_massless(const mb_real *Kx, mb_real *work) {\n"
-        "  mb_real *K1 = work + LDL_K1, *D = work + LDL_MLD;\n"
-        "  for (int q = 0; q < LDL_NK1; q++) {\n"
-        "    int s = ldl_K1src[q];\n"
-        "    K1[q] = s >= 0 ? Kx[s] : s == -2 ? 1 : s == -3 ? -1 : 0;\n  }\n"
+        "  mb_real *K1 = work + LDL_K1, *D = work + LDL_MLD;\n", f);
+  if (p->straight) { /* the gather with constant indices (the computed entries follow) */
+    for (int q = 0; q < p->nnz1; q++) {
+      int src = p->K1map[q];
+      if (src >= 0) fprintf(f, "  K1[%d] = Kx[%d];\n", q, src);
+      else if (src != -4) fprintf(f, "  K1[%d] = %s;\n", q, src == -2 ? "1" : src == -3 ? "-1" : "0");
+    }
+  } else {
+    fputs("  for (int q = 0; q < LDL_NK1; q++) {\n"
+          "    int s = ldl_K1src[q];\n"
+          "    K1[q] = s >= 0 ? Kx[s] : s == -2 ? 1 : s == -3 ? -1 : 0;\n  }\n", f);
+  }
+  fputs(
         "  for (int e = 0; e < LDL_NML; e++) {\n"
         "    const ldl_mlb *B = &ldl_ml[e];\n"
         "    int r = B->r, ny = B->ny, pi[LDL_MLR];\n"
