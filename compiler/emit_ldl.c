@@ -14,8 +14,12 @@
  *     factors): none when the relative residual ||r||_inf / (||K||_inf
  *     ||x||_inf + ||b||_inf) of the first solution is already at roundoff
  *     level (<= LDL_REFINE_TOL = 1e-15), else one step, a second when it is
- *     still above 1e-12; *res gets that relative residual.
- *     Returns MB_OK or MB_ERR_NONFINITE.
+ *     still above 1e-12; res[0] gets that relative residual, res[1] the one
+ *     of the first solution (before any refinement).  With res NULL
+ *     and no weighted rows (<M>_LDL_EXACT: K_aug = K, so the first solution
+ *     is already the direct one) the solve is that single pass, without
+ *     residual or refinement, as a library LDL^T would do it; with weighted
+ *     rows it still refines.  Returns MB_OK or MB_ERR_NONFINITE.
  *
  * Below the flop budget (LDL_FLOP_BUDGET, order.h) every operation is emitted
  * with constant indices (straight-line, the factorization split into
@@ -23,8 +27,8 @@
  * run as loops over static const index arrays, so that the C compiler's time
  * stays bounded (gcc 12 -O2 -g needs about 0.3 ms per straight-line flop).
  *
- * The workspace (<M>_LDL_WORK mb_real) holds Lx (nnz(L)), 1/d (n),
- * ||K||_inf (1), then x, r, t and the best x of the refinement (n each). */
+ * The workspace (<M>_LDL_WORK mb_real) holds Lx (nnz(L)), 1/d (n), then x,
+ * r, t and the best x of the refinement (n each). */
 #include <ctype.h>
 #include <stdlib.h>
 #include <string.h>
@@ -81,10 +85,13 @@ static void ml_max(const ldl_plan *p, int *rmax, long *dmax) {
   }
 }
 
+/* offset of the block pivots' workspace: after Lx, 1/d, x, r, t, best x, K', rr, d */
+static long block_base(const ldl_plan *p) { return p->nnzL + 5L * p->n + p->nnzR + 2L * p->n; }
+
 /* offset of the massless bodies' part of the workspace: K1, r1, D scratch, blocks */
 static long ml_base(const ldl_plan *p) {
-  long w = p->nnzL + 5L * p->n + 1;
-  if (p->nelim || p->nml) w += p->nnzR + 2L * p->n;
+  long w = p->nnzL + 5L * p->n;
+  if (p->nelim || p->nml) w = block_base(p);
   for (int e = 0; e < p->nelim; e++) w += block_work(p, e);
   return w;
 }
@@ -112,6 +119,8 @@ void emit_ldl_header(FILE *f, const lmodel *L, const char *nm) {
   fprintf(f, "#define %s_LDL_STRAIGHT %d   /* 1: straight-line code, 0: loops over tables */\n", U,
           p.straight);
   fprintf(f, "#define %s_LDL_WORK %ld      /* mb_real elements of the workspace */\n", U, work_size(&p));
+  fprintf(f, "#define %s_LDL_EXACT %d      /* 1: the factors are those of K (no weighted rows) */\n", U,
+          p.nw == 0);
   fprintf(f, "int %s_ldl_factor(const mb_real *Kx, mb_real *work);\n", nm);
   fprintf(f, "int %s_ldl_solve(const mb_real *Kx, mb_real *work, mb_real *b, mb_real *residual);\n", nm);
   ldl_plan_free(&p);
@@ -122,8 +131,9 @@ void emit_ldl_fields(FILE *f, const char *nm, int emitted) {
   char U[256];
   upper(U, nm, sizeof U);
   fprintf(f, "  .ldl_factor = ldl_factor_m, .ldl_solve = ldl_solve_m, .ldl_worksize = %s_LDL_WORK,\n"
-             "  .ldl_nnzL = %s_LDL_NNZL, .ldl_flops = %s_LDL_FLOPS, .ldl_straight = %s_LDL_STRAIGHT,\n",
-          U, U, U, U);
+             "  .ldl_nnzL = %s_LDL_NNZL, .ldl_flops = %s_LDL_FLOPS, .ldl_straight = %s_LDL_STRAIGHT,\n"
+             "  .ldl_exact = %s_LDL_EXACT,\n",
+          U, U, U, U, U);
 }
 
 /* ---------------------------------------------------------------- helpers */
@@ -160,14 +170,16 @@ static void aug_value(FILE *f, const ldl_plan *p, int e) {
 /* row sums of |K| (the same straight-line / looped choice as the factorization) */
 static void emit_knorm(FILE *f, const lmodel *L, const ldl_plan *p) {
   const mb_model *m = &L->m;
-  fputs("  /* ||K||_inf: the largest row sum of |K| (for the relative residual) */\n", f);
+  fputs("/* ||K||_inf: the largest row sum of |K| (for the relative residual); 'work' from\n"
+        " * LDL_R on is scratch */\n"
+        "static mb_real ldl_knorm(const mb_real *Kx, mb_real *work) {\n", f);
   if (!p->straight) {
     fputs("  {\n    mb_real *rs = work + LDL_R, a = 0;\n", f);
     fputs("    for (int i = 0; i < LDL_N; i++) rs[i] = 0;\n", f);
     fputs("    for (int j = 0; j < LDL_N; j++)\n"
           "      for (int q = ldl_Kp[j]; q < ldl_Kp[j + 1]; q++) rs[ldl_Ki[q]] += fabs(Kx[q]);\n", f);
     fputs("    for (int i = 0; i < LDL_N; i++) if (rs[i] > a) a = rs[i];\n", f);
-    fputs("    work[LDL_KNORM] = a;\n  }\n", f);
+    fputs("    return a;\n  }\n}\n\n", f);
     return;
   }
   /* rows of K: the entries (i, j) sit in column j */
@@ -186,8 +198,26 @@ static void emit_knorm(FILE *f, const lmodel *L, const ldl_plan *p) {
     for (int q = rp[i]; q < rp[i + 1]; q++) fprintf(f, "%sfabs(Kx[%d])", q > rp[i] ? " + " : "", rs[q]);
     fputs(";\n    if (c > a) a = c;\n", f);
   }
-  fputs("    work[LDL_KNORM] = a;\n  }\n", f);
+  fputs("    (void)work;\n    return a;\n  }\n}\n\n", f);
   free(cnt); free(rp); free(rs);
+}
+
+/* sum over k of the terms 'fmt' (two %d: a[k], b[k], e.g. "Lx[%d] * t[%d]"), as up
+ * to four interleaved partial sums: one long chain of dependent multiply-adds
+ * would leave the straight-line code waiting on latency */
+static void emit_sum(FILE *f, const char *fmt, const int *a, const int *b, int len) {
+  int ways = len >= 8 ? 4 : len >= 4 ? 2 : 1;
+  if (ways > 1) fputc('(', f);
+  for (int w = 0; w < ways; w++) {
+    if (w) fputs(ways == 4 && w == 2 ? ") + (" : " + ", f);
+    if (ways > 1) fputc('(', f);
+    for (int k = w; k < len; k += ways) {
+      if (k > w) fputs(" + ", f);
+      fprintf(f, fmt, a[k], b[k]);
+    }
+    if (ways > 1) fputc(')', f);
+  }
+  if (ways > 1) fputc(')', f);
 }
 
 /* --------------------------------------------------------- factorization */
@@ -480,7 +510,7 @@ static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
         "  const int *u, *r, *x, *s; /* its columns, weld rows, X, S (K indices) */\n"
         "  const int *du, *dx, *eu;  /* Kx slots (-1: zero) of Du (6 x 6), Dx (6 per x), Eu (6 per s) */\n"
         "} ldl_block;\n", f);
-  long w = (long)p->nnzL + 5L * p->n + 1 + p->nnzR + 2L * p->n;
+  long w = block_base(p);
   long *woff = malloc(sizeof(long) * (size_t)(p->nelim + 1));
   if (!woff) return;
   for (int e = 0; e < p->nelim; e++) {
@@ -633,6 +663,7 @@ static void emit_massless(FILE *f, const lmodel *L, const ldl_plan *p) {
         "  const int *u, *R, *T, *Y; /* its columns, rows, slots, the rows' other columns */\n"
         "  const int *du, *dy;       /* Kx slots (-1: zero) of D_RU (6 per row), D_RY (ny per row) */\n"
         "  const int *k1;            /* K1 positions of (t, y), (y, t): 2 per pair, slot-major */\n"
+        "  const int *hy;            /* per row: 1 if it has an entry in Y (else D_RY's row is 0) */\n"
         "} ldl_mlb;\n", f);
   for (int e = 0; e < p->nml; e++) {
     int r0 = p->mlrp[e], r = p->mlrp[e + 1] - r0, y0 = p->mlyp[e], ny = p->mlyp[e + 1] - y0;
@@ -651,11 +682,18 @@ static void emit_massless(FILE *f, const lmodel *L, const ldl_plan *p) {
     snprintf(nmx, sizeof nmx, "ldl_ml%d_dy", e); int_array(f, nmx, p->mldy + p->mldyp[e], (long)r * ny);
     snprintf(nmx, sizeof nmx, "ldl_ml%d_k1", e);
     int_array(f, nmx, p->mlk + 2 * p->mlkp[e], 2L * (p->mlkp[e + 1] - p->mlkp[e]));
+    int *hy = calloc((size_t)r + 1, sizeof(int));
+    if (!hy) return;
+    for (int k = 0; k < r; k++)
+      for (int y = 0; y < ny; y++) hy[k] |= p->mldy[p->mldyp[e] + (long)k * ny + y] >= 0;
+    snprintf(nmx, sizeof nmx, "ldl_ml%d_hy", e); int_array(f, nmx, hy, r);
+    free(hy);
   }
   fprintf(f, "#define LDL_NML %d\nstatic const ldl_mlb ldl_ml[LDL_NML] = {\n", p->nml);
   for (int e = 0; e < p->nml; e++) {
-    fprintf(f, "  {%d, %d, %d, %ldL, ldl_ml%d_u, ldl_ml%d_R, ldl_ml%d_T, ldl_ml%d_Y, ldl_ml%d_du, ldl_ml%d_dy, ldl_ml%d_k1},\n",
-            p->mlrp[e + 1] - p->mlrp[e], p->mlyp[e + 1] - p->mlyp[e], p->mlkp[e], w, e, e, e, e, e, e, e);
+    fprintf(f, "  {%d, %d, %d, %ldL, ldl_ml%d_u, ldl_ml%d_R, ldl_ml%d_T, ldl_ml%d_Y, ldl_ml%d_du, ldl_ml%d_dy, "
+               "ldl_ml%d_k1, ldl_ml%d_hy},\n",
+            p->mlrp[e + 1] - p->mlrp[e], p->mlyp[e + 1] - p->mlyp[e], p->mlkp[e], w, e, e, e, e, e, e, e, e);
     w += ml_work(p, e);
   }
   fputs("};\n", f);
@@ -688,7 +726,9 @@ static void emit_massless(FILE *f, const lmodel *L, const ldl_plan *p) {
         "    for (int i = 0; i < 6 * r; i++) {\n"
         "      A[i] = G[i] = B->du[i] >= 0 ? Kx[B->du[i]] : 0;\n"
         "      if (fabs(A[i]) > amax) amax = fabs(A[i]);\n    }\n"
-        "    for (int i = 0; i < r * ny; i++) D[i] = B->dy[i] >= 0 ? Kx[B->dy[i]] : 0;\n"
+        "    for (int i = 0; i < r; i++) /* the rows without Y entries are never read */\n"
+        "      if (B->hy[i])\n"
+        "        for (int y = ny * i; y < ny * (i + 1); y++) D[y] = B->dy[y] >= 0 ? Kx[B->dy[y]] : 0;\n"
         "    /* P: partial pivoting on D_RU chooses 6 independent rows */\n"
         "    for (int i = 0; i < r; i++) pi[i] = i;\n"
         "    for (int k = 0; k < 6; k++) {\n"
@@ -714,10 +754,14 @@ static void emit_massless(FILE *f, const lmodel *L, const ldl_plan *p) {
         "        mb_real v = 0;\n"
         "        for (int k = 0; k < 6; k++) v += a[k] * Di[6 * k + c];\n"
         "        W[6 * i + c] = v;\n      }\n"
-        "      for (int y = 0; y < ny; y++) {\n"
-        "        mb_real v = D[ny * pi[6 + i] + y];\n"
-        "        for (int c = 0; c < 6; c++) v -= W[6 * i + c] * D[ny * pi[c] + y];\n"
-        "        K1[k1[2 * y]] = K1[k1[2 * y + 1]] = v;\n      }\n    }\n  }\n  return 0;\n}\n\n", f);
+        "      /* rows without Y entries add nothing: the same sums, in the same order */\n"
+        "      const mb_real *ds = D + ny * pi[6 + i];\n"
+        "      for (int y = 0; y < ny; y++) K1[k1[2 * y]] = B->hy[pi[6 + i]] ? ds[y] : 0;\n"
+        "      for (int c = 0; c < 6; c++) {\n"
+        "        if (!B->hy[pi[c]]) continue;\n"
+        "        const mb_real w = W[6 * i + c], *dp = D + ny * pi[c];\n"
+        "        for (int y = 0; y < ny; y++) K1[k1[2 * y]] -= w * dp[y];\n      }\n"
+        "      for (int y = 0; y < ny; y++) K1[k1[2 * y + 1]] = K1[k1[2 * y]];\n    }\n  }\n  return 0;\n}\n\n", f);
   fputs("/* r1 = the right side of K1 from r: g1_t = g_s - W g_p, f1_y = f_y - D_PY^T Du^-T f_u */\n"
         "static void ldl_ml_rhs(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *r1) {\n"
         "  for (int i = 0; i < LDL_N; i++) r1[i] = r[i];\n"
@@ -776,8 +820,8 @@ static void emit_massless(FILE *f, const lmodel *L, const ldl_plan *p) {
 
 /* the public factorization: ||K||, the block pivots, then L D L^T of K_aug */
 static void emit_factor_entry(FILE *f, const lmodel *L, const ldl_plan *p, const char *nm) {
-  fprintf(f, "int %s_ldl_factor(const mb_real *Kx, mb_real *work) {\n", nm);
   emit_knorm(f, L, p);
+  fprintf(f, "int %s_ldl_factor(const mb_real *Kx, mb_real *work) {\n", nm);
   /* Kp: the matrix the rest works on (K, or K1 after the massless bodies) */
   if (p->nml)
     fputs("  int rc1 = ldl_massless(Kx, work);\n  if (rc1) return rc1;\n"
@@ -823,19 +867,52 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
 
   fputs("/* t <- (L D L^T)^-1 t */\n", f);
   fputs("static void ldl_lsolve(const mb_real *restrict Lx, const mb_real *restrict Dinv, mb_real *restrict t) {\n", f);
-  fputs("  /* forward: L y = t */\n", f);
-  for (int j = 0; j < n; j++)
-    for (int q = p->Lp[j]; q < p->Lp[j + 1]; q++)
-      fprintf(f, "  t[%d] -= Lx[%d] * t[%d];\n", p->Li[q], q, j);
+  fputs("  /* forward: L y = t, row by row */\n", f);
+  {
+    /* rows of L: the entries (i, j) of column j, in the order of j */
+    int *cnt = calloc((size_t)n + 1, sizeof(int)), *rp = calloc((size_t)n + 1, sizeof(int));
+    int *rq = malloc(sizeof(int) * (size_t)(p->nnzL + 1));
+    if (!cnt || !rp || !rq) { free(cnt); free(rp); free(rq); return; }
+    for (long q = 0; q < p->nnzL; q++) rp[p->Li[q] + 1]++;
+    for (int i = 0; i < n; i++) rp[i + 1] += rp[i];
+    for (int j = 0; j < n; j++)
+      for (int q = p->Lp[j]; q < p->Lp[j + 1]; q++) rq[rp[p->Li[q]] + cnt[p->Li[q]]++] = q;
+    for (int i = 0; i < n; i++) {
+      int len = rp[i + 1] - rp[i];
+      if (!len) continue;
+      int *col = malloc(sizeof(int) * (size_t)len), *lq = malloc(sizeof(int) * (size_t)len);
+      if (!col || !lq) { free(col); free(lq); break; }
+      for (int k = 0; k < len; k++) {
+        lq[k] = rq[rp[i] + k];
+        /* the column of entry q: the j with Lp[j] <= q < Lp[j + 1] */
+        int lo = 0, hi = n - 1;
+        while (lo < hi) {
+          int mid = (lo + hi + 1) / 2;
+          if (p->Lp[mid] <= lq[k]) lo = mid; else hi = mid - 1;
+        }
+        col[k] = lo;
+      }
+      fprintf(f, "  t[%d] -= ", i);
+      emit_sum(f, "Lx[%d] * t[%d]", lq, col, len);
+      fputs(";\n", f);
+      free(col);
+      free(lq);
+    }
+    free(cnt); free(rp); free(rq);
+  }
   fputs("  /* diagonal: z = D^-1 y */\n", f);
   for (int k = 0; k < n; k++) fprintf(f, "  t[%d] *= Dinv[%d];\n", k, k);
   fputs("  /* backward: L^T x = z */\n", f);
   for (int j = n - 1; j >= 0; j--) {
-    if (p->Lp[j] == p->Lp[j + 1]) continue;
+    int len = p->Lp[j + 1] - p->Lp[j];
+    if (!len) continue;
+    int *lq = malloc(sizeof(int) * (size_t)len);
+    if (!lq) break;
+    for (int k = 0; k < len; k++) lq[k] = p->Lp[j] + k;
     fprintf(f, "  t[%d] -= ", j);
-    for (int q = p->Lp[j]; q < p->Lp[j + 1]; q++)
-      fprintf(f, "%sLx[%d] * t[%d]", q > p->Lp[j] ? " + " : "", q, p->Li[q]);
+    emit_sum(f, "Lx[%d] * t[%d]", lq, p->Li + p->Lp[j], len);
     fputs(";\n", f);
+    free(lq);
   }
   if (p->nnzL == 0) fputs("  (void)Lx;\n", f);
   fputs("}\n\n", f);
@@ -911,6 +988,28 @@ static void emit_solve_helpers_looped(FILE *f, const ldl_plan *p) {
         "    for (int q = ldl_Kp[j]; q < ldl_Kp[j + 1]; q++) r[ldl_Ki[q]] -= Kx[q] * xj;\n  }\n}\n\n", f);
 }
 
+/* one pass of the solve: d (or x += ...) from the factors with right side 'rhs' */
+static void emit_solve_pass(FILE *f, const ldl_plan *p, const char *rhs, const char *ind) {
+  int staged = p->nelim || p->nml;
+  if (p->nml)
+    fprintf(f, "%sldl_ml_rhs(Kx, work, %s, r1); /* the massless bodies' right side: K1 */\n", ind, rhs);
+  else
+    fprintf(f, "%sr1 = %s;\n", ind, rhs);
+  const char *kc = p->straight ? " work + LDL_KR," : "";
+  if (p->nelim) {
+    fprintf(f, "%sldl_block_rhs(Kp, work, r1, rr); /* the block pivots' right side: K' */\n", ind);
+    fprintf(f, "%sldl_aug(%s,%s rr, t);\n", ind, p->straight ? "Kp" : "work + LDL_KR", kc);
+  } else {
+    fprintf(f, "%sldl_aug(Kp, r1, t);\n", ind);
+  }
+  fprintf(f, "%sldl_lsolve(Lx, Dinv, t);\n", ind);
+  if (staged) {
+    fprintf(f, "%sldl_scatter(t, d);\n", ind);
+    if (p->nelim) fprintf(f, "%sldl_block_back(Kp, work, r1, d); /* the block pivots' unknowns */\n", ind);
+    if (p->nml) fprintf(f, "%sldl_ml_back(Kx, work, %s, d); /* the massless bodies' unknowns */\n", ind, rhs);
+  }
+}
+
 static void emit_solve(FILE *f, const ldl_plan *p, const char *nm) {
   int staged = p->nelim || p->nml;
   fprintf(f, "int %s_ldl_solve(const mb_real *Kx, mb_real *work, mb_real *b, mb_real *residual) {\n", nm);
@@ -919,30 +1018,33 @@ static void emit_solve(FILE *f, const ldl_plan *p, const char *nm) {
   if (p->nelim) fputs("  mb_real *rr = work + LDL_RR;\n", f);
   if (staged) fputs("  mb_real *d = work + LDL_DD;\n", f);
   if (p->nml) fputs("  mb_real *r1 = work + LDL_R1;\n  const mb_real *Kp = work + LDL_K1;\n", f);
-  else fputs("  const mb_real *Kp = Kx, *r1 = r;\n", f);
-  fputs("  mb_real knorm = work[LDL_KNORM], bn = 0, best = 0;\n"
+  else fputs("  const mb_real *Kp = Kx;\n  const mb_real *r1;\n", f);
+  if (!p->nw) {
+    /* no weighted rows: the factors are those of K itself, and the first
+       solution is the one refinement would start from */
+    fputs("  if (!residual) { /* one pass: no residual, no refinement */\n", f);
+    if (staged) {
+      emit_solve_pass(f, p, "b", "    ");
+      fputs("    for (int i = 0; i < LDL_N; i++) b[i] = d[i];\n", f);
+    } else {
+      fputs("    for (int i = 0; i < LDL_N; i++) x[i] = 0;\n", f);
+      emit_solve_pass(f, p, "b", "    ");
+      fputs("    ldl_scatter_add(t, x);\n"
+            "    for (int i = 0; i < LDL_N; i++) b[i] = x[i];\n", f);
+    }
+    fputs("    for (int i = 0; i < LDL_N; i++)\n"
+          "      if (!isfinite(b[i])) return MB_ERR_NONFINITE;\n"
+          "    return MB_OK;\n  }\n", f);
+  }
+  fputs("  mb_real knorm = ldl_knorm(Kx, work), bn = 0, best = 0, first = 0;\n"
         "  for (int i = 0; i < LDL_N; i++) {\n"
         "    x[i] = 0;\n    r[i] = b[i];\n    if (fabs(b[i]) > bn) bn = fabs(b[i]);\n  }\n"
         "  /* pass 0: the solve; pass 1: refinement; pass 2: a second one if still above 1e-12 */\n"
         "  for (int it = 0; it < 3; it++) {\n"
         "    mb_real rn = 0, xn = 0, den, rel;\n", f);
-  if (p->nml) fputs("    ldl_ml_rhs(Kx, work, r, r1); /* the massless bodies' right side: K1 */\n", f);
-  const char *kc = p->straight ? " work + LDL_KR," : "";
-  if (p->nelim) {
-    fputs("    ldl_block_rhs(Kp, work, r1, rr); /* the block pivots' right side: K' */\n", f);
-    fprintf(f, "    ldl_aug(%s,%s rr, t);\n", p->straight ? "Kp" : "work + LDL_KR", kc);
-  } else {
-    fputs("    ldl_aug(Kp, r1, t);\n", f);
-  }
-  fputs("    ldl_lsolve(Lx, Dinv, t);\n", f);
-  if (staged) {
-    fputs("    ldl_scatter(t, d);\n", f);
-    if (p->nelim) fputs("    ldl_block_back(Kp, work, r1, d); /* the block pivots' unknowns */\n", f);
-    if (p->nml) fputs("    ldl_ml_back(Kx, work, r, d); /* the massless bodies' unknowns */\n", f);
-    fputs("    for (int i = 0; i < LDL_N; i++) x[i] += d[i];\n", f);
-  } else {
-    fputs("    ldl_scatter_add(t, x);\n", f);
-  }
+  emit_solve_pass(f, p, "r", "    ");
+  if (staged) fputs("    for (int i = 0; i < LDL_N; i++) x[i] += d[i];\n", f);
+  else fputs("    ldl_scatter_add(t, x);\n", f);
   fputs("    ldl_residual(Kx, x, b, r);\n"
         "    for (int i = 0; i < LDL_N; i++) {\n"
         "      if (!(fabs(r[i]) <= rn)) rn = fabs(r[i]);\n"
@@ -950,13 +1052,14 @@ static void emit_solve(FILE *f, const ldl_plan *p, const char *nm) {
         "    den = knorm * xn + bn;\n"
         "    rel = den > 0 ? rn / den : rn;\n"
         "    if (it > 0 && !(rel < best)) break; /* no longer improving: keep the best */\n"
+        "    if (it == 0) first = rel;\n"
         "    best = rel;\n"
         "    if (rel <= LDL_REFINE_TOL) break; /* at roundoff level: x is kept as it is */\n"
         "    for (int i = 0; i < LDL_N; i++) xb[i] = x[i];\n"
         "    if (it > 0 && rel <= 1e-12) break;\n  }\n"
         "  if (best <= LDL_REFINE_TOL) for (int i = 0; i < LDL_N; i++) b[i] = x[i];\n"
         "  else for (int i = 0; i < LDL_N; i++) b[i] = xb[i];\n"
-        "  if (residual) *residual = best;\n"
+        "  if (residual) {\n    residual[0] = best;\n    residual[1] = first;\n  }\n"
         "  (void)Kp;\n  (void)r1;\n"
         "  return isfinite(best) ? MB_OK : MB_ERR_NONFINITE;\n}\n\n", f);
 }
@@ -990,9 +1093,9 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
     fputs(k % 4 ? ", " : "\n *  ", f);
     fprintf(f, "%d: %.6g", p.wrow[k], p.w[k]);
   }
-  fputs("\n * Workspace: Lx, 1/d, ||K||_inf, x, r, t, best x. */\n", f);
-  fprintf(f, "#define LDL_N %d\n#define LDL_DINV %s_LDL_NNZL\n#define LDL_KNORM (LDL_DINV + LDL_N)\n"
-             "#define LDL_X (LDL_KNORM + 1)\n#define LDL_R (LDL_X + LDL_N)\n#define LDL_T (LDL_R + LDL_N)\n"
+  fputs("\n * Workspace: Lx, 1/d, x, r, t, best x. */\n", f);
+  fprintf(f, "#define LDL_N %d\n#define LDL_DINV %s_LDL_NNZL\n"
+             "#define LDL_X (LDL_DINV + LDL_N)\n#define LDL_R (LDL_X + LDL_N)\n#define LDL_T (LDL_R + LDL_N)\n"
              "#define LDL_XB (LDL_T + LDL_N)\n#define LDL_PIVTOL 1e-14\n"
              "#define LDL_KR (LDL_XB + LDL_N)\n#define LDL_RR (LDL_KR + %d)\n#define LDL_DD (LDL_RR + LDL_N)\n"
              "/* a solve whose relative residual is already this small is not refined */\n"

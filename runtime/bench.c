@@ -175,6 +175,7 @@ static void fmt_long(char *buf, size_t n, long v) {
 
 int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *defaults) {
   mb_settings set = *defaults;
+  set.timers = 0; /* every path is timed as a whole run: no clock inside the steps */
   const char *csv_path = NULL, *paths = NULL;
   int reps = 5, quiet = 0;
   long nnz_l = m->ldl_factor ? m->ldl_nnzL : -1; /* the emitted LDL^T's fill */

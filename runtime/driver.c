@@ -251,7 +251,10 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
               "start): the run passed close to a singular configuration; check the results there\n",
               argv[0], s->rcond_min_t, s->rcond_min, s->rcond_first);
     if (!strcmp(ls->name, "ldl"))
-      printf("ldl residual after refinement: last %.3g, largest %.3g\n", ls->residual, ls->residual_max);
+      printf("ldl residual after refinement (checked on %ld of %ld solves%s): last %.3g, largest %.3g; "
+             "single pass: largest %.3g\n", ls->residual_checks, ls->solves,
+             ls->refine_always ? ", refined on every solve" : "", ls->residual, ls->residual_max,
+             ls->residual_pass_max);
     printf("wrote %s (%d columns)\n", csv_path, m->ncols + 1);
   }
   mb_sim_free(&sim);

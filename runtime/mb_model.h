@@ -120,7 +120,9 @@ typedef struct mb_model {
   /* the emitted LDL^T of K (solver "ldl", compiler/emit_ldl.c); NULL / 0 when the
    * model has none (the generic path).  factor: 0, or 1 + the unknown whose pivot
    * is zero or tiny; solve: K x = b in place with refinement on the exact system,
-   * *residual = ||b - K x||_inf / (||K||_inf ||x||_inf + ||b||_inf) */
+   * residual[0] = ||b - K x||_inf / (||K||_inf ||x||_inf + ||b||_inf), residual[1]
+   * the same before refinement; with residual NULL and ldl_exact, one pass without
+   * residual or refinement */
   int (*ldl_factor)(const struct mb_model *m, const mb_real *Kx, mb_real *work);
   int (*ldl_solve)(const struct mb_model *m, const mb_real *Kx, mb_real *work, mb_real *b,
                    mb_real *residual);
@@ -128,6 +130,8 @@ typedef struct mb_model {
   long ldl_nnzL;               /* nonzeros of L (strictly lower) */
   double ldl_flops;            /* flops of one numeric factorization */
   int ldl_straight;            /* 1: straight-line code, 0: loops over static tables */
+  int ldl_exact;               /* 1: no weighted rows, so ldl_solve with residual NULL is
+                                  one pass without refinement (the factors are K's) */
 } mb_model;
 
 /* triplets (row, column, value) of K from the general generic path */

@@ -22,13 +22,15 @@ typedef struct {
   double projection_tol;      /* max |phi| after projection */
   double rho_inf;             /* generalized-alpha: spectral radius at infinite step, 0..1 */
   double max_steps;           /* stop with MB_ERR_STEP_BUDGET beyond this many steps */
+  int timers;                 /* 1: clock each evaluation and factor/solve (the breakdown
+                                 mbcc run prints); 0: only the whole run (mbcc bench) */
 } mb_settings;
 
 typedef struct {
   long steps, rejected, evals, solves, projections;
   long factorizations, full_factorizations;
   long newton_iterations, newton_failures; /* generalized-alpha */
-  double t_assembly, t_solve, t_total; /* seconds */
+  double t_assembly, t_solve, t_total; /* seconds (assembly, solve: 0 without timers) */
   double max_phi, max_phid;            /* largest constraint violations seen at outputs */
   double rcond_first, rcond_min, rcond_min_t; /* KLU's condition estimate of K: first, smallest, when */
 } mb_stats;

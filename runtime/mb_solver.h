@@ -21,6 +21,12 @@ typedef struct mb_solver {
    * failed in the last factorization, or -1 (other solvers leave these 0) */
   double residual, residual_max;
   int bad_pivot;
+  /* ldl: the residual is computed (and the solution refined) on every
+   * check_every-th solve, counted by 'solves'; 1 = on every solve.  The largest
+   * residual of a single pass seen; refine_always once it exceeded MB_LDL_PASS_TOL */
+  int check_every, refine_always;
+  long solves, residual_checks;
+  double residual_pass_max;
   /* klu: the reciprocal condition estimate (min |u_ii| / max |u_ii|) of the
      last factorization with fresh pivots: with the pivot order of an earlier
      configuration a small u_ii says little; 0 when not estimated */
@@ -40,6 +46,12 @@ mb_solver *mb_solver_generic(const mb_model *m, int dense);
 /* the LDL^T emitted with the model (m->ldl_factor, compiler/emit_ldl.c); NULL
  * when the model has none */
 mb_solver *mb_solver_ldl(const mb_model *m);
+/* ldl's default check_every on models without weighted rows: the residual of one
+ * solve in 64 (the factors are those of K; the check watches the conditioning) */
+#define MB_LDL_CHECK_EVERY 64
+/* a single pass with a larger relative residual turns refinement on for good: a
+ * tenth of the 1e-12 every solve must meet, for the residual varies along a run */
+#define MB_LDL_PASS_TOL 1e-13
 /* by name: "klu" or "dense"; NULL if unknown or out of memory */
 mb_solver *mb_solver_new(const char *name, const mb_model *m);
 

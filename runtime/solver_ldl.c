@@ -24,12 +24,24 @@ static int ldl_factor_fn(mb_solver *s, const mb_real *Kx) {
   return rc ? MB_ERR_SINGULAR : MB_OK;
 }
 
+/* Every check_every-th solve (the first included) computes the residual and
+ * refines; the others are the single pass of a library LDL^T.  When a checked
+ * solve finds the single pass above MB_LDL_PASS_TOL (static pivots on a badly
+ * scaled K: a slender body's tiny inertia), every later solve refines.  Models
+ * with weighted rows refine on every solve whatever check_every says (the
+ * emitted solve does), they only report less often. */
 static int ldl_solve_fn(mb_solver *s, mb_real *b) {
   ldl_solver *l = (ldl_solver *)s;
-  mb_real res = 0;
-  int rc = l->m->ldl_solve(l->m, l->Kx, l->work, b, &res);
-  s->residual = res;
-  if (!(res <= s->residual_max)) s->residual_max = res;
+  int check = s->check_every <= 1 || s->refine_always || s->solves % s->check_every == 0;
+  s->solves++;
+  if (!check) return l->m->ldl_solve(l->m, l->Kx, l->work, b, NULL);
+  mb_real res[2] = {0, 0};
+  int rc = l->m->ldl_solve(l->m, l->Kx, l->work, b, res);
+  s->residual = res[0];
+  s->residual_checks++;
+  if (!(res[0] <= s->residual_max)) s->residual_max = res[0];
+  if (!(res[1] <= s->residual_pass_max)) s->residual_pass_max = res[1];
+  if (!(res[1] <= MB_LDL_PASS_TOL)) s->refine_always = 1;
   return rc;
 }
 
@@ -51,6 +63,7 @@ mb_solver *mb_solver_ldl(const mb_model *m) {
   l->base.solve = ldl_solve_fn;
   l->base.destroy = ldl_destroy_fn;
   l->base.bad_pivot = -1;
+  l->base.check_every = m->ldl_exact ? MB_LDL_CHECK_EVERY : 1;
   l->m = m;
   l->Kx = calloc((size_t)m->nnz + 1, sizeof(mb_real));
   l->work = calloc(m->ldl_worksize + 1, sizeof(mb_real));

@@ -39,6 +39,7 @@ compile_model() {
 
 for t in tests/test_*.c; do
   name=$(basename "$t" .c)
+  [[ -n ${ONLY:-} && $name != $ONLY ]] && continue # ONLY=test_ldl: one test (or a glob)
   models=$(sed -n 's|^// models: *||p' "$t" | head -1)
   srcs=(); incs=()
   ok=1
@@ -64,6 +65,7 @@ done
 for t in tests/test_*.sh; do
   [ -e "$t" ] || continue
   name=$(basename "$t" .sh)
+  [[ -n ${ONLY:-} && $name != $ONLY ]] && continue
   if out=$(bash "$t" 2>&1); then
     echo "$name: ok"; passed=$((passed + 1))
   else
