@@ -868,37 +868,13 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
   fputs("/* t <- (L D L^T)^-1 t */\n", f);
   fputs("static void ldl_lsolve(const mb_real *restrict Lx, const mb_real *restrict Dinv, mb_real *restrict t) {\n", f);
   fputs("  /* forward: L y = t, row by row */\n", f);
-  {
-    /* rows of L: the entries (i, j) of column j, in the order of j */
-    int *cnt = calloc((size_t)n + 1, sizeof(int)), *rp = calloc((size_t)n + 1, sizeof(int));
-    int *rq = malloc(sizeof(int) * (size_t)(p->nnzL + 1));
-    if (!cnt || !rp || !rq) { free(cnt); free(rp); free(rq); return; }
-    for (long q = 0; q < p->nnzL; q++) rp[p->Li[q] + 1]++;
-    for (int i = 0; i < n; i++) rp[i + 1] += rp[i];
-    for (int j = 0; j < n; j++)
-      for (int q = p->Lp[j]; q < p->Lp[j + 1]; q++) rq[rp[p->Li[q]] + cnt[p->Li[q]]++] = q;
-    for (int i = 0; i < n; i++) {
-      int len = rp[i + 1] - rp[i];
-      if (!len) continue;
-      int *col = malloc(sizeof(int) * (size_t)len), *lq = malloc(sizeof(int) * (size_t)len);
-      if (!col || !lq) { free(col); free(lq); break; }
-      for (int k = 0; k < len; k++) {
-        lq[k] = rq[rp[i] + k];
-        /* the column of entry q: the j with Lp[j] <= q < Lp[j + 1] */
-        int lo = 0, hi = n - 1;
-        while (lo < hi) {
-          int mid = (lo + hi + 1) / 2;
-          if (p->Lp[mid] <= lq[k]) lo = mid; else hi = mid - 1;
-        }
-        col[k] = lo;
-      }
-      fprintf(f, "  t[%d] -= ", i);
-      emit_sum(f, "Lx[%d] * t[%d]", lq, col, len);
-      fputs(";\n", f);
-      free(col);
-      free(lq);
-    }
-    free(cnt); free(rp); free(rq);
+  /* row i of L from the plan (the factorization's rows): columns Rj at Lx[Rpos] */
+  for (int i = 0; i < n; i++) {
+    int len = p->Rp[i + 1] - p->Rp[i];
+    if (!len) continue;
+    fprintf(f, "  t[%d] -= ", i);
+    emit_sum(f, "Lx[%d] * t[%d]", p->Rpos + p->Rp[i], p->Rj + p->Rp[i], len);
+    fputs(";\n", f);
   }
   fputs("  /* diagonal: z = D^-1 y */\n", f);
   for (int k = 0; k < n; k++) fprintf(f, "  t[%d] *= Dinv[%d];\n", k, k);
