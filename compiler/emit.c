@@ -73,6 +73,18 @@ static void loc_comment(FILE *f, const lmodel *L, ir_loc loc) {
 static void emit_flex_tables(FILE *f, const lmodel *L, int b);
 static void emit_flex_contract(FILE *f, const lmodel *L, int b);
 
+/* entry (i, l) of a flexible body's mass matrix from the moving blocks of
+ * mb_flex_assemble (runtime/mb_flex.h): AS = A S~, AS1 = A S1, cs.J, cs.Gw */
+static void flex_moving_entry(char *e, size_t size, int i, int l) {
+  int bi = i < 3 ? 0 : i < 6 ? 1 : 2, bl = l < 3 ? 0 : l < 6 ? 1 : 2;
+  if (bi > bl) { int t = i; i = l; l = t; t = bi; bi = bl; bl = t; } /* symmetric */
+  if (bi == 0 && bl == 1) snprintf(e, size, "-AS[%d]", 3 * i + (l - 3));
+  else if (bi == 0 && bl == 2) snprintf(e, size, "AS1[%d]", 3 * (l - 6) + i);
+  else if (bi == 1 && bl == 1) snprintf(e, size, "cs.J[%d]", 3 * (i - 3) + (l - 3));
+  else if (bi == 1 && bl == 2) snprintf(e, size, "cs.Gw[%d]", 3 * (l - 6) + (i - 3));
+  else snprintf(e, size, "0 /* constant block */");
+}
+
 /* the tables: bodies, markers, rows, forces, profiles, outputs */
 static void emit_tables(FILE *f, const lmodel *L) {
   const mb_model *m = &L->m;
@@ -462,14 +474,19 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
     fprintf(f, "  /* body '%s' */\n", B->name);
     if (B->kind == MB_BODY_FLEXIBLE) {
       int nbk = 6 + B->nm;
-      fprintf(f, "  {\n    mb_real Mb[%d];\n    mb_flex_step cs;\n    flex%d_contract(q + %d, v + %d, &cs);\n"
-                 "    mb_flex_assemble(&flex%d, &cs, &f[%d], q + %d, v + %d, (const mb_real[3])",
-              nbk * nbk, b, B->qadr + 7, B->vadr + 6, b, b, B->qadr + 7, B->vadr + 6);
+      fprintf(f, "  {\n    mb_real AS[9], AS1[%d];\n    mb_flex_step cs;\n    flex%d_contract(q + %d, v + %d, &cs);\n"
+                 "    mb_flex_forces(&flex%d, &cs, &f[%d], q + %d, v + %d, (const mb_real[3])",
+              3 * B->nm, b, B->qadr + 7, B->vadr + 6, b, b, B->qadr + 7, B->vadr + 6);
       vec(f, m->gravity, 3);
-      fprintf(f, ", Mb, rhs + %d);\n", B->vadr);
+      fprintf(f, ", rhs + %d);\n", B->vadr);
+      fprintf(f, "    /* the mass blocks that move (mb_flex_assemble without m I and Mff, set by init) */\n"
+                 "    mb_flex_mass_moving(&flex%d, &cs, &f[%d], AS, AS1);\n", b, b);
       for (int i = 0; i < nbk * nbk; i++)
-        if (B->mslotf[i] >= 0 && flex_mass_entry(B->flex, i / nbk, i % nbk) == 2)
-          fprintf(f, "    Kx[%d] = Mb[%d];\n", B->mslotf[i], i);
+        if (B->mslotf[i] >= 0 && flex_mass_entry(B->flex, i / nbk, i % nbk) == 2) {
+          char e[48];
+          flex_moving_entry(e, sizeof e, i / nbk, i % nbk);
+          fprintf(f, "    Kx[%d] = %s;\n", B->mslotf[i], e);
+        }
       fputs("  }\n", f);
       continue;
     }

@@ -70,7 +70,7 @@ static long block_work(const ldl_plan *p, int e) { return 42L + 6L * (p->esp[e +
 /* the massless bodies' workspace: pi (r), Du^-1 (36), W = D_SU Du^-1 (6 per slot) */
 static long ml_work(const ldl_plan *p, int e) {
   long r = p->mlrp[e + 1] - p->mlrp[e];
-  return r + 36 + 6 * (r - 6);
+  return r + 36 + 6 * (r - 6) + 1; /* pi, Du^-1, W, which rows (1: the compile-time ones) */
 }
 
 /* largest r and r x ny over the massless bodies (their scratch) */
@@ -638,6 +638,154 @@ static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
 
 /* ------------------------------------------------------- massless bodies */
 
+/* workspace offset of massless body e's factors (pi, Du^-1, W, which rows) */
+static long ml_ws(const ldl_plan *p, int e) {
+  int rmax;
+  long dmax;
+  ml_max(p, &rmax, &dmax);
+  long w = ml_base(p) + p->nnz1 + p->n + dmax;
+  for (int k = 0; k < e; k++) w += ml_work(p, k);
+  return w;
+}
+
+/* Kx slot of D_RU (row at position k of R, column c of U) and of D_RY */
+static int ml_du(const ldl_plan *p, int e, int k, int c) { return p->mldu[6 * (p->mlrp[e] + k) + c]; }
+static int ml_dy(const ldl_plan *p, int e, int k, int t) {
+  return p->mldy[p->mldyp[e] + (long)(p->mlyp[e + 1] - p->mlyp[e]) * k + t];
+}
+static int ml_hy(const ldl_plan *p, int e, int k) {
+  int any = 0;
+  for (int t = 0; t < p->mlyp[e + 1] - p->mlyp[e]; t++) any |= ml_dy(p, e, k, t) >= 0;
+  return any;
+}
+
+/* ldl_mlN_fixed: ldl_ml_pivoting with the rows partial pivoting chose at t = 0
+ * (plan mlpi0), every index a constant and every sum in the same order, so
+ * that it gives the same numbers; it declines (returns 0) when those rows no
+ * longer suit: Du singular, or |W| above LDL_ML_WMAX (the other rows, in
+ * terms of the chosen ones, grow) */
+static void emit_ml_fixed_factor(FILE *f, const ldl_plan *p) {
+  fputs("#define LDL_ML_WMAX 4 /* see ldl_mlN_fixed */\n", f);
+  for (int e = 0; e < p->nml; e++) {
+    int r0 = p->mlrp[e], r = p->mlrp[e + 1] - r0, ny = p->mlyp[e + 1] - p->mlyp[e];
+    const int *pi = p->mlpi0 + r0;
+    fprintf(f, "/* massless body %d with its rows at t = 0 (positions in R):", e);
+    for (int k = 0; k < r; k++) fprintf(f, " %d", pi[k]);
+    fprintf(f, ";\n * 1, or 0 when they no longer suit and ldl_ml_pivoting must choose */\n"
+               "static int ldl_ml%d_fixed(const mb_real *Kx, mb_real *work) {\n"
+               "  mb_real *K1 = work + LDL_K1, *ws = work + %ld, *Di = ws + %d, *W = Di + 36;\n"
+               "  const mb_real Du[36] = {", e, ml_ws(p, e), r);
+    for (int i = 0; i < 6; i++)
+      for (int c = 0; c < 6; c++) {
+        int sl = ml_du(p, e, pi[i], c);
+        if (sl >= 0) fprintf(f, "%sKx[%d]", 6 * i + c ? ", " : "", sl);
+        else fprintf(f, "%s0", 6 * i + c ? ", " : "");
+      }
+    fputs("};\n  (void)K1;\n  if (ldl_inv6(Du, Di)) return 0;\n", f);
+    for (int i = 0; i < r - 6; i++)
+      for (int c = 0; c < 6; c++) {
+        int any = 0;
+        fprintf(f, "  W[%d] = ", 6 * i + c);
+        for (int k = 0; k < 6; k++) {
+          int sl = ml_du(p, e, pi[6 + i], k);
+          if (sl < 0) continue;
+          fprintf(f, "%sKx[%d] * Di[%d]", any ? " + " : "", sl, 6 * k + c);
+          any = 1;
+        }
+        fputs(any ? ";\n" : "0;\n", f);
+      }
+    fprintf(f, "  for (int k = 0; k < %d; k++) if (!(fabs(W[k]) <= LDL_ML_WMAX)) return 0;\n", 6 * (r - 6));
+    for (int i = 0; i < r - 6; i++)
+      for (int y = 0; y < ny; y++) {
+        long kk = p->mlkp[e] + (long)i * ny + y;
+        int sl = ml_dy(p, e, pi[6 + i], y);
+        fprintf(f, "  K1[%d] = ", p->mlk[2 * kk]);
+        if (ml_hy(p, e, pi[6 + i]) && sl >= 0) fprintf(f, "Kx[%d]", sl);
+        else fputs("0", f);
+        for (int c = 0; c < 6; c++) {
+          int sc = ml_dy(p, e, pi[c], y);
+          if (!ml_hy(p, e, pi[c]) || sc < 0) continue;
+          fprintf(f, " - W[%d] * Kx[%d]", 6 * i + c, sc);
+        }
+        fprintf(f, ";\n  K1[%d] = K1[%d];\n", p->mlk[2 * kk + 1], p->mlk[2 * kk]);
+      }
+    for (int k = 0; k < r; k++) fprintf(f, "  ws[%d] = %d;\n", k, pi[k]);
+    fprintf(f, "  LDL_ML_FIXED(&ldl_ml[%d], ws) = 1;\n  return 1;\n}\n\n", e);
+  }
+}
+
+/* ldl_ml_rhs_pivoting of body e with its rows at t = 0, when the factorization used them */
+static void emit_ml_fixed_rhs(FILE *f, const ldl_plan *p, int e) {
+  int r0 = p->mlrp[e], r = p->mlrp[e + 1] - r0, y0 = p->mlyp[e], ny = p->mlyp[e + 1] - y0;
+  const int *pi = p->mlpi0 + r0, *R = p->mlR + r0, *T = p->mlT + r0 - 6 * e, *u = p->mlu[e], *Y = p->mlY + y0;
+  long w = ml_ws(p, e);
+  fprintf(f, "  if (LDL_ML_FIXED(&ldl_ml[%d], (work + %ld))) { /* body %d, its rows at t = 0 */\n"
+             "    const mb_real *Di = work + %ld, *W = Di + 36;\n    mb_real z[6];\n    (void)W;\n", e, w, e, w + r);
+  for (int k = 0; k < r; k++) fprintf(f, "    r1[%d] = 0;\n", R[k]);
+  for (int i = 0; i < r - 6; i++) {
+    fprintf(f, "    r1[%d] = r[%d]", T[i], R[pi[6 + i]]);
+    for (int c = 0; c < 6; c++) fprintf(f, " - W[%d] * r[%d]", 6 * i + c, R[pi[c]]);
+    fputs(";\n", f);
+  }
+  for (int c = 0; c < 6; c++) {
+    fprintf(f, "    z[%d] = ", c);
+    for (int k = 0; k < 6; k++) fprintf(f, "%sDi[%d] * r[%d]", k ? " + " : "", 6 * k + c, u[k]);
+    fputs(";\n", f);
+  }
+  for (int y = 0; y < ny; y++) {
+    int any = 0;
+    for (int c = 0; c < 6; c++) {
+      int sl = ml_dy(p, e, pi[c], y);
+      if (sl < 0) continue;
+      if (!any) fprintf(f, "    r1[%d] -= ", Y[y]);
+      fprintf(f, "%sKx[%d] * z[%d]", any ? " + " : "", sl, c);
+      any = 1;
+    }
+    if (any) fputs(";\n", f);
+  }
+  for (int c = 0; c < 6; c++) fprintf(f, "    r1[%d] = 0;\n", u[c]);
+  fprintf(f, "  } else {\n    ldl_ml_rhs_pivoting(&ldl_ml[%d], Kx, work, r, r1);\n  }\n", e);
+}
+
+/* ldl_ml_back_pivoting of body e with its rows at t = 0, when the factorization used them */
+static void emit_ml_fixed_back(FILE *f, const ldl_plan *p, int e) {
+  int r0 = p->mlrp[e], r = p->mlrp[e + 1] - r0, y0 = p->mlyp[e], ny = p->mlyp[e + 1] - y0;
+  const int *pi = p->mlpi0 + r0, *R = p->mlR + r0, *T = p->mlT + r0 - 6 * e, *u = p->mlu[e], *Y = p->mlY + y0;
+  long w = ml_ws(p, e);
+  fprintf(f, "  if (LDL_ML_FIXED(&ldl_ml[%d], (work + %ld))) { /* body %d, its rows at t = 0 */\n"
+             "    const mb_real *Di = work + %ld;\n    mb_real mu[%d], y[6], z[6];\n    (void)mu;\n", e, w, e, w + r,
+          r > 6 ? r - 6 : 1);
+  for (int i = 0; i < r - 6; i++) fprintf(f, "    mu[%d] = d[%d];\n", i, T[i]);
+  for (int c = 0; c < 6; c++) {
+    fprintf(f, "    y[%d] = r[%d]", c, R[pi[c]]);
+    for (int t = 0; t < ny; t++) {
+      int sl = ml_dy(p, e, pi[c], t);
+      if (sl >= 0) fprintf(f, " - Kx[%d] * d[%d]", sl, Y[t]);
+    }
+    fputs(";\n", f);
+  }
+  for (int k = 0; k < 6; k++) {
+    fprintf(f, "    z[%d] = r[%d]", k, u[k]);
+    for (int i = 0; i < r - 6; i++) {
+      int sl = ml_du(p, e, pi[6 + i], k);
+      if (sl >= 0) fprintf(f, " - Kx[%d] * mu[%d]", sl, i);
+    }
+    fputs(";\n", f);
+  }
+  for (int k = 0; k < 6; k++) {
+    fprintf(f, "    d[%d] = ", u[k]);
+    for (int c = 0; c < 6; c++) fprintf(f, "%sDi[%d] * y[%d]", c ? " + " : "", 6 * k + c, c);
+    fputs(";\n", f);
+  }
+  for (int c = 0; c < 6; c++) {
+    fprintf(f, "    d[%d] = ", R[pi[c]]);
+    for (int k = 0; k < 6; k++) fprintf(f, "%sDi[%d] * z[%d]", k ? " + " : "", 6 * k + c, k);
+    fputs(";\n", f);
+  }
+  for (int i = 0; i < r - 6; i++) fprintf(f, "    d[%d] = mu[%d];\n", R[pi[6 + i]], i);
+  fprintf(f, "  } else {\n    ldl_ml_back_pivoting(&ldl_ml[%d], Kx, work, r, d);\n  }\n", e);
+}
+
 /* stage 1: the massless bodies that are not welded (see order.h): tables,
  * the elimination, its right side and the recovery of their unknowns */
 static void emit_massless(FILE *f, const lmodel *L, const ldl_plan *p) {
@@ -702,120 +850,145 @@ static void emit_massless(FILE *f, const lmodel *L, const ldl_plan *p) {
   fprintf(f, "#define LDL_NK1 %d\n", p->nnz1);
   if (!p->straight) int_array(f, "ldl_K1src", p->K1map, p->nnz1);
   emit_inv6(f);
+  fputs("/* where a body's factors came from: 1 its compile-time rows (ldl_mlN_static), 0 pivoting */\n"
+        "#define LDL_ML_FIXED(B, ws) ws[(B)->r + 36 + 6 * ((B)->r - 6)]\n\n", f);
+  fputs("/* body B by partial pivoting on D_RU (any configuration): Du^-1, W and the slot\n"
+        " * rows of K1; 0, or 1 + a column of B if its rows have lost rank 6 */\n"
+        "static int ldl_ml_pivoting(const ldl_mlb *B, const mb_real *Kx, mb_real *work) {\n"
+        "  mb_real *K1 = work + LDL_K1, *D = work + LDL_MLD;\n"
+        "  int r = B->r, ny = B->ny, pi[LDL_MLR];\n"
+        "  mb_real A[6 * LDL_MLR], G[6 * LDL_MLR], Du[36], amax = 0;\n"
+        "  mb_real *ws = work + B->w, *Di = ws + r, *W = Di + 36;\n"
+        "  LDL_ML_FIXED(B, ws) = 0;\n"
+        "  for (int i = 0; i < 6 * r; i++) {\n"
+        "    A[i] = G[i] = B->du[i] >= 0 ? Kx[B->du[i]] : 0;\n"
+        "    if (fabs(A[i]) > amax) amax = fabs(A[i]);\n  }\n"
+        "  for (int i = 0; i < r; i++) /* the rows without Y entries are never read */\n"
+        "    if (B->hy[i])\n"
+        "      for (int y = ny * i; y < ny * (i + 1); y++) D[y] = B->dy[y] >= 0 ? Kx[B->dy[y]] : 0;\n"
+        "  /* P: partial pivoting on D_RU chooses 6 independent rows */\n"
+        "  for (int i = 0; i < r; i++) pi[i] = i;\n"
+        "  for (int k = 0; k < 6; k++) {\n"
+        "    int pr = k;\n"
+        "    for (int i = k + 1; i < r; i++) if (fabs(G[6 * i + k]) > fabs(G[6 * pr + k])) pr = i;\n"
+        "    if (!(fabs(G[6 * pr + k]) > 1e-12 * amax)) return 1 + B->u[0];\n"
+        "    if (pr != k) {\n"
+        "      int t = pi[k]; pi[k] = pi[pr]; pi[pr] = t;\n"
+        "      for (int j = 0; j < 6; j++) { mb_real g = G[6 * k + j]; G[6 * k + j] = G[6 * pr + j]; G[6 * pr + j] = g; }\n"
+        "    }\n"
+        "    for (int i = k + 1; i < r; i++) {\n"
+        "      mb_real l = G[6 * i + k] / G[6 * k + k];\n"
+        "      for (int j = k; j < 6; j++) G[6 * i + j] -= l * G[6 * k + j];\n    }\n  }\n"
+        "  for (int i = 0; i < r; i++) ws[i] = (mb_real)pi[i];\n"
+        "  for (int i = 0; i < 6; i++)\n"
+        "    for (int c = 0; c < 6; c++) Du[6 * i + c] = A[6 * pi[i] + c];\n"
+        "  if (ldl_inv6(Du, Di)) return 1 + B->u[0];\n"
+        "  /* slot i: row pi[6 + i] less W times the P rows */\n"
+        "  for (int i = 0; i < r - 6; i++) {\n"
+        "    const mb_real *a = A + 6 * pi[6 + i];\n"
+        "    const int *k1 = B->k1 + 2 * ny * i;\n"
+        "    for (int c = 0; c < 6; c++) {\n"
+        "      mb_real v = 0;\n"
+        "      for (int k = 0; k < 6; k++) v += a[k] * Di[6 * k + c];\n"
+        "      W[6 * i + c] = v;\n    }\n"
+        "    /* rows without Y entries add nothing: the same sums, in the same order */\n"
+        "    const mb_real *ds = D + ny * pi[6 + i];\n"
+        "    for (int y = 0; y < ny; y++) K1[k1[2 * y]] = B->hy[pi[6 + i]] ? ds[y] : 0;\n"
+        "    for (int c = 0; c < 6; c++) {\n"
+        "      if (!B->hy[pi[c]]) continue;\n"
+        "      const mb_real w = W[6 * i + c], *dp = D + ny * pi[c];\n"
+        "      for (int y = 0; y < ny; y++) K1[k1[2 * y]] -= w * dp[y];\n    }\n"
+        "    for (int y = 0; y < ny; y++) K1[k1[2 * y + 1]] = K1[k1[2 * y]];\n  }\n  return 0;\n}\n\n", f);
+  if (p->straight) emit_ml_fixed_factor(f, p);
   fputs("/* K1 (work + LDL_K1) from Kx; returns 0, or 1 + a column of a massless body whose\n"
         " * rows have lost rank 6 on it */\n"
         "static int ldl_massless(const mb_real *Kx, mb_real *work) {\n"
-        "  mb_real *K1 = work + LDL_K1, *D = work + LDL_MLD;\n", f);
+        "  mb_real *K1 = work + LDL_K1;\n", f);
   if (p->straight) { /* the gather with constant indices (the computed entries follow) */
     for (int q = 0; q < p->nnz1; q++) {
       int src = p->K1map[q];
       if (src >= 0) fprintf(f, "  K1[%d] = Kx[%d];\n", q, src);
       else if (src != -4) fprintf(f, "  K1[%d] = %s;\n", q, src == -2 ? "1" : src == -3 ? "-1" : "0");
     }
+    for (int e = 0; e < p->nml; e++)
+      fprintf(f, "  if (!ldl_ml%d_fixed(Kx, work)) {\n"
+                 "    int rc = ldl_ml_pivoting(&ldl_ml[%d], Kx, work);\n    if (rc) return rc;\n  }\n", e, e);
+    fputs("  return 0;\n}\n\n", f);
   } else {
     fputs("  for (int q = 0; q < LDL_NK1; q++) {\n"
           "    int s = ldl_K1src[q];\n"
-          "    K1[q] = s >= 0 ? Kx[s] : s == -2 ? 1 : s == -3 ? -1 : 0;\n  }\n", f);
+          "    K1[q] = s >= 0 ? Kx[s] : s == -2 ? 1 : s == -3 ? -1 : 0;\n  }\n"
+          "  for (int e = 0; e < LDL_NML; e++) {\n"
+          "    int rc = ldl_ml_pivoting(&ldl_ml[e], Kx, work);\n    if (rc) return rc;\n  }\n"
+          "  return 0;\n}\n\n", f);
   }
-  fputs(
-        "  for (int e = 0; e < LDL_NML; e++) {\n"
-        "    const ldl_mlb *B = &ldl_ml[e];\n"
-        "    int r = B->r, ny = B->ny, pi[LDL_MLR];\n"
-        "    mb_real A[6 * LDL_MLR], G[6 * LDL_MLR], Du[36], amax = 0;\n"
-        "    mb_real *ws = work + B->w, *Di = ws + r, *W = Di + 36;\n"
-        "    for (int i = 0; i < 6 * r; i++) {\n"
-        "      A[i] = G[i] = B->du[i] >= 0 ? Kx[B->du[i]] : 0;\n"
-        "      if (fabs(A[i]) > amax) amax = fabs(A[i]);\n    }\n"
-        "    for (int i = 0; i < r; i++) /* the rows without Y entries are never read */\n"
-        "      if (B->hy[i])\n"
-        "        for (int y = ny * i; y < ny * (i + 1); y++) D[y] = B->dy[y] >= 0 ? Kx[B->dy[y]] : 0;\n"
-        "    /* P: partial pivoting on D_RU chooses 6 independent rows */\n"
-        "    for (int i = 0; i < r; i++) pi[i] = i;\n"
-        "    for (int k = 0; k < 6; k++) {\n"
-        "      int pr = k;\n"
-        "      for (int i = k + 1; i < r; i++) if (fabs(G[6 * i + k]) > fabs(G[6 * pr + k])) pr = i;\n"
-        "      if (!(fabs(G[6 * pr + k]) > 1e-12 * amax)) return 1 + B->u[0];\n"
-        "      if (pr != k) {\n"
-        "        int t = pi[k]; pi[k] = pi[pr]; pi[pr] = t;\n"
-        "        for (int j = 0; j < 6; j++) { mb_real g = G[6 * k + j]; G[6 * k + j] = G[6 * pr + j]; G[6 * pr + j] = g; }\n"
-        "      }\n"
-        "      for (int i = k + 1; i < r; i++) {\n"
-        "        mb_real l = G[6 * i + k] / G[6 * k + k];\n"
-        "        for (int j = k; j < 6; j++) G[6 * i + j] -= l * G[6 * k + j];\n      }\n    }\n"
-        "    for (int i = 0; i < r; i++) ws[i] = (mb_real)pi[i];\n"
-        "    for (int i = 0; i < 6; i++)\n"
-        "      for (int c = 0; c < 6; c++) Du[6 * i + c] = A[6 * pi[i] + c];\n"
-        "    if (ldl_inv6(Du, Di)) return 1 + B->u[0];\n"
-        "    /* slot i: row pi[6 + i] less W times the P rows */\n"
-        "    for (int i = 0; i < r - 6; i++) {\n"
-        "      const mb_real *a = A + 6 * pi[6 + i];\n"
-        "      const int *k1 = B->k1 + 2 * ny * i;\n"
-        "      for (int c = 0; c < 6; c++) {\n"
-        "        mb_real v = 0;\n"
-        "        for (int k = 0; k < 6; k++) v += a[k] * Di[6 * k + c];\n"
-        "        W[6 * i + c] = v;\n      }\n"
-        "      /* rows without Y entries add nothing: the same sums, in the same order */\n"
-        "      const mb_real *ds = D + ny * pi[6 + i];\n"
-        "      for (int y = 0; y < ny; y++) K1[k1[2 * y]] = B->hy[pi[6 + i]] ? ds[y] : 0;\n"
-        "      for (int c = 0; c < 6; c++) {\n"
-        "        if (!B->hy[pi[c]]) continue;\n"
-        "        const mb_real w = W[6 * i + c], *dp = D + ny * pi[c];\n"
-        "        for (int y = 0; y < ny; y++) K1[k1[2 * y]] -= w * dp[y];\n      }\n"
-        "      for (int y = 0; y < ny; y++) K1[k1[2 * y + 1]] = K1[k1[2 * y]];\n    }\n  }\n  return 0;\n}\n\n", f);
-  fputs("/* r1 = the right side of K1 from r: g1_t = g_s - W g_p, f1_y = f_y - D_PY^T Du^-T f_u */\n"
+  fputs("/* body B's part of r1 (the right side of K1, from r): g1_t = g_s - W g_p,\n"
+        " * f1_y = f_y - D_PY^T Du^-T f_u, with the rows ldl_ml_pivoting chose */\n"
+        "static void ldl_ml_rhs_pivoting(const ldl_mlb *B, const mb_real *Kx, const mb_real *work,\n"
+        "                                const mb_real *r, mb_real *r1) {\n"
+        "  const mb_real *ws = work + B->w, *Di = ws + B->r, *W = Di + 36;\n"
+        "  int nr = B->r, ny = B->ny, pi[LDL_MLR];\n"
+        "  mb_real z[6];\n"
+        "  for (int i = 0; i < nr; i++) { pi[i] = (int)ws[i]; r1[B->R[i]] = 0; }\n"
+        "  for (int i = 0; i < nr - 6; i++) {\n"
+        "    mb_real v = r[B->R[pi[6 + i]]];\n"
+        "    for (int c = 0; c < 6; c++) v -= W[6 * i + c] * r[B->R[pi[c]]];\n"
+        "    r1[B->T[i]] = v;\n  }\n"
+        "  for (int c = 0; c < 6; c++) {\n"
+        "    z[c] = 0;\n"
+        "    for (int k = 0; k < 6; k++) z[c] += Di[6 * k + c] * r[B->u[k]];\n  }\n"
+        "  for (int y = 0; y < ny; y++) {\n"
+        "    mb_real v = 0;\n"
+        "    for (int c = 0; c < 6; c++) {\n"
+        "      int s = B->dy[ny * pi[c] + y];\n"
+        "      if (s >= 0) v += Kx[s] * z[c];\n    }\n"
+        "    r1[B->Y[y]] -= v;\n  }\n"
+        "  for (int c = 0; c < 6; c++) r1[B->u[c]] = 0;\n}\n\n", f);
+  fputs("/* r1 = the right side of K1 from r */\n"
         "static void ldl_ml_rhs(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *r1) {\n"
-        "  for (int i = 0; i < LDL_N; i++) r1[i] = r[i];\n"
-        "  for (int e = 0; e < LDL_NML; e++) {\n"
-        "    const ldl_mlb *B = &ldl_ml[e];\n"
-        "    const mb_real *ws = work + B->w, *Di = ws + B->r, *W = Di + 36;\n"
-        "    int nr = B->r, ny = B->ny, pi[LDL_MLR];\n"
-        "    mb_real z[6];\n"
-        "    for (int i = 0; i < nr; i++) { pi[i] = (int)ws[i]; r1[B->R[i]] = 0; }\n"
+        "  for (int i = 0; i < LDL_N; i++) r1[i] = r[i];\n", f);
+  if (p->straight)
+    for (int e = 0; e < p->nml; e++) emit_ml_fixed_rhs(f, p, e);
+  else
+    fputs("  for (int e = 0; e < LDL_NML; e++) ldl_ml_rhs_pivoting(&ldl_ml[e], Kx, work, r, r1);\n", f);
+  fputs("}\n\n", f);
+  fputs("/* body B's unknowns from d (the solution of K1): a_u = Du^-1 (g_p - D_PY a_y),\n"
+        " * lambda_s = mu, lambda_p = Du^-T (f_u - D_SU^T mu), with the rows ldl_ml_pivoting chose */\n"
+        "static void ldl_ml_back_pivoting(const ldl_mlb *B, const mb_real *Kx, const mb_real *work,\n"
+        "                                 const mb_real *r, mb_real *d) {\n"
+        "  const mb_real *ws = work + B->w, *Di = ws + B->r;\n"
+        "  int nr = B->r, ny = B->ny, pi[LDL_MLR];\n"
+        "  mb_real mu[LDL_MLR], y[6], z[6];\n"
+        "  for (int i = 0; i < nr; i++) pi[i] = (int)ws[i];\n"
+        "  for (int i = 0; i < nr - 6; i++) mu[i] = d[B->T[i]];\n"
+        "  for (int c = 0; c < 6; c++) {\n"
+        "    mb_real v = r[B->R[pi[c]]];\n"
+        "    for (int t = 0; t < ny; t++) {\n"
+        "      int s = B->dy[ny * pi[c] + t];\n"
+        "      if (s >= 0) v -= Kx[s] * d[B->Y[t]];\n    }\n"
+        "    y[c] = v;\n  }\n"
+        "  for (int k = 0; k < 6; k++) {\n"
+        "    mb_real v = r[B->u[k]];\n"
         "    for (int i = 0; i < nr - 6; i++) {\n"
-        "      mb_real v = r[B->R[pi[6 + i]]];\n"
-        "      for (int c = 0; c < 6; c++) v -= W[6 * i + c] * r[B->R[pi[c]]];\n"
-        "      r1[B->T[i]] = v;\n    }\n"
-        "    for (int c = 0; c < 6; c++) {\n"
-        "      z[c] = 0;\n"
-        "      for (int k = 0; k < 6; k++) z[c] += Di[6 * k + c] * r[B->u[k]];\n    }\n"
-        "    for (int y = 0; y < ny; y++) {\n"
-        "      mb_real v = 0;\n"
-        "      for (int c = 0; c < 6; c++) {\n"
-        "        int s = B->dy[ny * pi[c] + y];\n"
-        "        if (s >= 0) v += Kx[s] * z[c];\n      }\n"
-        "      r1[B->Y[y]] -= v;\n    }\n"
-        "    for (int c = 0; c < 6; c++) r1[B->u[c]] = 0;\n  }\n}\n\n", f);
-  fputs("/* d (the solution of K1) into the solution of K: a_u = Du^-1 (g_p - D_PY a_y),\n"
-        " * lambda_s = mu, lambda_p = Du^-T (f_u - D_SU^T mu) */\n"
-        "static void ldl_ml_back(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *d) {\n"
-        "  for (int e = 0; e < LDL_NML; e++) {\n"
-        "    const ldl_mlb *B = &ldl_ml[e];\n"
-        "    const mb_real *ws = work + B->w, *Di = ws + B->r;\n"
-        "    int nr = B->r, ny = B->ny, pi[LDL_MLR];\n"
-        "    mb_real mu[LDL_MLR], y[6], z[6];\n"
-        "    for (int i = 0; i < nr; i++) pi[i] = (int)ws[i];\n"
-        "    for (int i = 0; i < nr - 6; i++) mu[i] = d[B->T[i]];\n"
-        "    for (int c = 0; c < 6; c++) {\n"
-        "      mb_real v = r[B->R[pi[c]]];\n"
-        "      for (int t = 0; t < ny; t++) {\n"
-        "        int s = B->dy[ny * pi[c] + t];\n"
-        "        if (s >= 0) v -= Kx[s] * d[B->Y[t]];\n      }\n"
-        "      y[c] = v;\n    }\n"
-        "    for (int k = 0; k < 6; k++) {\n"
-        "      mb_real v = r[B->u[k]];\n"
-        "      for (int i = 0; i < nr - 6; i++) {\n"
-        "        int s = B->du[6 * pi[6 + i] + k];\n"
-        "        if (s >= 0) v -= Kx[s] * mu[i];\n      }\n"
-        "      z[k] = v;\n    }\n"
-        "    for (int k = 0; k < 6; k++) {\n"
-        "      mb_real a = 0;\n"
-        "      for (int c = 0; c < 6; c++) a += Di[6 * k + c] * y[c];\n"
-        "      d[B->u[k]] = a;\n    }\n"
-        "    for (int c = 0; c < 6; c++) {\n"
-        "      mb_real l = 0;\n"
-        "      for (int k = 0; k < 6; k++) l += Di[6 * k + c] * z[k];\n"
-        "      d[B->R[pi[c]]] = l;\n    }\n"
-        "    for (int i = 0; i < nr - 6; i++) d[B->R[pi[6 + i]]] = mu[i];\n  }\n}\n\n", f);
+        "      int s = B->du[6 * pi[6 + i] + k];\n"
+        "      if (s >= 0) v -= Kx[s] * mu[i];\n    }\n"
+        "    z[k] = v;\n  }\n"
+        "  for (int k = 0; k < 6; k++) {\n"
+        "    mb_real a = 0;\n"
+        "    for (int c = 0; c < 6; c++) a += Di[6 * k + c] * y[c];\n"
+        "    d[B->u[k]] = a;\n  }\n"
+        "  for (int c = 0; c < 6; c++) {\n"
+        "    mb_real l = 0;\n"
+        "    for (int k = 0; k < 6; k++) l += Di[6 * k + c] * z[k];\n"
+        "    d[B->R[pi[c]]] = l;\n  }\n"
+        "  for (int i = 0; i < nr - 6; i++) d[B->R[pi[6 + i]]] = mu[i];\n}\n\n", f);
+  fputs("/* d (the solution of K1) into the solution of K */\n"
+        "static void ldl_ml_back(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *d) {\n", f);
+  if (p->straight)
+    for (int e = 0; e < p->nml; e++) emit_ml_fixed_back(f, p, e);
+  else
+    fputs("  for (int e = 0; e < LDL_NML; e++) ldl_ml_back_pivoting(&ldl_ml[e], Kx, work, r, d);\n", f);
+  fputs("}\n\n", f);
 }
 
 /* the public factorization: ||K||, the block pivots, then L D L^T of K_aug */

@@ -30,7 +30,7 @@ void ldl_plan_free(ldl_plan *p) {
   free(p->eb); free(p->eu); free(p->er); free(p->exp_); free(p->ex); free(p->esp); free(p->es);
   free(p->edu); free(p->edx); free(p->eeu); free(p->ekr); free(p->ekrp);
   free(p->Krp); free(p->Kri); free(p->Krmap);
-  free(p->mlb); free(p->mlu); free(p->mlrp); free(p->mlR); free(p->mlT); free(p->mlyp); free(p->mlY);
+  free(p->mlb); free(p->mlu); free(p->mlrp); free(p->mlR); free(p->mlT); free(p->mlpi0); free(p->mlyp); free(p->mlY);
   free(p->mldu); free(p->mldy); free(p->mldyp); free(p->mlk); free(p->mlkp);
   free(p->K1p); free(p->K1i); free(p->K1map);
   memset(p, 0, sizeof *p);
@@ -385,8 +385,9 @@ static int find_massless(const mb_model *m, const double *Kx, ldl_plan *p) {
   p->mldyp = calloc((size_t)nb + 2, sizeof(int));
   p->mlR = malloc(sizeof(int) * (size_t)(m->nc + 1));
   p->mlT = malloc(sizeof(int) * (size_t)(m->nc + 1));
+  p->mlpi0 = malloc(sizeof(int) * (size_t)(m->nc + 1));
   p->mlY = malloc(sizeof(int) * (size_t)(nb * 0 + nv * (nb + 1) + 1));
-  if (!weld || !p->mlb || !p->mlu || !p->mlrp || !p->mlyp || !p->mldyp || !p->mlR || !p->mlT || !p->mlY) goto done;
+  if (!weld || !p->mlb || !p->mlu || !p->mlrp || !p->mlyp || !p->mldyp || !p->mlR || !p->mlT || !p->mlpi0 || !p->mlY) goto done;
   int ne = 0, nr = 0, ny = 0, nt = 0;
   for (int b = 0; b < nb && !(env && !strcmp(env, "0")); b++) {
     const mb_body *B = &m->body[b];
@@ -428,7 +429,7 @@ static int find_massless(const mb_model *m, const double *Kx, ldl_plan *p) {
     }
     ok = !ml_eliminate(A, D, r, y, pi, Di, W, V);
     if (ok) {
-      for (int k = 0; k < r; k++) p->mlR[nr + k] = rows[k];
+      for (int k = 0; k < r; k++) { p->mlR[nr + k] = rows[k]; p->mlpi0[nr + k] = pi[k]; }
       for (int k = 6; k < r; k++) p->mlT[nt++] = rows[pi[k]];
       qsort(p->mlT + nt - (r - 6), (size_t)(r - 6), sizeof(int), int_cmp);
       for (int t = 0; t < y; t++) p->mlY[ny + t] = cols[t];

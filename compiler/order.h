@@ -75,6 +75,8 @@ typedef struct {
   int (*mlu)[6];     /* its 6 velocity columns */
   int *mlrp, *mlR;   /* rows R (K indices) of body b: mlR[mlrp[b]..mlrp[b+1]) */
   int *mlT;          /* slots: r - 6 per body, at mlrp[b] - 6 b */
+  int *mlpi0;        /* the order partial pivoting finds at t = 0 (positions in R,
+                        r per body at mlrp[b]): the straight-line code's rows */
   int *mlyp, *mlY;   /* columns Y: mlY[mlyp[b]..mlyp[b+1]) */
   int *mldu;         /* Kx slots of D_RU: 6 per row of R (-1: zero) */
   int *mldy;         /* Kx slots of D_RY: ny per row of R, at mldyp[b] */

@@ -49,6 +49,10 @@ int mb_sim_init(mb_sim *s, const mb_model *m, mb_solver *ls, const mb_settings *
   memset(s, 0, sizeof *s);
   s->m = m;
   s->ls = ls;
+  /* every factor() here gets s->Kx (or genalpha's iteration matrix), and
+     neither changes before the next factor(): s->Kx is evaluated again only
+     at a new q (then factored) or at the factored q (the same values) */
+  ls->kx_stable = 1;
   s->set = *set;
   if (s->set.integrator == MB_AUTO) s->set.integrator = mb_integrator_auto(m, set, NULL, 0);
   size_t ny = (size_t)(m->nq + m->nv);

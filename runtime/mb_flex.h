@@ -192,40 +192,28 @@ static inline void mb_flex_contract(const mb_flex *fx, const mb_real *w, const m
     }
 }
 
-/* The flexible body's mass matrix Mb ((6+nm)^2, row-major, coordinates
- * [rd; w'; wd]) and its forces fb (6+nm): gravity g (global), quadratic-velocity
- * terms, modal stiffness and damping, from the contractions c of
- * mb_flex_contract.  See the header comment. */
-static inline void mb_flex_assemble(const mb_flex *fx, const mb_flex_step *c, const mb_frame *f,
-                                    const mb_real *w, const mb_real *wd, const mb_real g[3],
-                                    mb_real *Mb, mb_real *fb) {
-  int nm = fx->nm, n = 6 + nm;
+/* The blocks of the flexible body's mass matrix that change with the motion
+ * and are not contractions already in c:  AS = A S~ (M_rth = -AS, M_thr =
+ * -AS^T) and AS1 = A S1 (3 x nm by columns; M_rf = AS1, M_fr = AS1^T).  The
+ * others are m I and Mff (constant), J (c->J) and M_thf (c->Gw). */
+static inline void mb_flex_mass_moving(const mb_flex *fx, const mb_flex_step *c, const mb_frame *f,
+                                       mb_real AS[9], mb_real *AS1) {
+  const mb_real *S = c->S;
+  mb_real Sx[9] = {0, -S[2], S[1], S[2], 0, -S[0], -S[1], S[0], 0};
+  mb_matmul3(f->A, Sx, AS);
+  for (int j = 0; j < fx->nm; j++) mb_mul3(f->A, fx->S1 + 3 * j, AS1 + 3 * j);
+}
+
+/* The flexible body's forces fb (6+nm), coordinates [rd; w'; wd]: gravity g
+ * (global), quadratic-velocity terms, modal stiffness and damping, from the
+ * contractions c of mb_flex_contract.  See the header comment. */
+static inline void mb_flex_forces(const mb_flex *fx, const mb_flex_step *c, const mb_frame *f,
+                                  const mb_real *w, const mb_real *wd, const mb_real g[3],
+                                  mb_real *fb) {
+  int nm = fx->nm;
   const mb_real *wl = f->wl, *S = c->S, *J = c->J;
   mb_real h = 0, H[9] = {0}, t[3], t2[3], Ag[3];
-  for (int i = 0; i < n * n; i++) Mb[i] = 0;
-  /* M_rr = m I, M_rth = -A S~, M_rf = A S1, M_thth = J, M_thf = [Gw_j] */
-  mb_real AS[9], Sx[9] = {0, -S[2], S[1], S[2], 0, -S[0], -S[1], S[0], 0};
-  mb_matmul3(f->A, Sx, AS);
-  for (int i = 0; i < 3; i++) {
-    Mb[n * i + i] = fx->mass;
-    for (int l = 0; l < 3; l++) {
-      Mb[n * i + 3 + l] = -AS[3 * i + l];
-      Mb[n * (3 + l) + i] = -AS[3 * i + l];
-      Mb[n * (3 + i) + 3 + l] = J[3 * i + l];
-    }
-  }
-  for (int j = 0; j < nm; j++) {
-    mb_real col[3];
-    const mb_real *thf = c->Gw + 3 * j;
-    mb_mul3(f->A, fx->S1 + 3 * j, col);
-    for (int i = 0; i < 3; i++) {
-      Mb[n * i + 6 + j] = Mb[n * (6 + j) + i] = col[i];
-      Mb[n * (3 + i) + 6 + j] = Mb[n * (6 + j) + 3 + i] = thf[i];
-    }
-    for (int l = 0; l < nm; l++) Mb[n * (6 + j) + 6 + l] = fx->Mff[nm * j + l];
-  }
-
-  /* forces: rigid-frame part */
+  /* rigid-frame part */
   mb_real wS[3];
   mb_wwa(wl, S, t);
   mb_cross3(wl, c->S1wd, t2);
@@ -258,6 +246,38 @@ static inline void mb_flex_assemble(const mb_flex *fx, const mb_flex_step *c, co
     fb[6 + j] = -(mb_dot3(wl, Bw) - ww * (B[0] + B[4] + B[8])) - 2 * mb_dot3(wl, c->Gd + 3 * j) +
                 mb_dot3(fx->S1 + 3 * j, Ag) - fx->stiffness[j] * w[j] - fx->damping[j] * wd[j];
   }
+}
+
+/* The flexible body's mass matrix Mb ((6+nm)^2, row-major, coordinates
+ * [rd; w'; wd]) and its forces fb (6+nm) (mb_flex_forces), from the
+ * contractions c of mb_flex_contract.  The generated code stores the moving
+ * blocks (mb_flex_mass_moving, c->J, c->Gw) straight into K instead. */
+static inline void mb_flex_assemble(const mb_flex *fx, const mb_flex_step *c, const mb_frame *f,
+                                    const mb_real *w, const mb_real *wd, const mb_real g[3],
+                                    mb_real *Mb, mb_real *fb) {
+  int nm = fx->nm, n = 6 + nm;
+  const mb_real *J = c->J;
+  mb_real AS[9], AS1[3 * MB_MAX_MODES];
+  for (int i = 0; i < n * n; i++) Mb[i] = 0;
+  /* M_rr = m I, M_rth = -A S~, M_rf = A S1, M_thth = J, M_thf = [Gw_j] */
+  mb_flex_mass_moving(fx, c, f, AS, AS1);
+  for (int i = 0; i < 3; i++) {
+    Mb[n * i + i] = fx->mass;
+    for (int l = 0; l < 3; l++) {
+      Mb[n * i + 3 + l] = -AS[3 * i + l];
+      Mb[n * (3 + l) + i] = -AS[3 * i + l];
+      Mb[n * (3 + i) + 3 + l] = J[3 * i + l];
+    }
+  }
+  for (int j = 0; j < nm; j++) {
+    const mb_real *col = AS1 + 3 * j, *thf = c->Gw + 3 * j;
+    for (int i = 0; i < 3; i++) {
+      Mb[n * i + 6 + j] = Mb[n * (6 + j) + i] = col[i];
+      Mb[n * (3 + i) + 6 + j] = Mb[n * (6 + j) + 3 + i] = thf[i];
+    }
+    for (int l = 0; l < nm; l++) Mb[n * (6 + j) + 6 + l] = fx->Mff[nm * j + l];
+  }
+  mb_flex_forces(fx, c, f, w, wd, g, fb);
 }
 
 /* mb_flex_assemble of mb_flex_contract (the generic path's one call) */

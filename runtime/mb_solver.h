@@ -27,6 +27,10 @@ typedef struct mb_solver {
   int check_every, refine_always;
   long solves, residual_checks;
   double residual_pass_max;
+  /* set by a caller that leaves the Kx it passed to factor() unchanged until
+     the next factor() (the simulation drivers do): the ldl solver then reads
+     that Kx in its solves instead of keeping a copy (nnz values per factor) */
+  int kx_stable;
   /* klu: the reciprocal condition estimate (min |u_ii| / max |u_ii|) of the
      last factorization with fresh pivots: with the pivot order of an earlier
      configuration a small u_ii says little; 0 when not estimated */

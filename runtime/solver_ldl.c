@@ -1,8 +1,10 @@
 /* solver_ldl.c: K x = b with the LDL^T that the compiler emitted with the
  * model (m->ldl_factor / m->ldl_solve, compiler/emit_ldl.c): pattern,
  * ordering and every index fixed at compile time.  This wrapper only holds
- * the workspace and a copy of Kx (the refinement works on the exact system,
- * so the solve needs the K that was factored); it allocates at creation only. */
+ * the workspace and the K that was factored (the solve reads it: the massless
+ * bodies' right side, the residual and the refinement): a copy, or the
+ * caller's own Kx when the caller promises to keep it (kx_stable); it
+ * allocates at creation only. */
 #include <stdlib.h>
 #include <string.h>
 #include "mb_solver.h"
@@ -10,16 +12,22 @@
 typedef struct {
   mb_solver base;
   const mb_model *m;
-  mb_real *Kx;    /* the K of the last factorization */
+  mb_real *Kx;    /* a copy of the K of the last factorization */
+  const mb_real *K; /* the K of the last factorization: Kx, or the caller's */
   mb_real *work;  /* m->ldl_worksize */
 } ldl_solver;
 
 static int ldl_factor_fn(mb_solver *s, const mb_real *Kx) {
   ldl_solver *l = (ldl_solver *)s;
-  memcpy(l->Kx, Kx, sizeof(mb_real) * (size_t)l->m->nnz);
+  if (s->kx_stable) {
+    l->K = Kx;
+  } else {
+    memcpy(l->Kx, Kx, sizeof(mb_real) * (size_t)l->m->nnz);
+    l->K = l->Kx;
+  }
   s->factorizations++;
   s->full_factorizations++;
-  int rc = l->m->ldl_factor(l->m, l->Kx, l->work);
+  int rc = l->m->ldl_factor(l->m, l->K, l->work);
   s->bad_pivot = rc ? rc - 1 : -1;
   return rc ? MB_ERR_SINGULAR : MB_OK;
 }
@@ -34,9 +42,9 @@ static int ldl_solve_fn(mb_solver *s, mb_real *b) {
   ldl_solver *l = (ldl_solver *)s;
   int check = s->check_every <= 1 || s->refine_always || s->solves % s->check_every == 0;
   s->solves++;
-  if (!check) return l->m->ldl_solve(l->m, l->Kx, l->work, b, NULL);
+  if (!check) return l->m->ldl_solve(l->m, l->K, l->work, b, NULL);
   mb_real res[2] = {0, 0};
-  int rc = l->m->ldl_solve(l->m, l->Kx, l->work, b, res);
+  int rc = l->m->ldl_solve(l->m, l->K, l->work, b, res);
   s->residual = res[0];
   s->residual_checks++;
   if (!(res[0] <= s->residual_max)) s->residual_max = res[0];
@@ -68,5 +76,6 @@ mb_solver *mb_solver_ldl(const mb_model *m) {
   l->Kx = calloc((size_t)m->nnz + 1, sizeof(mb_real));
   l->work = calloc(m->ldl_worksize + 1, sizeof(mb_real));
   if (!l->Kx || !l->work) { ldl_destroy_fn(&l->base); return NULL; }
+  l->K = l->Kx;
   return &l->base;
 }

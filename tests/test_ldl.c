@@ -14,6 +14,8 @@
  *     loops: "+looped" above, MBCC_LDL_BUDGET=0), with and without block
  *     pivots (the welded virtual bodies of the virtual1 / virtual2 scenes)
  *     and with the massless slider eliminated first (every slider-crank);
+ *   - the straight-line elimination of the massless slider with its rows of
+ *     t = 0 falls back to pivoting when one of those rows loses the slider;
  *   - a zero pivot is reported with its unknown; a model without emitted
  *     LDL^T gives no "ldl" solver;
  *   - the flexible slider-crank with two virtual bodies simulated with "ldl"
@@ -263,6 +265,64 @@ static void zero_pivot_and_missing(void **state) {
 }
 
 
+/* The straight-line code eliminates a massless body with the rows partial
+ * pivoting chose at t = 0 (ldl_mlN_fixed) and falls back to pivoting when
+ * they no longer suit.  Make them unsuitable: take one of the slider's
+ * constraint rows that also act on other bodies (the wrist pin's) off the
+ * slider (zero its entries in the slider's columns, both triangles): a
+ * chosen row, so Du is singular.  Where K stays regular (KLU factors it
+ * with a fair condition estimate), the emitted LDL^T must still factor it
+ * and agree with KLU; without the fallback its factorization would fail. */
+static void massless_rows_fallback(void **state) {
+  (void)state;
+  const mb_model *m = &slider_crank_flexible_model;
+  int n = m->n, nv = m->nv, u0 = -1, tried = 0;
+  for (int b = 0; b < m->nbody; b++)
+    if (!strcmp(m->body[b].name, "slider")) u0 = m->body[b].vadr;
+  assert_true(u0 >= 0);
+  double *K0 = calloc((size_t)m->nnz, sizeof(double)), *Kx = calloc((size_t)m->nnz, sizeof(double));
+  double *rhs = calloc((size_t)n, sizeof(double)), *b = malloc(sizeof(double) * (size_t)n);
+  double *x = malloc(sizeof(double) * (size_t)n), *y = malloc(sizeof(double) * (size_t)n);
+  void *work = malloc(mb_model_worksize(m) + 16);
+  double *lwork = calloc(m->ldl_worksize + 1, sizeof(double));
+  assert_true(K0 && Kx && rhs && b && x && y && work && lwork);
+  state_near_q0(m, 1, K0, rhs, work);
+  for (int row = nv; row < n; row++) {
+    int on_u = 0, off_u = 0;
+    for (int j = 0; j < nv; j++)
+      for (int q = m->Kp[j]; q < m->Kp[j + 1]; q++)
+        if (m->Ki[q] == row && K0[q] != 0) *(j >= u0 && j < u0 + 6 ? &on_u : &off_u) = 1;
+    if (!on_u || !off_u) continue;
+    memcpy(Kx, K0, sizeof(double) * (size_t)m->nnz);
+    for (int j = 0; j < n; j++)
+      for (int q = m->Kp[j]; q < m->Kp[j + 1]; q++) {
+        int i = m->Ki[q];
+        if ((i == row && j >= u0 && j < u0 + 6) || (j == row && i >= u0 && i < u0 + 6)) Kx[q] = 0;
+      }
+    mb_solver *klu = mb_solver_new("klu", m);
+    assert_non_null(klu);
+    if (klu->factor(klu, Kx) == MB_OK && klu->rcond > 1e-10) {
+      tried++;
+      assert_int_equal(m->ldl_factor(m, Kx, lwork), 0);
+      for (int i = 0; i < n; i++) b[i] = urand(-1, 1);
+      memcpy(x, b, sizeof(double) * (size_t)n);
+      memcpy(y, b, sizeof(double) * (size_t)n);
+      mb_real res[2];
+      assert_int_equal(m->ldl_solve(m, Kx, lwork, x, res), MB_OK);
+      assert_int_equal(klu->solve(klu, y), MB_OK);
+      double d = 0, yn = 0;
+      for (int i = 0; i < n; i++) { d = fmax(d, fabs(x[i] - y[i])); yn = fmax(yn, fabs(y[i])); }
+      printf("  row %d off the slider: residual %.2g, against KLU %.2g\n", row, rel_residual(m, Kx, x, b),
+             d / yn);
+      assert_true(rel_residual(m, Kx, x, b) < 1e-12);
+      assert_true(d <= 1e-10 * yn);
+    }
+    klu->destroy(klu);
+  }
+  assert_true(tried > 0);
+  free(K0); free(Kx); free(rhs); free(b); free(x); free(y); free(work); free(lwork);
+}
+
 /* the flexible slider-crank with two virtual bodies (looped code, 18
  * massless unknowns): ldl against klu over a fifth of a crank revolution */
 static void simulate_virtual2(void **state) {
@@ -289,6 +349,7 @@ int main(void) {
       cmocka_unit_test(code_forms),
       cmocka_unit_test(sampled_checks),
       cmocka_unit_test(zero_pivot_and_missing),
+      cmocka_unit_test(massless_rows_fallback),
       cmocka_unit_test(simulate_virtual2),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
