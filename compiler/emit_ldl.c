@@ -358,12 +358,15 @@ static void emit_inv6(FILE *f) {
         "      for (int j = 0; j < 6; j++) {\n"
         "        mb_real t = A[6 * k + j]; A[6 * k + j] = A[6 * pr + j]; A[6 * pr + j] = t;\n"
         "        t = X[6 * k + j]; X[6 * k + j] = X[6 * pr + j]; X[6 * pr + j] = t;\n      }\n"
+        "    /* columns up to k of A are done (unit vectors): only those right of k change */\n"
         "    mb_real d = 1 / A[6 * k + k];\n"
-        "    for (int j = 0; j < 6; j++) { A[6 * k + j] *= d; X[6 * k + j] *= d; }\n"
+        "    for (int j = k + 1; j < 6; j++) A[6 * k + j] *= d;\n"
+        "    for (int j = 0; j < 6; j++) X[6 * k + j] *= d;\n"
         "    for (int i = 0; i < 6; i++) {\n"
         "      mb_real l = A[6 * i + k];\n"
         "      if (i == k || l == 0) continue;\n"
-        "      for (int j = 0; j < 6; j++) { A[6 * i + j] -= l * A[6 * k + j]; X[6 * i + j] -= l * X[6 * k + j]; }\n"
+        "      for (int j = k + 1; j < 6; j++) A[6 * i + j] -= l * A[6 * k + j];\n"
+        "      for (int j = 0; j < 6; j++) X[6 * i + j] -= l * X[6 * k + j];\n"
         "    }\n  }\n  return 0;\n}\n\n", f);
 }
 

@@ -307,12 +307,14 @@ static int inv6(const double *A0, double *X) {
         double t = A[6 * k + j]; A[6 * k + j] = A[6 * pr + j]; A[6 * pr + j] = t;
         t = X[6 * k + j]; X[6 * k + j] = X[6 * pr + j]; X[6 * pr + j] = t;
       }
-    double d = 1 / A[6 * k + k];
-    for (int j = 0; j < 6; j++) { A[6 * k + j] *= d; X[6 * k + j] *= d; }
+    double d = 1 / A[6 * k + k]; /* columns up to k of A are done (unit vectors) */
+    for (int j = k + 1; j < 6; j++) A[6 * k + j] *= d;
+    for (int j = 0; j < 6; j++) X[6 * k + j] *= d;
     for (int i = 0; i < 6; i++) {
       double l = A[6 * i + k];
       if (i == k || l == 0) continue;
-      for (int j = 0; j < 6; j++) { A[6 * i + j] -= l * A[6 * k + j]; X[6 * i + j] -= l * X[6 * k + j]; }
+      for (int j = k + 1; j < 6; j++) A[6 * i + j] -= l * A[6 * k + j];
+      for (int j = 0; j < 6; j++) X[6 * i + j] -= l * X[6 * k + j];
     }
   }
   return 0;
