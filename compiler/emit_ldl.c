@@ -662,6 +662,21 @@ static int ml_hy(const ldl_plan *p, int e, int k) {
   return any;
 }
 
+/* massless body e as the fixed-row emitters see it: its rows R (t = 0 order pi),
+ * slots T, columns u and Y, and its workspace offset */
+typedef struct {
+  int r, ny;
+  const int *pi, *R, *T, *u, *Y;
+  long w;
+} ml_view;
+
+static ml_view ml_body(const ldl_plan *p, int e) {
+  int r0 = p->mlrp[e], y0 = p->mlyp[e];
+  ml_view v = {p->mlrp[e + 1] - r0, p->mlyp[e + 1] - y0, p->mlpi0 + r0, p->mlR + r0,
+               p->mlT + r0 - 6 * e, p->mlu[e], p->mlY + y0, ml_ws(p, e)};
+  return v;
+}
+
 /* ldl_mlN_fixed: ldl_ml_pivoting with the rows partial pivoting chose at t = 0
  * (plan mlpi0), every index a constant and every sum in the same order, so
  * that it gives the same numbers; it declines (returns 0) when those rows no
@@ -670,14 +685,15 @@ static int ml_hy(const ldl_plan *p, int e, int k) {
 static void emit_ml_fixed_factor(FILE *f, const ldl_plan *p) {
   fputs("#define LDL_ML_WMAX 4 /* see ldl_mlN_fixed */\n", f);
   for (int e = 0; e < p->nml; e++) {
-    int r0 = p->mlrp[e], r = p->mlrp[e + 1] - r0, ny = p->mlyp[e + 1] - p->mlyp[e];
-    const int *pi = p->mlpi0 + r0;
+    ml_view b = ml_body(p, e);
+    int r = b.r, ny = b.ny;
+    const int *pi = b.pi;
     fprintf(f, "/* massless body %d with its rows at t = 0 (positions in R):", e);
     for (int k = 0; k < r; k++) fprintf(f, " %d", pi[k]);
     fprintf(f, ";\n * 1, or 0 when they no longer suit and ldl_ml_pivoting must choose */\n"
                "static int ldl_ml%d_fixed(const mb_real *Kx, mb_real *work) {\n"
                "  mb_real *K1 = work + LDL_K1, *ws = work + %ld, *Di = ws + %d, *W = Di + 36;\n"
-               "  const mb_real Du[36] = {", e, ml_ws(p, e), r);
+               "  const mb_real Du[36] = {", e, b.w, r);
     for (int i = 0; i < 6; i++)
       for (int c = 0; c < 6; c++) {
         int sl = ml_du(p, e, pi[i], c);
@@ -712,16 +728,17 @@ static void emit_ml_fixed_factor(FILE *f, const ldl_plan *p) {
         }
         fprintf(f, ";\n  K1[%d] = K1[%d];\n", p->mlk[2 * kk + 1], p->mlk[2 * kk]);
       }
-    for (int k = 0; k < r; k++) fprintf(f, "  ws[%d] = %d;\n", k, pi[k]);
+    /* (the pivot order in ws is for the pivoting solve only: not stored here) */
     fprintf(f, "  LDL_ML_FIXED(&ldl_ml[%d], ws) = 1;\n  return 1;\n}\n\n", e);
   }
 }
 
 /* ldl_ml_rhs_pivoting of body e with its rows at t = 0, when the factorization used them */
 static void emit_ml_fixed_rhs(FILE *f, const ldl_plan *p, int e) {
-  int r0 = p->mlrp[e], r = p->mlrp[e + 1] - r0, y0 = p->mlyp[e], ny = p->mlyp[e + 1] - y0;
-  const int *pi = p->mlpi0 + r0, *R = p->mlR + r0, *T = p->mlT + r0 - 6 * e, *u = p->mlu[e], *Y = p->mlY + y0;
-  long w = ml_ws(p, e);
+  ml_view b = ml_body(p, e);
+  int r = b.r, ny = b.ny;
+  const int *pi = b.pi, *R = b.R, *T = b.T, *u = b.u, *Y = b.Y;
+  long w = b.w;
   fprintf(f, "  if (LDL_ML_FIXED(&ldl_ml[%d], (work + %ld))) { /* body %d, its rows at t = 0 */\n"
              "    const mb_real *Di = work + %ld, *W = Di + 36;\n    mb_real z[6];\n    (void)W;\n", e, w, e, w + r);
   for (int k = 0; k < r; k++) fprintf(f, "    r1[%d] = 0;\n", R[k]);
@@ -752,9 +769,10 @@ static void emit_ml_fixed_rhs(FILE *f, const ldl_plan *p, int e) {
 
 /* ldl_ml_back_pivoting of body e with its rows at t = 0, when the factorization used them */
 static void emit_ml_fixed_back(FILE *f, const ldl_plan *p, int e) {
-  int r0 = p->mlrp[e], r = p->mlrp[e + 1] - r0, y0 = p->mlyp[e], ny = p->mlyp[e + 1] - y0;
-  const int *pi = p->mlpi0 + r0, *R = p->mlR + r0, *T = p->mlT + r0 - 6 * e, *u = p->mlu[e], *Y = p->mlY + y0;
-  long w = ml_ws(p, e);
+  ml_view b = ml_body(p, e);
+  int r = b.r, ny = b.ny;
+  const int *pi = b.pi, *R = b.R, *T = b.T, *u = b.u, *Y = b.Y;
+  long w = b.w;
   fprintf(f, "  if (LDL_ML_FIXED(&ldl_ml[%d], (work + %ld))) { /* body %d, its rows at t = 0 */\n"
              "    const mb_real *Di = work + %ld;\n    mb_real mu[%d], y[6], z[6];\n    (void)mu;\n", e, w, e, w + r,
           r > 6 ? r - 6 : 1);
