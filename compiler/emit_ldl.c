@@ -1059,23 +1059,34 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
   if (p->nw == 0) fputs("  (void)Kx;\n", f);
   fputs("}\n\n", f);
 
-  fputs("/* t <- (L D L^T)^-1 t */\n", f);
-  fputs("static void ldl_lsolve(const mb_real *restrict Lx, const mb_real *restrict Dinv, mb_real *restrict t) {\n", f);
-  fputs("  /* forward: L y = t, row by row */\n", f);
-  /* row i of L from the plan (the factorization's rows): columns Rj at Lx[Rpos] */
+  /* the triangular solves in out-of-line parts of about LDL_CHUNK_FLOPS, for
+   * the same reason as the factorization's: the C compiler's time stays linear */
+  int nfwd = 0, nbwd = 0;
+  double part_flops = 0;
   for (int i = 0; i < n; i++) {
     int len = p->Rp[i + 1] - p->Rp[i];
     if (!len) continue;
+    if (nfwd == 0 || part_flops > LDL_CHUNK_FLOPS) {
+      if (nfwd) fputs("}\n\n", f);
+      fprintf(f, "/* forward: L y = t, row by row (part %d) */\n", nfwd);
+      fprintf(f, "static LDL_NOINLINE void ldl_forward%d(const mb_real *restrict Lx, mb_real *restrict t) {\n", nfwd++);
+      part_flops = 0;
+    }
     fprintf(f, "  t[%d] -= ", i);
     emit_sum(f, "Lx[%d] * t[%d]", p->Rpos + p->Rp[i], p->Rj + p->Rp[i], len);
     fputs(";\n", f);
+    part_flops += 2.0 * len;
   }
-  fputs("  /* diagonal: z = D^-1 y */\n", f);
-  for (int k = 0; k < n; k++) fprintf(f, "  t[%d] *= Dinv[%d];\n", k, k);
-  fputs("  /* backward: L^T x = z */\n", f);
+  if (nfwd) fputs("}\n\n", f);
   for (int j = n - 1; j >= 0; j--) {
     int len = p->Lp[j + 1] - p->Lp[j];
     if (!len) continue;
+    if (nbwd == 0 || part_flops > LDL_CHUNK_FLOPS) {
+      if (nbwd) fputs("}\n\n", f);
+      fprintf(f, "/* backward: L^T x = z, row by row (part %d) */\n", nbwd);
+      fprintf(f, "static LDL_NOINLINE void ldl_backward%d(const mb_real *restrict Lx, mb_real *restrict t) {\n", nbwd++);
+      part_flops = 0;
+    }
     int *lq = malloc(sizeof(int) * (size_t)len);
     if (!lq) break;
     for (int k = 0; k < len; k++) lq[k] = p->Lp[j] + k;
@@ -1083,7 +1094,15 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
     emit_sum(f, "Lx[%d] * t[%d]", lq, p->Li + p->Lp[j], len);
     fputs(";\n", f);
     free(lq);
+    part_flops += 2.0 * len;
   }
+  if (nbwd) fputs("}\n\n", f);
+  fputs("/* t <- (L D L^T)^-1 t */\n", f);
+  fputs("static void ldl_lsolve(const mb_real *restrict Lx, const mb_real *restrict Dinv, mb_real *restrict t) {\n", f);
+  for (int c = 0; c < nfwd; c++) fprintf(f, "  ldl_forward%d(Lx, t);\n", c);
+  fputs("  /* diagonal: z = D^-1 y */\n", f);
+  for (int k = 0; k < n; k++) fprintf(f, "  t[%d] *= Dinv[%d];\n", k, k);
+  for (int c = 0; c < nbwd; c++) fprintf(f, "  ldl_backward%d(Lx, t);\n", c);
   if (p->nnzL == 0) fputs("  (void)Lx;\n", f);
   fputs("}\n\n", f);
 

@@ -29,7 +29,7 @@
 
 /* default flop budget for straight-line code (above it: loops over tables);
  * the environment variable MBCC_LDL_BUDGET overrides it */
-#define LDL_FLOP_BUDGET 10000.0
+#define LDL_FLOP_BUDGET 20000.0
 
 typedef struct {
   int n, nv, nc;
