@@ -10,7 +10,7 @@ RT_SRC  := runtime/model_generic.c runtime/solver_select.c runtime/genalpha.c ru
            runtime/integrate.c runtime/driver.c runtime/ida.c runtime/bench.c
 RT_HDR  := $(wildcard runtime/*.h)
 CC_SRC  := compiler/main.c compiler/reader.c compiler/diag.c compiler/lower.c compiler/fe.c compiler/flex.c \
-           compiler/assemble.c compiler/emit.c compiler/order.c compiler/emit_ldl.c \
+           compiler/assemble.c compiler/emit.c compiler/emit_rows.c compiler/order.c compiler/emit_ldl.c \
            compiler/trade.c compiler/trade_metric.c
 CC_HDR  := $(wildcard compiler/*.h)
 B       ?= build

@@ -15,6 +15,7 @@
 
 #include "diag.h"
 #include "emit_ldl.h"
+#include "emit_rows.h"
 #include "flex.h"
 #include "lower.h"
 
@@ -246,13 +247,7 @@ static void emit_tables(FILE *f, const lmodel *L) {
  * frame, or Craig-Bampton interface nodes held by it): its marker is a rigid
  * marker at the node's position, the same numbers without the modal sums,
  * the rotation exponential and the zero modal columns (known at compile time) */
-static int node_static(const mb_body *B, int node) {
-  const mb_flex *fx = B->flex;
-  if (!fx || node < 0) return 0;
-  for (int i = 0; i < 3 * fx->nm; i++)
-    if (fx->node_X[3 * node * fx->nm + i] != 0 || fx->node_Psi[3 * node * fx->nm + i] != 0) return 0;
-  return 1;
-}
+static int node_static(const mb_body *B, int node) { return emit_node_static(B, node); }
 
 /* c = the body columns of (dV, dW) at marker k; returns how many (6 or 6 + nm) */
 static int emit_cols(FILE *f, const lmodel *L, int k, const char *P, const char *dV, const char *dW,
@@ -447,13 +442,8 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
     if (d->body < 0) {
       fprintf(f, "  mb_marker_ground(markers[%d].s, markers[%d].C, &k[%d]);\n", k, k, k);
     } else if (d->node >= 0 && node_static(&L->body[d->body], d->node)) {
-      const mb_flex *fx = L->body[d->body].flex;
-      fprintf(f, "  /* node %d: its mode shapes vanish: a rigid marker */\n", d->node);
-      fprintf(f, "  mb_marker_rigid(&f[%d], (const mb_real[3])", d->body);
-      vec(f, fx->node_x + 3 * d->node, 3);
-      fputs(",\n      (const mb_real[9])", f);
-      vec(f, d->C, 9);
-      fprintf(f, ", &k[%d]);\n", k);
+      fprintf(f, "  /* node %d: its mode shapes vanish: a rigid marker (mb_marker_rigid) */\n", d->node);
+      emit_marker_special(f, L, k);
     } else if (d->node >= 0) {
       const mb_body *B = &L->body[d->body];
       fprintf(f, "  mb_marker_node(&f[%d], &flex%d, %d, q + %d, v + %d, (const mb_real[9])", d->body,
@@ -461,11 +451,8 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
       vec(f, d->C, 9);
       fprintf(f, ", &k[%d]);\n", k);
     } else {
-      fprintf(f, "  mb_marker_rigid(&f[%d], (const mb_real[3])", d->body);
-      vec(f, d->s, 3);
-      fputs(",\n      (const mb_real[9])", f);
-      vec(f, d->C, 9);
-      fprintf(f, ", &k[%d]);\n", k);
+      fputs("  /* mb_marker_rigid, its zeros and ones folded */\n", f);
+      emit_marker_special(f, L, k);
     }
   }
   fprintf(f, "\n  /* body forces: gravity and the quadratic-velocity (gyroscopic) terms */\n");
@@ -579,6 +566,7 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
     fprintf(f, "  /* row %d: %s (", r, L->row_desc[r]);
     loc_comment(f, L, L->row_loc[r]);
     fputs(") */\n", f);
+    if (emit_row_special(f, L, r)) continue;
     switch (R->kind) {
     case MB_PRIM_SPH: fprintf(f, "  mb_prim_sph(&k[%d], &k[%d], %d, &r);\n", R->m0, R->m1, R->a); break;
     case MB_PRIM_DOT1: fprintf(f, "  mb_prim_dot1(&k[%d], &k[%d], %d, %d, &r);\n", R->m0, R->m1, R->a, R->b); break;

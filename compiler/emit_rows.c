@@ -1,0 +1,370 @@
+/* emit_rows.c: the markers on rigid bodies and the spherical and dot-1 rows of
+ * the generated evaluation, written out expression by expression.
+ *
+ * The kernels of runtime/mb_kernels.h (mb_marker_rigid, mb_prim_sph,
+ * mb_prim_dot1, mb_row_phidot, mb_row_gamma, mb_rigid_cols) are general: a
+ * spherical row's Jacobian is a unit vector, a dot-1 row has no point terms,
+ * a rigid marker's angular acceleration term is zero, a ground marker does
+ * not move, most markers have axes C = I, and the kernels multiply and add
+ * all of these zeros and ones at run time.  The compiler knows them.  Here
+ * the same formulas are written as C expressions over the frames and markers
+ * with the compile-time zeros and ones folded: a product with an exact zero
+ * is dropped and a product with one is its other factor.  The remaining terms
+ * keep the kernels' order of operations, so for finite values the numbers are
+ * the kernels' own (up to the sign of a zero); test_generic and test_ldl
+ * compare the two paths. */
+#include <stdio.h>
+#include <string.h>
+
+#include "emit_rows.h"
+
+#define EXPR 640 /* longest expression kept symbolic; longer ones go to locals */
+
+typedef struct { char e[3][EXPR]; } svec;
+
+static int is_zero(const char *a) { return !strcmp(a, "0"); }
+static int is_one(const char *a) { return !strcmp(a, "1"); }
+static int is_mone(const char *a) { return !strcmp(a, "-1"); }
+static int is_atom(const char *a) { return !strchr(a, ' '); }
+
+static void lit(char *o, double x) {
+  if (x == 0) x = 0; /* no "-0" */
+  snprintf(o, EXPR, "%.17g", x);
+}
+
+static void s_neg(char *o, const char *a) {
+  char t[EXPR];
+  if (is_zero(a)) snprintf(t, sizeof t, "0");
+  else if (is_atom(a) && a[0] == '-') snprintf(t, sizeof t, "%s", a + 1);
+  else if (is_atom(a)) snprintf(t, sizeof t, "-%s", a);
+  else snprintf(t, sizeof t, "-(%s)", a);
+  memcpy(o, t, EXPR);
+}
+
+/* o = a * b */
+static void s_mul(char *o, const char *a, const char *b) {
+  char t[EXPR];
+  if (is_zero(a) || is_zero(b)) snprintf(t, sizeof t, "0");
+  else if (is_one(a)) snprintf(t, sizeof t, "%s", b);
+  else if (is_one(b)) snprintf(t, sizeof t, "%s", a);
+  else if (is_mone(a)) s_neg(t, b);
+  else if (is_mone(b)) s_neg(t, a);
+  else
+    snprintf(t, sizeof t, "%s%s%s * %s%s%s", is_atom(a) ? "" : "(", a, is_atom(a) ? "" : ")",
+             is_atom(b) ? "" : "(", b, is_atom(b) ? "" : ")");
+  memcpy(o, t, EXPR);
+}
+
+/* o = a + b (a's own sum is left-associative: no parentheses needed) */
+static void s_add(char *o, const char *a, const char *b) {
+  char t[EXPR];
+  if (is_zero(b)) snprintf(t, sizeof t, "%s", a);
+  else if (is_zero(a)) snprintf(t, sizeof t, "%s", b);
+  else snprintf(t, sizeof t, "%s + %s%s%s", a, is_atom(b) ? "" : "(", b, is_atom(b) ? "" : ")");
+  memcpy(o, t, EXPR);
+}
+
+/* o = a - b */
+static void s_sub(char *o, const char *a, const char *b) {
+  char t[EXPR];
+  if (is_zero(b)) snprintf(t, sizeof t, "%s", a);
+  else if (is_zero(a)) s_neg(t, b);
+  else snprintf(t, sizeof t, "%s - %s%s%s", a, is_atom(b) ? "" : "(", b, is_atom(b) ? "" : ")");
+  memcpy(o, t, EXPR);
+}
+
+/* a . b, summed left to right as mb_dot3 */
+static void s_dot(char *o, const svec *a, const svec *b) {
+  char t[EXPR], p[EXPR];
+  s_mul(t, a->e[0], b->e[0]);
+  s_mul(p, a->e[1], b->e[1]);
+  s_add(t, t, p);
+  s_mul(p, a->e[2], b->e[2]);
+  s_add(o, t, p);
+}
+
+/* a x b as mb_cross3 */
+static void s_cross(svec *o, const svec *a, const svec *b) {
+  svec t;
+  char p[EXPR], q[EXPR];
+  for (int i = 0; i < 3; i++) {
+    int j = (i + 1) % 3, k = (i + 2) % 3;
+    s_mul(p, a->e[j], b->e[k]);
+    s_mul(q, a->e[k], b->e[j]);
+    s_sub(t.e[i], p, q);
+  }
+  *o = t;
+}
+
+/* A^T x (A row-major, 9 expressions) as mb_mul3t */
+static void s_mul3t(svec *o, char A[9][EXPR], const svec *x) {
+  svec t;
+  char p[EXPR];
+  for (int i = 0; i < 3; i++) {
+    s_mul(t.e[i], A[i], x->e[0]);
+    s_mul(p, A[3 + i], x->e[1]);
+    s_add(t.e[i], t.e[i], p);
+    s_mul(p, A[6 + i], x->e[2]);
+    s_add(t.e[i], t.e[i], p);
+  }
+  *o = t;
+}
+
+static void s_names(svec *o, const char *fmt, int a) {
+  for (int i = 0; i < 3; i++) {
+    char base[64];
+    snprintf(base, sizeof base, fmt, a);
+    snprintf(o->e[i], EXPR, "%s[%d]", base, i);
+  }
+}
+
+static void s_zero(svec *o) {
+  for (int i = 0; i < 3; i++) snprintf(o->e[i], EXPR, "0");
+}
+
+/* declare a local 'name' for the entries of v that are not atoms; they become
+ * name[i] (an entry that is zero or an atom stays as it is) */
+static void s_local(FILE *f, svec *v, const char *name, const char *indent) {
+  int need = 0;
+  for (int i = 0; i < 3; i++) need |= !is_atom(v->e[i]);
+  if (!need) return;
+  fprintf(f, "%smb_real %s[3] = {%s, %s, %s};\n", indent, name, v->e[0], v->e[1], v->e[2]);
+  for (int i = 0; i < 3; i++)
+    if (!is_atom(v->e[i])) snprintf(v->e[i], EXPR, "%s[%d]", name, i);
+}
+
+int emit_node_static(const mb_body *B, int node) {
+  const mb_flex *fx = B->flex;
+  if (!fx || node < 0) return 0;
+  for (int i = 0; i < 3 * fx->nm; i++)
+    if (fx->node_X[3 * node * fx->nm + i] != 0 || fx->node_Psi[3 * node * fx->nm + i] != 0) return 0;
+  return 1;
+}
+
+/* a marker on a rigid body (or on a node whose mode shapes vanish there) */
+static int marker_rigid(const lmodel *L, int k, const double **s) {
+  const mb_markerdef *d = &L->marker[k];
+  if (d->body < 0) return 0;
+  const mb_body *B = &L->body[d->body];
+  if (d->node >= 0 && !emit_node_static(B, d->node)) return 0;
+  if (s) *s = d->node >= 0 ? B->flex->node_x + 3 * d->node : d->s;
+  return 1;
+}
+
+int emit_marker_special(FILE *f, const lmodel *L, int k) {
+  const double *s;
+  if (!marker_rigid(L, k, &s)) return 0;
+  const mb_markerdef *d = &L->marker[k];
+  int b = d->body;
+  /* mb_marker_rigid: u = A s, R = A C, P = r + u, V = rd + w x u, W = w,
+     aP = w x (w x u), aW = 0 */
+  char A[9][EXPR], p[EXPR], c[EXPR];
+  for (int i = 0; i < 9; i++) snprintf(A[i], EXPR, "f[%d].A[%d]", b, i);
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      char e[EXPR];
+      lit(c, d->C[j]);
+      s_mul(e, A[3 * i], c);
+      lit(c, d->C[3 + j]);
+      s_mul(p, A[3 * i + 1], c);
+      s_add(e, e, p);
+      lit(c, d->C[6 + j]);
+      s_mul(p, A[3 * i + 2], c);
+      s_add(e, e, p);
+      fprintf(f, "  k[%d].R[%d] = %s;\n", k, 3 * i + j, e);
+    }
+  svec u;
+  for (int i = 0; i < 3; i++) {
+    lit(c, s[0]);
+    s_mul(u.e[i], A[3 * i], c);
+    lit(c, s[1]);
+    s_mul(p, A[3 * i + 1], c);
+    s_add(u.e[i], u.e[i], p);
+    lit(c, s[2]);
+    s_mul(p, A[3 * i + 2], c);
+    s_add(u.e[i], u.e[i], p);
+  }
+  int moving = !(is_zero(u.e[0]) && is_zero(u.e[1]) && is_zero(u.e[2]));
+  if (moving) {
+    fprintf(f, "  {\n    mb_real u[3] = {%s, %s, %s}, wu[3];\n", u.e[0], u.e[1], u.e[2]);
+    fprintf(f, "    mb_cross3(f[%d].w, u, wu);\n    mb_cross3(f[%d].w, wu, k[%d].aP);\n", b, b, k);
+    for (int i = 0; i < 3; i++)
+      fprintf(f, "    k[%d].P[%d] = f[%d].r[%d] + u[%d];\n    k[%d].V[%d] = f[%d].rd[%d] + wu[%d];\n", k, i, b,
+              i, i, k, i, b, i, i);
+    fputs("  }\n", f);
+  } else {
+    for (int i = 0; i < 3; i++)
+      fprintf(f, "  k[%d].P[%d] = f[%d].r[%d];\n  k[%d].V[%d] = f[%d].rd[%d];\n  k[%d].aP[%d] = 0;\n", k, i, b,
+              i, k, i, b, i, k, i);
+  }
+  for (int i = 0; i < 3; i++) fprintf(f, "  k[%d].W[%d] = f[%d].w[%d];\n  k[%d].aW[%d] = 0;\n", k, i, b, i, k, i);
+  return 1;
+}
+
+/* what the rows know of marker k: its fields as expressions, zeros folded */
+typedef struct {
+  svec P, V, W, aP, aW;
+  char R[9][EXPR];
+  int rigid;   /* rigid body (or static node): columns by mb_rigid_cols */
+  int at_origin; /* rigid and s = 0: P = r exactly */
+} smark;
+
+static void mark_view(const lmodel *L, int k, smark *m) {
+  const mb_markerdef *d = &L->marker[k];
+  const double *s = NULL;
+  memset(m, 0, sizeof *m);
+  if (d->body < 0) {
+    for (int i = 0; i < 3; i++) lit(m->P.e[i], d->s[i]);
+    for (int i = 0; i < 9; i++) lit(m->R[i], d->C[i]);
+    s_zero(&m->V); s_zero(&m->W); s_zero(&m->aP); s_zero(&m->aW);
+    return;
+  }
+  s_names(&m->P, "k[%d].P", k);
+  s_names(&m->V, "k[%d].V", k);
+  s_names(&m->W, "k[%d].W", k);
+  s_names(&m->aP, "k[%d].aP", k);
+  s_names(&m->aW, "k[%d].aW", k);
+  for (int i = 0; i < 9; i++) snprintf(m->R[i], EXPR, "k[%d].R[%d]", k, i);
+  if (marker_rigid(L, k, &s)) {
+    m->rigid = 1;
+    s_zero(&m->aW);
+    if (s[0] == 0 && s[1] == 0 && s[2] == 0) {
+      m->at_origin = 1;
+      s_zero(&m->aP);
+    }
+  }
+}
+
+/* a row's phi, phid, gamma and its entries of D (both triangles of K), from
+ * the row's d(phidot)/dV, d(phidot)/dW of each marker, its quadratic term and
+ * nu, as mb_row_phidot, mb_row_gamma and mb_rigid_cols / mb_node_cols_mk */
+static void emit_row_common(FILE *f, const lmodel *L, int r, const smark mk[2], svec dV[2], svec dW[2],
+                            const char *quad) {
+  const mb_model *m = &L->m;
+  const mb_rowdef *R = &L->row[r];
+  char t[EXPR], p[EXPR];
+  /* phid = dV0.V0 + dW0.W0 + dV1.V1 + dW1.W1 - nu (nu = 0: no driver) */
+  s_dot(t, &dV[0], &mk[0].V);
+  s_dot(p, &dW[0], &mk[0].W);
+  s_add(t, t, p);
+  s_dot(p, &dV[1], &mk[1].V);
+  s_add(t, t, p);
+  s_dot(p, &dW[1], &mk[1].W);
+  s_add(t, t, p);
+  fprintf(f, "    phid[%d] = %s;\n", r, t);
+  /* gamma = -(dV0.aP0 + dW0.aW0 + dV1.aP1 + dW1.aW1 + quad) */
+  s_dot(t, &dV[0], &mk[0].aP);
+  s_dot(p, &dW[0], &mk[0].aW);
+  s_add(t, t, p);
+  s_dot(p, &dV[1], &mk[1].aP);
+  s_add(t, t, p);
+  s_dot(p, &dW[1], &mk[1].aW);
+  s_add(t, t, p);
+  s_add(t, t, quad);
+  s_neg(t, t);
+  fprintf(f, "    rhs[%d] = %s;\n", m->nv + r, t);
+  for (int s = 0; s < 2; s++) {
+    int k = s ? R->m1 : R->m0, b = L->marker[k].body, any = 0;
+    if (b < 0) continue;
+    for (int j = 0; j < 6; j++) any |= R->slot[s][j] >= 0 && !R->constant[s][j];
+    if (R->mslot[s] >= 0) any = 1;
+    if (!any) continue;
+    char c[6][EXPR];
+    if (mk[s].rigid) {
+      /* mb_rigid_cols: [dV; A^T ((P - r) x dV + dW)] */
+      svec u, x;
+      char A[9][EXPR];
+      for (int i = 0; i < 9; i++) snprintf(A[i], EXPR, "f[%d].A[%d]", b, i);
+      if (mk[s].at_origin) s_zero(&u);
+      else
+        for (int i = 0; i < 3; i++) {
+          snprintf(p, sizeof p, "f[%d].r[%d]", b, i);
+          s_sub(u.e[i], mk[s].P.e[i], p);
+        }
+      s_cross(&x, &u, &dV[s]);
+      for (int i = 0; i < 3; i++) s_add(x.e[i], x.e[i], dW[s].e[i]);
+      s_local(f, &x, s ? "t1" : "t0", "    ");
+      svec a;
+      s_mul3t(&a, A, &x);
+      for (int i = 0; i < 3; i++) {
+        memcpy(c[i], dV[s].e[i], EXPR);
+        memcpy(c[3 + i], a.e[i], EXPR);
+      }
+    } else {
+      /* a flexible node: its modal columns too */
+      svec v = dV[s], w = dW[s];
+      fprintf(f, "    mb_real dV%d[3] = {%s, %s, %s}, dW%d[3] = {%s, %s, %s};\n", s, v.e[0], v.e[1], v.e[2],
+              s, w.e[0], w.e[1], w.e[2]);
+      fprintf(f, "    mb_node_cols_mk(&f[%d], &flex%d, %d, &k[%d], dV%d, dW%d, c);\n", b, b, L->marker[k].node,
+              k, s, s);
+      for (int j = 0; j < 6; j++) snprintf(c[j], EXPR, "c[%d]", j);
+    }
+    for (int j = 0; j < 6; j++)
+      if (R->slot[s][j] >= 0 && !R->constant[s][j])
+        fprintf(f, "    Kx[%d] = Kx[%d] = %s;\n", R->slot[s][j], R->slotT[s][j], c[j]);
+    if (R->mslot[s] >= 0) {
+      int nmb = L->body[b].nm;
+      const int *ms = L->modal_slot + R->mslot[s];
+      for (int j = 0; j < nmb; j++)
+        if (ms[j] >= 0 && mk[s].rigid) fprintf(f, "    Kx[%d] = Kx[%d] = 0;\n", ms[j], ms[nmb + j]);
+        else if (ms[j] >= 0) fprintf(f, "    Kx[%d] = Kx[%d] = c[%d];\n", ms[j], ms[nmb + j], 6 + j);
+    }
+  }
+}
+
+int emit_row_special(FILE *f, const lmodel *L, int r) {
+  const mb_rowdef *R = &L->row[r];
+  if (R->kind != MB_PRIM_SPH && R->kind != MB_PRIM_DOT1) return 0;
+  smark mk[2];
+  mark_view(L, R->m0, &mk[0]);
+  mark_view(L, R->m1, &mk[1]);
+  svec dV[2], dW[2];
+  char t[EXPR];
+  fputs("  {\n", f);
+  if (R->kind == MB_PRIM_SPH) {
+    /* mb_prim_sph: phi = (P1 - P0)_a, dV0 = -e_a, dV1 = e_a */
+    int a = R->a;
+    s_sub(t, mk[1].P.e[a], mk[0].P.e[a]);
+    fprintf(f, "    phi[%d] = %s;\n", r, t);
+    for (int s = 0; s < 2; s++) {
+      s_zero(&dV[s]);
+      s_zero(&dW[s]);
+      snprintf(dV[s].e[a], EXPR, s ? "1" : "-1");
+    }
+    emit_row_common(f, L, r, mk, dV, dW, "0");
+  } else {
+    /* mb_prim_dot1: phi = ai . aj (ai axis a of marker 0, aj axis b of
+       marker 1), dW0 = ai x aj = -dW1, quad = (W0 x (W0 x ai)) . aj
+       + 2 (W0 x ai) . (W1 x aj) + ai . (W1 x (W1 x aj)) */
+    svec ai, aj, cr, wai, waj, qi, qj;
+    char p[EXPR], quad[EXPR];
+    for (int i = 0; i < 3; i++) {
+      memcpy(ai.e[i], mk[0].R[3 * i + R->a], EXPR);
+      memcpy(aj.e[i], mk[1].R[3 * i + R->b], EXPR);
+    }
+    s_dot(t, &ai, &aj);
+    fprintf(f, "    phi[%d] = %s;\n", r, t);
+    s_cross(&cr, &ai, &aj);
+    s_local(f, &cr, "cr", "    ");
+    s_cross(&wai, &mk[0].W, &ai);
+    s_local(f, &wai, "wai", "    ");
+    s_cross(&waj, &mk[1].W, &aj);
+    s_local(f, &waj, "waj", "    ");
+    s_cross(&qi, &mk[0].W, &wai);
+    s_local(f, &qi, "qi", "    ");
+    s_cross(&qj, &mk[1].W, &waj);
+    s_local(f, &qj, "qj", "    ");
+    s_dot(quad, &qi, &aj);
+    s_dot(t, &wai, &waj);
+    s_mul(t, "2", t);
+    s_add(quad, quad, t);
+    s_dot(p, &ai, &qj);
+    s_add(quad, quad, p);
+    for (int s = 0; s < 2; s++) s_zero(&dV[s]);
+    dW[0] = cr;
+    for (int i = 0; i < 3; i++) s_neg(dW[1].e[i], cr.e[i]);
+    emit_row_common(f, L, r, mk, dV, dW, quad);
+  }
+  fputs("  }\n", f);
+  return 1;
+}

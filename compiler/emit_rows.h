@@ -1,0 +1,17 @@
+/* emit_rows.h: the rigid markers and the spherical and dot-1 rows of the
+ * generated evaluation as expressions with the compile-time zeros and ones
+ * folded (emit_rows.c) */
+#ifndef EMIT_ROWS_H
+#define EMIT_ROWS_H
+
+#include <stdio.h>
+#include "lower.h"
+
+/* 1 if node 'node' of body B is one where all its mode shapes vanish */
+int emit_node_static(const mb_body *B, int node);
+/* write marker k if it sits on a rigid body (or a static node); 0: not handled */
+int emit_marker_special(FILE *f, const lmodel *L, int k);
+/* write row r if it is a spherical or dot-1 row; 0: not handled */
+int emit_row_special(FILE *f, const lmodel *L, int r);
+
+#endif
