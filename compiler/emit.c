@@ -255,8 +255,7 @@ static int emit_cols(FILE *f, const lmodel *L, int k, const char *P, const char 
   const mb_markerdef *d = &L->marker[k];
   const mb_body *B = &L->body[d->body];
   if (d->node >= 0 && !node_static(B, d->node)) {
-    fprintf(f, "%smb_node_cols_mk(&f[%d], &flex%d, %d, &k[%d], %s, %s, c);\n", indent, d->body,
-            d->body, d->node, k, dV, dW);
+    emit_node_cols(f, L, k, dV, dW, indent);
     return 6 + B->nm;
   }
   fprintf(f, "%smb_rigid_cols(&f[%d], %s, %s, %s, c);\n", indent, d->body, P, dV, dW);
@@ -445,11 +444,7 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
       fprintf(f, "  /* node %d: its mode shapes vanish: a rigid marker (mb_marker_rigid) */\n", d->node);
       emit_marker_special(f, L, k);
     } else if (d->node >= 0) {
-      const mb_body *B = &L->body[d->body];
-      fprintf(f, "  mb_marker_node(&f[%d], &flex%d, %d, q + %d, v + %d, (const mb_real[9])", d->body,
-              d->body, d->node, B->qadr + 7, B->vadr + 6);
-      vec(f, d->C, 9);
-      fprintf(f, ", &k[%d]);\n", k);
+      emit_marker_node(f, L, k);
     } else {
       fputs("  /* mb_marker_rigid, its zeros and ones folded */\n", f);
       emit_marker_special(f, L, k);

@@ -201,6 +201,74 @@ int emit_marker_special(FILE *f, const lmodel *L, int k) {
   return 1;
 }
 
+/* marker k on a flexible node (mb_marker_node): the node's modal sums with
+ * its shapes as constants (zeros dropped, the kernel's order kept), then
+ * mb_marker_node_sums */
+void emit_marker_node(FILE *f, const lmodel *L, int k) {
+  const mb_markerdef *d = &L->marker[k];
+  const mb_body *B = &L->body[d->body];
+  const mb_flex *fx = B->flex;
+  int nm = fx->nm, node = d->node;
+  const double *X = fx->node_X + 3 * node * nm, *Psi = fx->node_Psi + 3 * node * nm;
+  fputs("  {\n    mb_real b[3], th[3], thd[3], Xwd[3];\n", f);
+  const char *nmv[4] = {"b", "th", "thd", "Xwd"};
+  for (int s = 0; s < 4; s++) {
+    const double *T = (s == 0 || s == 3) ? X : Psi;
+    int qa = (s == 0 || s == 1) ? B->qadr + 7 : B->vadr + 6;
+    const char *arr = (s == 0 || s == 1) ? "q" : "v";
+    for (int i = 0; i < 3; i++) {
+      char e[EXPR], c[EXPR], x[EXPR];
+      snprintf(e, sizeof e, "0");
+      for (int j = 0; j < nm; j++) {
+        lit(c, T[3 * j + i]);
+        snprintf(x, sizeof x, "%s[%d]", arr, qa + j);
+        s_mul(c, c, x);
+        s_add(e, e, c);
+      }
+      if (s == 0) {
+        lit(c, fx->node_x[3 * node + i]);
+        s_add(e, e, c);
+      }
+      fprintf(f, "    %s[%d] = %s;\n", nmv[s], i, e);
+    }
+  }
+  fprintf(f, "    mb_marker_node_sums(&f[%d], b, th, thd, Xwd, (const mb_real[9]){", d->body);
+  for (int i = 0; i < 9; i++) {
+    char c[EXPR];
+    lit(c, d->C[i]);
+    fprintf(f, "%s%s", i ? ", " : "", c);
+  }
+  fprintf(f, "}, &k[%d]);\n  }\n", k);
+}
+
+void emit_node_cols(FILE *f, const lmodel *L, int k, const char *dV, const char *dW, const char *indent) {
+  const mb_markerdef *d = &L->marker[k];
+  const mb_flex *fx = L->body[d->body].flex;
+  int nm = fx->nm;
+  const double *X = fx->node_X + 3 * d->node * nm, *Psi = fx->node_Psi + 3 * d->node * nm;
+  fprintf(f, "%s{ /* mb_node_cols_mk, node %d's shapes as constants */\n", indent, d->node);
+  fprintf(f, "%s  mb_real lV[3], JtW[3];\n", indent);
+  fprintf(f, "%s  mb_node_cols_local(&f[%d], &k[%d], %s, %s, c, lV, JtW);\n", indent, d->body, k, dV, dW);
+  svec lv, jw;
+  for (int i = 0; i < 3; i++) {
+    snprintf(lv.e[i], EXPR, "lV[%d]", i);
+    snprintf(jw.e[i], EXPR, "JtW[%d]", i);
+  }
+  for (int j = 0; j < nm; j++) {
+    svec xj, pj;
+    char a[EXPR], b[EXPR];
+    for (int i = 0; i < 3; i++) {
+      lit(xj.e[i], X[3 * j + i]);
+      lit(pj.e[i], Psi[3 * j + i]);
+    }
+    s_dot(a, &xj, &lv);
+    s_dot(b, &pj, &jw);
+    s_add(a, a, b);
+    fprintf(f, "%s  c[%d] = %s;\n", indent, 6 + j, a);
+  }
+  fprintf(f, "%s}\n", indent);
+}
+
 /* what the rows know of marker k: its fields as expressions, zeros folded */
 typedef struct {
   svec P, V, W, aP, aW;
@@ -295,8 +363,10 @@ static void emit_row_common(FILE *f, const lmodel *L, int r, const smark mk[2], 
       svec v = dV[s], w = dW[s];
       fprintf(f, "    mb_real dV%d[3] = {%s, %s, %s}, dW%d[3] = {%s, %s, %s};\n", s, v.e[0], v.e[1], v.e[2],
               s, w.e[0], w.e[1], w.e[2]);
-      fprintf(f, "    mb_node_cols_mk(&f[%d], &flex%d, %d, &k[%d], dV%d, dW%d, c);\n", b, b, L->marker[k].node,
-              k, s, s);
+      char nv[8], nw[8];
+      snprintf(nv, sizeof nv, "dV%d", s);
+      snprintf(nw, sizeof nw, "dW%d", s);
+      emit_node_cols(f, L, k, nv, nw, "    ");
       for (int j = 0; j < 6; j++) snprintf(c[j], EXPR, "c[%d]", j);
     }
     for (int j = 0; j < 6; j++)

@@ -14,4 +14,10 @@ int emit_marker_special(FILE *f, const lmodel *L, int k);
 /* write row r if it is a spherical or dot-1 row; 0: not handled */
 int emit_row_special(FILE *f, const lmodel *L, int r);
 
+/* write marker k on a flexible node: the modal sums with the node's shapes as constants */
+void emit_marker_node(FILE *f, const lmodel *L, int k);
+/* c = mb_node_cols_mk at marker k (a flexible node) with the node's shapes as
+ * constants; dV, dW: names of 3-vectors */
+void emit_node_cols(FILE *f, const lmodel *L, int k, const char *dV, const char *dW, const char *indent);
+
 #endif

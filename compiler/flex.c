@@ -73,6 +73,12 @@ int flex_build(const ir_flex *fx, const fe_modes *fm, flex_data *out, char *err,
         out->node_Psi[3 * ((size_t)k * nm + j) + i] = fm->shapes[col + 6 * (size_t)k + 3 + i];
       }
   }
+  /* the shapes' rounding residue (an in-plane mode's out-of-plane entries
+     come out of the eigensolver at 1e-30 and below) becomes exact zeros, as
+     the invariants' below: the same tables for both paths, and the generated
+     code drops them (compiler/emit_rows.c, a node marker's modal sums) */
+  clean_table(out->node_X, n3 * (size_t)nn);
+  clean_table(out->node_Psi, n3 * (size_t)nn);
   /* invariants: sums over the nodes' lumped masses m_k and rotary inertias J_k */
   for (int k = 0; k < nn; k++) {
     double mk = fm->node_mass[k];
@@ -121,6 +127,9 @@ int flex_build(const ir_flex *fx, const fe_modes *fm, flex_data *out, char *err,
   clean_table(out->G, 3 * (size_t)nm * (size_t)nm);
   clean_table(out->C0, 3 * (size_t)nm);
   clean_table(out->CPsi, 3 * (size_t)nm);
+  /* M_ff of mass-normalized modes is I up to rounding: its off-diagonal
+     residue is not a coupling (and not an entry of K's pattern) */
+  clean_table(out->Mff, (size_t)nm * (size_t)nm);
   for (int j = 0; j < nm; j++) {
     double om = 2 * MB_PI * fm->freq_hz[j];
     /* mass-normalized modes: X^T K X = diag(omega^2); the damping ratio

@@ -86,17 +86,13 @@ static inline void mb_modal3(const mb_real *X, int nm, const mb_real *w, mb_real
     for (int i = 0; i < 3; i++) y[i] += X[3 * j + i] * w[j];
 }
 
-/* marker on node k of a flexible body (frame f, modal w, wd), axes C in body axes */
-static inline void mb_marker_node(const mb_frame *f, const mb_flex *fx, int k, const mb_real *w,
-                                  const mb_real *wd, const mb_real C[9], mb_marker *m) {
-  int nm = fx->nm;
-  const mb_real *X = fx->node_X + 3 * k * nm, *Psi = fx->node_Psi + 3 * k * nm;
-  mb_real b[3], th[3], thd[3], Xwd[3], Jl[9], Jld[9], Ex[9], AE[9], u[3], t1[3], t2[3], g[3];
-  mb_modal3(X, nm, w, b);
-  for (int i = 0; i < 3; i++) b[i] += fx->node_x[3 * k + i];
-  mb_modal3(Psi, nm, w, th);
-  mb_modal3(Psi, nm, wd, thd);
-  mb_modal3(X, nm, wd, Xwd);
+/* marker on node k of a flexible body from the node's modal sums b = x_k + X_k w
+ * (its position in body axes), th = Psi_k w, thd = Psi_k wd and Xwd = X_k wd
+ * (the generated code forms them with the node's shapes as constants) */
+static inline void mb_marker_node_sums(const mb_frame *f, const mb_real b[3], const mb_real th[3],
+                                       const mb_real thd[3], const mb_real Xwd[3], const mb_real C[9],
+                                       mb_marker *m) {
+  mb_real Jl[9], Jld[9], Ex[9], AE[9], u[3], t1[3], t2[3], g[3];
   mb_so3_jl(th, thd, Jl, Jld);
   for (int i = 0; i < 9; i++) m->Jl[i] = Jl[i];
   mb_so3_exp(th, Ex);
@@ -123,6 +119,32 @@ static inline void mb_marker_node(const mb_frame *f, const mb_flex *fx, int k, c
   mb_mul3(f->A, t1, m->aW);
 }
 
+/* marker on node k of a flexible body (frame f, modal w, wd), axes C in body axes */
+static inline void mb_marker_node(const mb_frame *f, const mb_flex *fx, int k, const mb_real *w,
+                                  const mb_real *wd, const mb_real C[9], mb_marker *m) {
+  int nm = fx->nm;
+  const mb_real *X = fx->node_X + 3 * k * nm, *Psi = fx->node_Psi + 3 * k * nm;
+  mb_real b[3], th[3], thd[3], Xwd[3];
+  mb_modal3(X, nm, w, b);
+  for (int i = 0; i < 3; i++) b[i] += fx->node_x[3 * k + i];
+  mb_modal3(Psi, nm, w, th);
+  mb_modal3(Psi, nm, wd, thd);
+  mb_modal3(X, nm, wd, Xwd);
+  mb_marker_node_sums(f, b, th, thd, Xwd, C, m);
+}
+
+/* the body columns of mb_node_cols_mk (c[0..5]) and what its modal columns
+ * are made of: c[6 + j] = X_j . lV + Psi_j . JtW, lV = A^T dV,
+ * JtW = Jl^T A^T dW */
+static inline void mb_node_cols_local(const mb_frame *f, const mb_marker *mk, const mb_real dV[3],
+                                      const mb_real dW[3], mb_real *c, mb_real lV[3], mb_real JtW[3]) {
+  mb_real lW[3];
+  mb_rigid_cols(f, mk->P, dV, dW, c);
+  mb_mul3t(f->A, dV, lV);
+  mb_mul3t(f->A, dW, lW);
+  mb_mul3t(mk->Jl, lW, JtW);
+}
+
 /* Map (dV, dW) at the marker mk of node k (as set by mb_marker_node: its
  * point and the left Jacobian of the node rotation) to the body's 6 + nm
  * velocity coordinates:
@@ -131,11 +153,8 @@ static inline void mb_node_cols_mk(const mb_frame *f, const mb_flex *fx, int k, 
                                    const mb_real dV[3], const mb_real dW[3], mb_real *c) {
   int nm = fx->nm;
   const mb_real *X = fx->node_X + 3 * k * nm, *Psi = fx->node_Psi + 3 * k * nm;
-  mb_real lV[3], lW[3], JtW[3];
-  mb_rigid_cols(f, mk->P, dV, dW, c);
-  mb_mul3t(f->A, dV, lV);
-  mb_mul3t(f->A, dW, lW);
-  mb_mul3t(mk->Jl, lW, JtW);
+  mb_real lV[3], JtW[3];
+  mb_node_cols_local(f, mk, dV, dW, c, lV, JtW);
   for (int j = 0; j < nm; j++) c[6 + j] = mb_dot3(X + 3 * j, lV) + mb_dot3(Psi + 3 * j, JtW);
 }
 
