@@ -345,7 +345,7 @@ static void emit_inv6(FILE *f) {
         " * unknowns), Gauss-Jordan with partial pivoting; 1 if a pivot is below 1e-12\n"
         " * of the largest entry.  D_u is a rotation and the identity up to signs, so\n"
         " * the explicit inverse is accurate, and every later use is a 6 x 6 product */\n"
-        "static int ldl_inv6(const mb_real *A0, mb_real *X) {\n"
+        "static LDL_MAYBE_UNUSED int ldl_inv6(const mb_real *A0, mb_real *X) {\n"
         "  mb_real A[36], amax = 0;\n"
         "  for (int i = 0; i < 36; i++) {\n"
         "    A[i] = A0[i];\n    X[i] = i % 7 == 0;\n"
@@ -376,6 +376,96 @@ static void kx_or_zero(FILE *f, int slot) {
   else fputs("0", f);
 }
 
+/* The diagonal blocks of a 6 x 6 A whose structure nz[36] is known (1 where
+ * A can be nonzero): rows and columns i, j are in one block when A(i, j) or a
+ * chain of such entries joins them.  A welded virtual body's D_u is
+ * block-diagonal (its three point rows see only the translations, its three
+ * angle rows only the rotations), and so is its inverse: comp[i] is i's block,
+ * and A^-1(i, j) is zero unless comp[i] == comp[j].  Returns the number of
+ * blocks. */
+static int inv_blocks(const int *nz, int comp[6]) {
+  int par[6], lab[6], nb = 0;
+  for (int i = 0; i < 6; i++) par[i] = i, lab[i] = -1;
+  for (int i = 0; i < 6; i++)
+    for (int j = 0; j < 6; j++)
+      if (nz[6 * i + j]) {
+        int a = i, b = j;
+        while (par[a] != a) a = par[a];
+        while (par[b] != b) b = par[b];
+        if (a != b) par[a < b ? b : a] = a < b ? a : b;
+      }
+  for (int i = 0; i < 6; i++) {
+    int a = i;
+    while (par[a] != a) a = par[a];
+    if (lab[a] < 0) lab[a] = nb++;
+    comp[i] = lab[a];
+  }
+  return nb;
+}
+
+/* ldl_invn (once per file): ldl_inv6 on an n x n block, the pivot threshold
+ * relative to amax (the largest entry of the whole 6 x 6) */
+static int invn_emitted;
+static void emit_invn(FILE *f) {
+  if (invn_emitted) return;
+  invn_emitted = 1;
+  fputs("\n/* X = A^-1 for an n x n diagonal block A of a 6 x 6 (row-major, n <= 6; A is\n"
+        " * overwritten), as ldl_inv6; 1 if a pivot is below 1e-12 amax */\n"
+        "static int ldl_invn(int n, mb_real *A, mb_real *X, mb_real amax) {\n"
+        "  for (int i = 0; i < n * n; i++) X[i] = i % (n + 1) == 0;\n"
+        "  for (int k = 0; k < n; k++) {\n"
+        "    int pr = k;\n"
+        "    for (int i = k + 1; i < n; i++) if (fabs(A[n * i + k]) > fabs(A[n * pr + k])) pr = i;\n"
+        "    if (!(fabs(A[n * pr + k]) > 1e-12 * amax)) return 1;\n"
+        "    if (pr != k)\n"
+        "      for (int j = 0; j < n; j++) {\n"
+        "        mb_real t = A[n * k + j]; A[n * k + j] = A[n * pr + j]; A[n * pr + j] = t;\n"
+        "        t = X[n * k + j]; X[n * k + j] = X[n * pr + j]; X[n * pr + j] = t;\n      }\n"
+        "    mb_real d = 1 / A[n * k + k];\n"
+        "    for (int j = k + 1; j < n; j++) A[n * k + j] *= d;\n"
+        "    for (int j = 0; j < n; j++) X[n * k + j] *= d;\n"
+        "    for (int i = 0; i < n; i++) {\n"
+        "      mb_real l = A[n * i + k];\n"
+        "      if (i == k || l == 0) continue;\n"
+        "      for (int j = k + 1; j < n; j++) A[n * i + j] -= l * A[n * k + j];\n"
+        "      for (int j = 0; j < n; j++) X[n * i + j] -= l * X[n * k + j];\n"
+        "    }\n  }\n  return 0;\n}\n\n", f);
+}
+
+/* "X = A^-1" for the 6 x 6 A of structure nz, block by block (inv_blocks);
+ * 'fail' is the statement run when a pivot is too small */
+static void emit_inv_blocked(FILE *f, const char *A, const char *X, const int *nz, const char *fail) {
+  int comp[6], nb = inv_blocks(nz, comp);
+  if (nb == 1) {
+    fprintf(f, "  if (ldl_inv6(%s, %s)) %s;\n", A, X, fail);
+    return;
+  }
+  fprintf(f, "  { /* %s is block-diagonal: %d blocks inverted apart */\n    mb_real amax = 0;\n", A, nb);
+  for (int k = 0; k < 36; k++)
+    if (nz[k]) fprintf(f, "    if (fabs(%s[%d]) > amax) amax = fabs(%s[%d]);\n", A, k, A, k);
+  for (int c = 0; c < nb; c++) {
+    int mem[6], n = 0;
+    for (int i = 0; i < 6; i++)
+      if (comp[i] == c) mem[n++] = i;
+    if (n == 1) {
+      int d = 7 * mem[0];
+      fprintf(f, "    if (!(fabs(%s[%d]) > 1e-12 * amax)) %s;\n    %s[%d] = 1 / %s[%d];\n", A, d, fail, X, d, A, d);
+      continue;
+    }
+    fprintf(f, "    {\n      mb_real a[%d], x[%d];\n", n * n, n * n);
+    for (int i = 0; i < n; i++)
+      for (int j = 0; j < n; j++) fprintf(f, "      a[%d] = %s[%d];\n", n * i + j, A, 6 * mem[i] + mem[j]);
+    fprintf(f, "      if (ldl_invn(%d, a, x, amax)) %s;\n", n, fail);
+    for (int i = 0; i < n; i++)
+      for (int j = 0; j < n; j++) fprintf(f, "      %s[%d] = x[%d];\n", X, 6 * mem[i] + mem[j], n * i + j);
+    fputs("    }\n", f);
+  }
+  for (int i = 0; i < 6; i++)
+    for (int j = 0; j < 6; j++)
+      if (comp[i] != comp[j]) fprintf(f, "    %s[%d] = 0;\n", X, 6 * i + j);
+  fputs("  }\n", f);
+}
+
 /* the block pivots straight-line (below the flop budget): every slot a
  * constant, structural zeros of Du, Dx and Eu skipped */
 /* "  v[i] = r[row] - Kx[slot] * d[col] ...;": row of a block's right side less
@@ -397,6 +487,15 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
   if (!src) return;
   for (int q = 0; q < p->nnzR; q++)
     if (kc_of[q] >= 0) src[kc_of[q]] = p->Krmap[q];
+  /* the blocks' D_u structure, and with it which entries of D_u^-1 can be nonzero */
+  int (*dinz)[36] = calloc((size_t)p->nelim + 1, sizeof *dinz);
+  if (!dinz) return;
+  for (int e = 0; e < p->nelim; e++) {
+    int nz[36], comp[6];
+    for (int i = 0; i < 36; i++) nz[i] = p->edu[e][i] >= 0;
+    if (inv_blocks(nz, comp) > 1) emit_invn(f);
+    for (int i = 0; i < 36; i++) dinz[e][i] = comp[i / 6] == comp[i % 6];
+  }
   fputs("/* Kc (the entries of K' the block pivots set) from Kx; returns 0, or 1 + a column\n"
         " * of a virtual body whose Du is singular */\n"
         "static int ldl_block_pivots(const mb_real *Kx, mb_real *work) {\n"
@@ -418,7 +517,13 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
       kx_or_zero(f, p->edu[e][i]);
       fputs(";\n", f);
     }
-    fprintf(f, "  if (ldl_inv6(A, Di)) return %d;\n", 1 + p->eu[e][0]);
+    {
+      int nz[36];
+      char fail[32];
+      for (int i = 0; i < 36; i++) nz[i] = p->edu[e][i] >= 0;
+      snprintf(fail, sizeof fail, "return %d", 1 + p->eu[e][0]);
+      emit_inv_blocked(f, "A", "Di", nz, fail);
+    }
     int k = p->ekrp[e];
     for (int si = 0; si < ns; si++) {
       const int *eu = p->eeu + 6 * (ss + si);
@@ -428,7 +533,10 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
         fprintf(f, "  W[%d] = ", 6 * si + i);
         int any = 0;
         for (int c = 0; c < 6; c++)
-          if (eu[c] >= 0) { fprintf(f, "%sKx[%d] * Di[%d]", any ? " + " : "", eu[c], 6 * c + i); any = 1; }
+          if (eu[c] >= 0 && dinz[e][6 * c + i]) {
+            fprintf(f, "%sKx[%d] * Di[%d]", any ? " + " : "", eu[c], 6 * c + i);
+            any = 1;
+          }
         if (!any) fputs("0", f);
         fputs(";\n", f);
       }
@@ -460,9 +568,14 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
       fputs(";\n", f);
     }
     for (int i = 0; i < 6; i++) {
+      int any = 0;
       fprintf(f, "  z[%d] = ", i);
-      for (int c = 0; c < 6; c++) fprintf(f, "%sDi[%d] * r[%d]", c ? " + " : "", 6 * c + i, p->eu[e][c]);
-      fputs(";\n", f);
+      for (int c = 0; c < 6; c++)
+        if (dinz[e][6 * c + i]) {
+          fprintf(f, "%sDi[%d] * r[%d]", any ? " + " : "", 6 * c + i, p->eu[e][c]);
+          any = 1;
+        }
+      fputs(any ? ";\n" : "0;\n", f);
     }
     for (int xi = 0; xi < nx; xi++) {
       const int *dx = p->edx + 6 * (xs + xi);
@@ -489,14 +602,25 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
     for (int i = 0; i < 6; i++) emit_reduced_rhs(f, "y", i, p->er[e][i], p->edx + 6 * xs, p->ex + xs, nx);
     for (int c = 0; c < 6; c++) emit_reduced_rhs(f, "z", c, p->eu[e][c], p->eeu + 6 * ss, p->es + ss, ns);
     for (int c = 0; c < 6; c++) {
+      int any = 0;
       fprintf(f, "  d[%d] = ", p->eu[e][c]);
-      for (int i = 0; i < 6; i++) fprintf(f, "%sDi[%d] * y[%d]", i ? " + " : "", 6 * c + i, i);
-      fprintf(f, ";\n  d[%d] = ", p->er[e][c]);
-      for (int i = 0; i < 6; i++) fprintf(f, "%sDi[%d] * z[%d]", i ? " + " : "", 6 * i + c, i);
-      fputs(";\n", f);
+      for (int i = 0; i < 6; i++)
+        if (dinz[e][6 * c + i]) {
+          fprintf(f, "%sDi[%d] * y[%d]", any ? " + " : "", 6 * c + i, i);
+          any = 1;
+        }
+      fprintf(f, "%s;\n  d[%d] = ", any ? "" : "0", p->er[e][c]);
+      any = 0;
+      for (int i = 0; i < 6; i++)
+        if (dinz[e][6 * i + c]) {
+          fprintf(f, "%sDi[%d] * z[%d]", any ? " + " : "", 6 * i + c, i);
+          any = 1;
+        }
+      fputs(any ? ";\n" : "0;\n", f);
     }
   }
   fputs("  (void)Kx;\n}\n\n", f);
+  free(dinz);
 }
 
 static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
@@ -1289,7 +1413,7 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
              "#define LDL_KR (LDL_XB + LDL_N)\n#define LDL_RR (LDL_KR + %d)\n#define LDL_DD (LDL_RR + LDL_N)\n"
              "/* a solve whose relative residual is already this small is not refined */\n"
              "#define LDL_REFINE_TOL 1e-15\n"
-             "#if defined(__GNUC__)\n#define LDL_NOINLINE __attribute__((noinline))\n#else\n#define LDL_NOINLINE\n#endif\n",
+             "#if defined(__GNUC__)\n#define LDL_NOINLINE __attribute__((noinline))\n#define LDL_MAYBE_UNUSED __attribute__((unused))\n#else\n#define LDL_NOINLINE\n#define LDL_MAYBE_UNUSED\n#endif\n",
           n, U, p.nelim ? p.nnzR : 0);
   /* pivot order as a comment (straight) or a table (looped) */
   if (p.straight) {
@@ -1348,6 +1472,7 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
   }
   int *kc = NULL;
   inv6_emitted = 0;
+  invn_emitted = 0;
   if (p.nml) emit_massless(f, L, &p);
   if (p.nelim) {
     kc = malloc(sizeof(int) * (size_t)(p.nnzR + 1));
