@@ -432,6 +432,14 @@ static void emit_invn(FILE *f) {
         "    }\n  }\n  return 0;\n}\n\n", f);
 }
 
+/* W(s, i) = sum_c Eu(s, c) Du^-1(c, i) can be nonzero (eu: row s's slots in
+ * the body's columns, -1 none; dinz: the structure of Du^-1) */
+static int w_nonzero(const int *eu, const int *dinz, int i) {
+  for (int c = 0; c < 6; c++)
+    if (eu[c] >= 0 && dinz[6 * c + i]) return 1;
+  return 0;
+}
+
 /* "X = A^-1" for the 6 x 6 A of structure nz, block by block (inv_blocks);
  * 'fail' is the statement run when a pivot is too small */
 static void emit_inv_blocked(FILE *f, const char *A, const char *X, const int *nz, const char *fail) {
@@ -544,7 +552,7 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
         const int *dx = p->edx + 6 * (xs + xi);
         int any = 0;
         for (int i = 0; i < 6; i++)
-          if (dx[i] >= 0) {
+          if (dx[i] >= 0 && w_nonzero(eu, dinz[e], i)) {
             fprintf(f, "%sW[%d] * Kx[%d]", any ? " + " : "  v = ", 6 * si + i, dx[i]);
             any = 1;
           }
@@ -563,9 +571,15 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
     int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
     fprintf(f, "  /* block %d */\n  Di = work + %ld;\n  W = Di + 42;\n", e, woff[e]);
     for (int si = 0; si < ns; si++) {
-      fprintf(f, "  rr[%d] -= ", p->es[ss + si]);
-      for (int c = 0; c < 6; c++) fprintf(f, "%sW[%d] * r[%d]", c ? " + " : "", 6 * si + c, p->er[e][c]);
-      fputs(";\n", f);
+      const int *eu = p->eeu + 6 * (ss + si);
+      int any = 0;
+      for (int c = 0; c < 6; c++)
+        if (w_nonzero(eu, dinz[e], c)) {
+          if (!any) fprintf(f, "  rr[%d] -= ", p->es[ss + si]);
+          fprintf(f, "%sW[%d] * r[%d]", any ? " + " : "", 6 * si + c, p->er[e][c]);
+          any = 1;
+        }
+      if (any) fputs(";\n", f);
     }
     for (int i = 0; i < 6; i++) {
       int any = 0;
