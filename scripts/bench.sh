@@ -122,7 +122,9 @@ tmp=$OUT.part
   echo "  IDA (BDF, dense LU, difference-quotient Jacobian), with the generated evaluation."
   echo
   echo "All but \`ida\` use the model's integrator (Dormand–Prince 5(4), the model's tolerances,"
-  echo "coordinate projection), so they take the same steps. Per-step time is the median over"
+  echo "coordinate projection), so they take the same steps up to round-off (paths whose error"
+  echo "estimates differ in the last digits can accept or reject a step differently, a few steps"
+  echo "in 24000 on the flexible slider-crank; hence the per-step ratios). Per-step time is the median over"
   echo "$REPS repetitions of (whole-run time / steps); the run time is the median whole-run time"
   echo "(solver set-up included). \`ratio (run)\` divides by the fastest run of the table,"
   echo "\`ratio (per step)\` by the fastest per-step time of the Dormand–Prince paths (IDA's BDF"
