@@ -363,7 +363,7 @@ static void emit_row_common(FILE *f, const lmodel *L, int r, const smark mk[2], 
       svec v = dV[s], w = dW[s];
       fprintf(f, "    mb_real dV%d[3] = {%s, %s, %s}, dW%d[3] = {%s, %s, %s};\n", s, v.e[0], v.e[1], v.e[2],
               s, w.e[0], w.e[1], w.e[2]);
-      char nv[8], nw[8];
+      char nv[16], nw[16];
       snprintf(nv, sizeof nv, "dV%d", s);
       snprintf(nw, sizeof nw, "dW%d", s);
       emit_node_cols(f, L, k, nv, nw, "    ");
