@@ -336,38 +336,42 @@ static void emit_factor_looped(FILE *f, const lmodel *L, const ldl_plan *p, cons
 
 /* ----------------------------------------------------------- block pivots */
 
-/* ldl_inv6 of the generated code (once per file) */
+/* ldl_invn and ldl_inv6 of the generated code (once per file) */
 static int inv6_emitted;
 static void emit_inv6(FILE *f) {
   if (inv6_emitted) return;
   inv6_emitted = 1;
-  fputs("\n/* X = A^-1 for a 6 x 6 A (row-major: rows the weld rows, columns the body's\n"
-        " * unknowns), Gauss-Jordan with partial pivoting; 1 if a pivot is below 1e-12\n"
-        " * of the largest entry.  D_u is a rotation and the identity up to signs, so\n"
-        " * the explicit inverse is accurate, and every later use is a 6 x 6 product */\n"
+  fputs("\n/* X = A^-1 for an n x n A (row-major, n <= 6; A is overwritten), Gauss-Jordan\n"
+        " * with partial pivoting; 1 if a pivot is below 1e-12 amax.  The 6 x 6 are a\n"
+        " * body's D_u: a rotation and the identity up to signs, so the explicit inverse\n"
+        " * is accurate, and every later use is a 6 x 6 product */\n"
+        "static LDL_MAYBE_UNUSED int ldl_invn(int n, mb_real *A, mb_real *X, mb_real amax) {\n"
+        "  for (int i = 0; i < n * n; i++) X[i] = i % (n + 1) == 0;\n"
+        "  for (int k = 0; k < n; k++) {\n"
+        "    int pr = k;\n"
+        "    for (int i = k + 1; i < n; i++) if (fabs(A[n * i + k]) > fabs(A[n * pr + k])) pr = i;\n"
+        "    if (!(fabs(A[n * pr + k]) > 1e-12 * amax)) return 1;\n"
+        "    if (pr != k)\n"
+        "      for (int j = 0; j < n; j++) {\n"
+        "        mb_real t = A[n * k + j]; A[n * k + j] = A[n * pr + j]; A[n * pr + j] = t;\n"
+        "        t = X[n * k + j]; X[n * k + j] = X[n * pr + j]; X[n * pr + j] = t;\n      }\n"
+        "    /* columns up to k of A are done (unit vectors): only those right of k change */\n"
+        "    mb_real d = 1 / A[n * k + k];\n"
+        "    for (int j = k + 1; j < n; j++) A[n * k + j] *= d;\n"
+        "    for (int j = 0; j < n; j++) X[n * k + j] *= d;\n"
+        "    for (int i = 0; i < n; i++) {\n"
+        "      mb_real l = A[n * i + k];\n"
+        "      if (i == k || l == 0) continue;\n"
+        "      for (int j = k + 1; j < n; j++) A[n * i + j] -= l * A[n * k + j];\n"
+        "      for (int j = 0; j < n; j++) X[n * i + j] -= l * X[n * k + j];\n"
+        "    }\n  }\n  return 0;\n}\n\n"
+        "/* X = A0^-1 for a 6 x 6 A0, the threshold relative to its largest entry */\n"
         "static LDL_MAYBE_UNUSED int ldl_inv6(const mb_real *A0, mb_real *X) {\n"
         "  mb_real A[36], amax = 0;\n"
         "  for (int i = 0; i < 36; i++) {\n"
-        "    A[i] = A0[i];\n    X[i] = i % 7 == 0;\n"
+        "    A[i] = A0[i];\n"
         "    if (fabs(A[i]) > amax) amax = fabs(A[i]);\n  }\n"
-        "  for (int k = 0; k < 6; k++) {\n"
-        "    int pr = k;\n"
-        "    for (int i = k + 1; i < 6; i++) if (fabs(A[6 * i + k]) > fabs(A[6 * pr + k])) pr = i;\n"
-        "    if (!(fabs(A[6 * pr + k]) > 1e-12 * amax)) return 1;\n"
-        "    if (pr != k)\n"
-        "      for (int j = 0; j < 6; j++) {\n"
-        "        mb_real t = A[6 * k + j]; A[6 * k + j] = A[6 * pr + j]; A[6 * pr + j] = t;\n"
-        "        t = X[6 * k + j]; X[6 * k + j] = X[6 * pr + j]; X[6 * pr + j] = t;\n      }\n"
-        "    /* columns up to k of A are done (unit vectors): only those right of k change */\n"
-        "    mb_real d = 1 / A[6 * k + k];\n"
-        "    for (int j = k + 1; j < 6; j++) A[6 * k + j] *= d;\n"
-        "    for (int j = 0; j < 6; j++) X[6 * k + j] *= d;\n"
-        "    for (int i = 0; i < 6; i++) {\n"
-        "      mb_real l = A[6 * i + k];\n"
-        "      if (i == k || l == 0) continue;\n"
-        "      for (int j = k + 1; j < 6; j++) A[6 * i + j] -= l * A[6 * k + j];\n"
-        "      for (int j = 0; j < 6; j++) X[6 * i + j] -= l * X[6 * k + j];\n"
-        "    }\n  }\n  return 0;\n}\n\n", f);
+        "  return ldl_invn(6, A, X, amax);\n}\n\n", f);
 }
 
 /* "Kx[slot]" or "0" */
@@ -401,35 +405,6 @@ static int inv_blocks(const int *nz, int comp[6]) {
     comp[i] = lab[a];
   }
   return nb;
-}
-
-/* ldl_invn (once per file): ldl_inv6 on an n x n block, the pivot threshold
- * relative to amax (the largest entry of the whole 6 x 6) */
-static int invn_emitted;
-static void emit_invn(FILE *f) {
-  if (invn_emitted) return;
-  invn_emitted = 1;
-  fputs("\n/* X = A^-1 for an n x n diagonal block A of a 6 x 6 (row-major, n <= 6; A is\n"
-        " * overwritten), as ldl_inv6; 1 if a pivot is below 1e-12 amax */\n"
-        "static int ldl_invn(int n, mb_real *A, mb_real *X, mb_real amax) {\n"
-        "  for (int i = 0; i < n * n; i++) X[i] = i % (n + 1) == 0;\n"
-        "  for (int k = 0; k < n; k++) {\n"
-        "    int pr = k;\n"
-        "    for (int i = k + 1; i < n; i++) if (fabs(A[n * i + k]) > fabs(A[n * pr + k])) pr = i;\n"
-        "    if (!(fabs(A[n * pr + k]) > 1e-12 * amax)) return 1;\n"
-        "    if (pr != k)\n"
-        "      for (int j = 0; j < n; j++) {\n"
-        "        mb_real t = A[n * k + j]; A[n * k + j] = A[n * pr + j]; A[n * pr + j] = t;\n"
-        "        t = X[n * k + j]; X[n * k + j] = X[n * pr + j]; X[n * pr + j] = t;\n      }\n"
-        "    mb_real d = 1 / A[n * k + k];\n"
-        "    for (int j = k + 1; j < n; j++) A[n * k + j] *= d;\n"
-        "    for (int j = 0; j < n; j++) X[n * k + j] *= d;\n"
-        "    for (int i = 0; i < n; i++) {\n"
-        "      mb_real l = A[n * i + k];\n"
-        "      if (i == k || l == 0) continue;\n"
-        "      for (int j = k + 1; j < n; j++) A[n * i + j] -= l * A[n * k + j];\n"
-        "      for (int j = 0; j < n; j++) X[n * i + j] -= l * X[n * k + j];\n"
-        "    }\n  }\n  return 0;\n}\n\n", f);
 }
 
 /* W(s, i) = sum_c Eu(s, c) Du^-1(c, i) can be nonzero (eu: row s's slots in
@@ -501,7 +476,7 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
   for (int e = 0; e < p->nelim; e++) {
     int nz[36], comp[6];
     for (int i = 0; i < 36; i++) nz[i] = p->edu[e][i] >= 0;
-    if (inv_blocks(nz, comp) > 1) emit_invn(f);
+    inv_blocks(nz, comp);
     for (int i = 0; i < 36; i++) dinz[e][i] = comp[i / 6] == comp[i % 6];
   }
   fputs("/* Kc (the entries of K' the block pivots set) from Kx; returns 0, or 1 + a column\n"
@@ -1486,7 +1461,6 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
   }
   int *kc = NULL;
   inv6_emitted = 0;
-  invn_emitted = 0;
   if (p.nml) emit_massless(f, L, &p);
   if (p.nelim) {
     kc = malloc(sizeof(int) * (size_t)(p.nnzR + 1));
