@@ -243,18 +243,13 @@ static void emit_tables(FILE *f, const lmodel *L) {
   }
 }
 
-/* a node whose mode shapes all vanish there (the reference node of the body
- * frame, or Craig-Bampton interface nodes held by it): its marker is a rigid
- * marker at the node's position, the same numbers without the modal sums,
- * the rotation exponential and the zero modal columns (known at compile time) */
-static int node_static(const mb_body *B, int node) { return emit_node_static(B, node); }
 
 /* c = the body columns of (dV, dW) at marker k; returns how many (6 or 6 + nm) */
 static int emit_cols(FILE *f, const lmodel *L, int k, const char *P, const char *dV, const char *dW,
                      const char *indent) {
   const mb_markerdef *d = &L->marker[k];
   const mb_body *B = &L->body[d->body];
-  if (d->node >= 0 && !node_static(B, d->node)) {
+  if (d->node >= 0 && !emit_node_static(B, d->node)) {
     emit_node_cols(f, L, k, dV, dW, indent);
     return 6 + B->nm;
   }
@@ -440,7 +435,7 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
     fprintf(f, "  /* %s */\n", L->marker_desc[k]);
     if (d->body < 0) {
       fprintf(f, "  mb_marker_ground(markers[%d].s, markers[%d].C, &k[%d]);\n", k, k, k);
-    } else if (d->node >= 0 && node_static(&L->body[d->body], d->node)) {
+    } else if (d->node >= 0 && emit_node_static(&L->body[d->body], d->node)) {
       fprintf(f, "  /* node %d: its mode shapes vanish: a rigid marker (mb_marker_rigid) */\n", d->node);
       emit_marker_special(f, L, k);
     } else if (d->node >= 0) {
@@ -583,26 +578,15 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
                "  rhs[%d] = mb_row_gamma(&r, &k[%d], &k[%d]);\n", r, r, R->m0, R->m1,
             m->nv + r, R->m0, R->m1);
     for (int s = 0; s < 2; s++) {
-      int mk = s ? R->m1 : R->m0, b = L->marker[mk].body, any = 0;
-      if (b < 0) continue;
-      for (int j = 0; j < 6; j++) any |= R->slot[s][j] >= 0 && !R->constant[s][j];
-      if (R->mslot[s] >= 0) any = 1;
-      if (!any) continue;
+      int mk = s ? R->m1 : R->m0;
+      if (!emit_row_side_varies(L, r, s)) continue;
+      static const char *const cs[6] = {"c[0]", "c[1]", "c[2]", "c[3]", "c[4]", "c[5]"};
       char P[32], dV[32], dW[32];
       snprintf(P, sizeof P, "k[%d].P", mk);
       snprintf(dV, sizeof dV, "r.dV[%d]", s);
       snprintf(dW, sizeof dW, "r.dW[%d]", s);
       emit_cols(f, L, mk, P, dV, dW, "  ");
-      for (int j = 0; j < 6; j++)
-        if (R->slot[s][j] >= 0 && !R->constant[s][j])
-          fprintf(f, "  Kx[%d] = Kx[%d] = c[%d];\n", R->slot[s][j], R->slotT[s][j], j);
-      if (R->mslot[s] >= 0) {
-        int nmb = L->body[b].nm, stat = node_static(&L->body[b], L->marker[mk].node);
-        const int *ms = L->modal_slot + R->mslot[s];
-        for (int j = 0; j < nmb; j++)
-          if (ms[j] >= 0 && stat) fprintf(f, "  Kx[%d] = Kx[%d] = 0;\n", ms[j], ms[nmb + j]);
-          else if (ms[j] >= 0) fprintf(f, "  Kx[%d] = Kx[%d] = c[%d];\n", ms[j], ms[nmb + j], 6 + j);
-      }
+      emit_row_stores(f, L, r, s, cs, "  ");
     }
   }
   fputs("}\n", f);

@@ -133,6 +133,10 @@ static void s_local(FILE *f, svec *v, const char *name, const char *indent) {
     if (!is_atom(v->e[i])) snprintf(v->e[i], EXPR, "%s[%d]", name, i);
 }
 
+/* a node whose mode shapes all vanish there (the reference node of the body
+ * frame, or Craig-Bampton interface nodes held by it): its marker is a rigid
+ * marker at the node's position, the same numbers without the modal sums,
+ * the rotation exponential and the zero modal columns (known at compile time) */
 int emit_node_static(const mb_body *B, int node) {
   const mb_flex *fx = B->flex;
   if (!fx || node < 0) return 0;
@@ -303,6 +307,44 @@ static void mark_view(const lmodel *L, int k, smark *m) {
   }
 }
 
+/* dV0.a0 + dW0.b0 + dV1.a1 + dW1.b1, summed left to right as mb_row_phidot and
+ * mb_row_gamma do (a, b: the markers' V, W or aP, aW) */
+static void s_row_sum(char *o, const svec dV[2], const svec dW[2], const svec *a0, const svec *b0,
+                      const svec *a1, const svec *b1) {
+  char p[EXPR];
+  s_dot(o, &dV[0], a0);
+  s_dot(p, &dW[0], b0);
+  s_add(o, o, p);
+  s_dot(p, &dV[1], a1);
+  s_add(o, o, p);
+  s_dot(p, &dW[1], b1);
+  s_add(o, o, p);
+}
+
+int emit_row_side_varies(const lmodel *L, int r, int s) {
+  const mb_rowdef *R = &L->row[r];
+  if (L->marker[s ? R->m1 : R->m0].body < 0) return 0;
+  if (R->mslot[s] >= 0) return 1;
+  for (int j = 0; j < 6; j++)
+    if (R->slot[s][j] >= 0 && !R->constant[s][j]) return 1;
+  return 0;
+}
+
+void emit_row_stores(FILE *f, const lmodel *L, int r, int s, const char *const c[6], const char *indent) {
+  const mb_rowdef *R = &L->row[r];
+  int k = s ? R->m1 : R->m0;
+  const mb_body *B = &L->body[L->marker[k].body];
+  for (int j = 0; j < 6; j++)
+    if (R->slot[s][j] >= 0 && !R->constant[s][j])
+      fprintf(f, "%sKx[%d] = Kx[%d] = %s;\n", indent, R->slot[s][j], R->slotT[s][j], c[j]);
+  if (R->mslot[s] < 0) return;
+  int stat = marker_rigid(L, k, NULL);
+  const int *ms = L->modal_slot + R->mslot[s];
+  for (int j = 0; j < B->nm; j++)
+    if (ms[j] >= 0 && stat) fprintf(f, "%sKx[%d] = Kx[%d] = 0;\n", indent, ms[j], ms[B->nm + j]);
+    else if (ms[j] >= 0) fprintf(f, "%sKx[%d] = Kx[%d] = c[%d];\n", indent, ms[j], ms[B->nm + j], 6 + j);
+}
+
 /* a row's phi, phid, gamma and its entries of D (both triangles of K), from
  * the row's d(phidot)/dV, d(phidot)/dW of each marker, its quadratic term and
  * nu, as mb_row_phidot, mb_row_gamma and mb_rigid_cols / mb_node_cols_mk */
@@ -312,31 +354,16 @@ static void emit_row_common(FILE *f, const lmodel *L, int r, const smark mk[2], 
   const mb_rowdef *R = &L->row[r];
   char t[EXPR], p[EXPR];
   /* phid = dV0.V0 + dW0.W0 + dV1.V1 + dW1.W1 - nu (nu = 0: no driver) */
-  s_dot(t, &dV[0], &mk[0].V);
-  s_dot(p, &dW[0], &mk[0].W);
-  s_add(t, t, p);
-  s_dot(p, &dV[1], &mk[1].V);
-  s_add(t, t, p);
-  s_dot(p, &dW[1], &mk[1].W);
-  s_add(t, t, p);
+  s_row_sum(t, dV, dW, &mk[0].V, &mk[0].W, &mk[1].V, &mk[1].W);
   fprintf(f, "    phid[%d] = %s;\n", r, t);
   /* gamma = -(dV0.aP0 + dW0.aW0 + dV1.aP1 + dW1.aW1 + quad) */
-  s_dot(t, &dV[0], &mk[0].aP);
-  s_dot(p, &dW[0], &mk[0].aW);
-  s_add(t, t, p);
-  s_dot(p, &dV[1], &mk[1].aP);
-  s_add(t, t, p);
-  s_dot(p, &dW[1], &mk[1].aW);
-  s_add(t, t, p);
+  s_row_sum(t, dV, dW, &mk[0].aP, &mk[0].aW, &mk[1].aP, &mk[1].aW);
   s_add(t, t, quad);
   s_neg(t, t);
   fprintf(f, "    rhs[%d] = %s;\n", m->nv + r, t);
   for (int s = 0; s < 2; s++) {
-    int k = s ? R->m1 : R->m0, b = L->marker[k].body, any = 0;
-    if (b < 0) continue;
-    for (int j = 0; j < 6; j++) any |= R->slot[s][j] >= 0 && !R->constant[s][j];
-    if (R->mslot[s] >= 0) any = 1;
-    if (!any) continue;
+    int k = s ? R->m1 : R->m0, b = L->marker[k].body;
+    if (!emit_row_side_varies(L, r, s)) continue;
     char c[6][EXPR];
     if (mk[s].rigid) {
       /* mb_rigid_cols: [dV; A^T ((P - r) x dV + dW)] */
@@ -369,16 +396,8 @@ static void emit_row_common(FILE *f, const lmodel *L, int r, const smark mk[2], 
       emit_node_cols(f, L, k, nv, nw, "    ");
       for (int j = 0; j < 6; j++) snprintf(c[j], EXPR, "c[%d]", j);
     }
-    for (int j = 0; j < 6; j++)
-      if (R->slot[s][j] >= 0 && !R->constant[s][j])
-        fprintf(f, "    Kx[%d] = Kx[%d] = %s;\n", R->slot[s][j], R->slotT[s][j], c[j]);
-    if (R->mslot[s] >= 0) {
-      int nmb = L->body[b].nm;
-      const int *ms = L->modal_slot + R->mslot[s];
-      for (int j = 0; j < nmb; j++)
-        if (ms[j] >= 0 && mk[s].rigid) fprintf(f, "    Kx[%d] = Kx[%d] = 0;\n", ms[j], ms[nmb + j]);
-        else if (ms[j] >= 0) fprintf(f, "    Kx[%d] = Kx[%d] = c[%d];\n", ms[j], ms[nmb + j], 6 + j);
-    }
+    const char *cs[6] = {c[0], c[1], c[2], c[3], c[4], c[5]};
+    emit_row_stores(f, L, r, s, cs, "    ");
   }
 }
 

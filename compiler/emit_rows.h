@@ -20,4 +20,12 @@ void emit_marker_node(FILE *f, const lmodel *L, int k);
  * constants; dV, dW: names of 3-vectors */
 void emit_node_cols(FILE *f, const lmodel *L, int k, const char *dV, const char *dW, const char *indent);
 
+/* 1 when row r writes entries of D through its marker s (0 or 1): on a body,
+ * with varying or modal slots */
+int emit_row_side_varies(const lmodel *L, int r, int s);
+/* row r's stores into both triangles of K through marker s: the varying body
+ * columns from the expressions c[0..5], the modal columns from c[6 + j]
+ * (zero on a node whose shapes vanish) */
+void emit_row_stores(FILE *f, const lmodel *L, int r, int s, const char *const c[6], const char *indent);
+
 #endif
