@@ -42,7 +42,7 @@ static void usage(void) {
           "                [--end T] [--output-step H] [--step H] [--max-step H] [--rtol R] [--atol A]\n"
           "                [--stabilization projection|baumgarte|none] [--rho-inf R] [--max-steps N] [--quiet]\n"
           "       mbcc bench M.yaml [--scene S] [--csv FILE] [--reps N] [--paths a,b,...]\n"
-          "                [--integrator rk4|dopri5] [--end T] [--rtol R] [--atol A] [--quiet]\n"
+          "                [--integrator rk4|dopri5] [--end T] [--rtol R] [--atol A] [--ida-rtol R] [--quiet]\n"
           "       mbcc modes M.yaml --body NAME [--scene S] [--shapes shapes.csv]\n"
           "                [--write-modal body.modal.yaml]\n"
           "       mbcc plot results.csv [-o out.png] [--columns a,b,...]\n"
@@ -90,7 +90,7 @@ static int parse_options(int argc, char **argv, options *o) {
              !strcmp(a, "--output-step") || !strcmp(a, "--step") || !strcmp(a, "--max-step") || !strcmp(a, "--rtol") ||
              !strcmp(a, "--atol") || !strcmp(a, "--stabilization") || !strcmp(a, "--columns") ||
              !strcmp(a, "--csv") || !strcmp(a, "--reps") || !strcmp(a, "--paths") || !strcmp(a, "--rho-inf") ||
-             !strcmp(a, "--max-steps")) {
+             !strcmp(a, "--max-steps") || !strcmp(a, "--ida-rtol")) {
       if (o->nsim + 2 > 30) { fprintf(stderr, "mbcc: error: too many options\n"); return 2; }
       o->sim_args[o->nsim++] = a;
       o->sim_args[o->nsim++] = v;

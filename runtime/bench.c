@@ -60,8 +60,10 @@ typedef struct {
   double step_med, run_med;
   long steps, evals;
   double residual;     /* ldl: largest relative residual of a solve after refinement */
-  double max_rel;      /* against the reference path */
+  double max_rel;      /* against the reference path, every output */
   int worst_col;
+  double max_rel_pos;  /* the same over the position outputs only (is_position_col) */
+  int worst_col_pos;
   recorder rec;
 } path_result;
 
@@ -76,7 +78,8 @@ static double median(double *a, int n) {
 }
 
 /* one run of path p; its wall time, steps and the recorded outputs */
-static int run_once(const path_def *p, const mb_model *m, const mb_settings *set, recorder *rec,
+static int run_once(const path_def *p, const mb_model *m, const mb_settings *set, double ida_rtol,
+                    recorder *rec,
                     double *wall, long *steps, long *evals, double *residual, double *fail_time,
                     char *detail, size_t ndetail) {
   rec->nrows = 0;
@@ -85,7 +88,12 @@ static int run_once(const path_def *p, const mb_model *m, const mb_settings *set
   double t0 = now();
   if (p->eval == EVAL_IDA) {
     mb_stats stats;
-    st = mb_ida_simulate(m, set, record, rec, &stats, fail_time);
+    mb_settings ida_set = *set;
+    if (ida_rtol > 0) { /* tighter (or looser) BDF tolerances, atol scaled alike */
+      ida_set.atol = set->atol * ida_rtol / set->rtol;
+      ida_set.rtol = ida_rtol;
+    }
+    st = mb_ida_simulate(m, &ida_set, record, rec, &stats, fail_time);
     *wall = now() - t0;
     *steps = stats.steps;
     *evals = stats.evals;
@@ -131,12 +139,27 @@ static double col_scale(const mb_model *m, const recorder *ref, int j) {
   return range > 0 ? range : big > 0 ? big : 1;
 }
 
-/* max over columns and output times of |a - ref| / col_scale */
-static double compare(const mb_model *m, const recorder *ref, const recorder *a, int *worst) {
+/* column j belongs to a configuration output: a position, orientation, angle,
+ * deflection or modal coordinate (the quantities the agreement target is stated on) */
+static int is_position_col(const mb_model *m, int j) {
+  for (int o = 0; o < m->noutput; o++) {
+    const mb_outputdef *d = &m->output[o];
+    if (j >= d->col && j < d->col + d->ncols)
+      return d->kind == MB_OUT_POSITION || d->kind == MB_OUT_ORIENTATION ||
+             d->kind == MB_OUT_ANGLE || d->kind == MB_OUT_DEFLECTION || d->kind == MB_OUT_MODAL;
+  }
+  return 0;
+}
+
+/* max over columns (only position columns when positions_only) and output times of
+ * |a - ref| / col_scale */
+static double compare(const mb_model *m, const recorder *ref, const recorder *a, int positions_only,
+                      int *worst) {
   int nc = m->ncols, nr = ref->nrows < a->nrows ? ref->nrows : a->nrows;
   double mx = 0;
   *worst = -1;
   for (int j = 0; j < nc; j++) {
+    if (positions_only && !is_position_col(m, j)) continue;
     double scale = col_scale(m, ref, j);
     for (int k = 0; k < nr; k++) {
       double d = fabs(a->y[(size_t)k * (size_t)nc + (size_t)j] - ref->y[(size_t)k * (size_t)nc + (size_t)j]) / scale;
@@ -148,7 +171,7 @@ static double compare(const mb_model *m, const recorder *ref, const recorder *a,
 
 static void usage(const char *prog) {
   fprintf(stderr,
-          "usage: %s [--reps N] [--csv FILE] [--paths a,b,...] [--quiet]\n"
+          "usage: %s [--reps N] [--csv FILE] [--paths a,b,...] [--quiet] [--ida-rtol R]\n"
           "          [--integrator rk4|dopri5] [--stabilization projection|baumgarte|none]\n"
           "          [--end T] [--output-step H] [--step H] [--rtol R] [--atol A]\n"
           "paths: generated+ldl generated+klu generated+dense generic+klu generic+dense ida\n",
@@ -178,6 +201,7 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
   set.timers = 0; /* every path is timed as a whole run: no clock inside the steps */
   const char *csv_path = NULL, *paths = NULL;
   int reps = 5, quiet = 0;
+  double ida_rtol = 0; /* --ida-rtol: 0 = the model's rtol */
   long nnz_l = m->ldl_factor ? m->ldl_nnzL : -1; /* the emitted LDL^T's fill */
   for (int i = 1; i < argc; i++) {
     const char *a = argv[i], *val = (i + 1 < argc) ? argv[i + 1] : NULL;
@@ -200,6 +224,13 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
         }
         if (!e) break;
         s = e + 1;
+      }
+    } else if (!strcmp(a, "--ida-rtol")) {
+      char *end;
+      ida_rtol = strtod(val, &end);
+      if (*end || !(ida_rtol > 0) || !(ida_rtol < 1)) {
+        fprintf(stderr, "%s: error: '--ida-rtol' needs a number between 0 and 1\n", argv[0]);
+        return 2;
       }
     } else if (!strcmp(a, "--reps")) {
       char *end;
@@ -257,7 +288,7 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
     for (int k = 0; k < reps; k++) {
       double ft = 0;
       char detail[160];
-      int st = run_once(pd, pm, &set, &r->rec, &walls[k], &r->steps, &r->evals, &r->residual, &ft,
+      int st = run_once(pd, pm, &set, ida_rtol, &r->rec, &walls[k], &r->steps, &r->evals, &r->residual, &ft,
                         detail, sizeof detail);
       if (st) {
         r->state = 3;
@@ -273,7 +304,8 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
     r->run_med = median(walls, reps);
     r->step_med = median(per, reps);
     if (ref < 0) ref = p;
-    r->max_rel = compare(m, &res[ref].rec, &r->rec, &r->worst_col);
+    r->max_rel = compare(m, &res[ref].rec, &r->rec, 0, &r->worst_col);
+    r->max_rel_pos = compare(m, &res[ref].rec, &r->rec, 1, &r->worst_col_pos);
     if (r->rec.nrows != res[ref].rec.nrows)
       snprintf(r->note, sizeof r->note, "%d output rows, reference %d", r->rec.nrows, res[ref].rec.nrows);
     else if (r->residual > 0)
@@ -303,15 +335,17 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
          set.stabilization == MB_STAB_PROJECTION ? "projection"
          : set.stabilization == MB_STAB_BAUMGARTE ? "baumgarte" : "no stabilization",
          reps, reps == 1 ? "" : "s");
-  printf("\n%-16s %5s %7s %7s %8s %13s %10s %7s %7s %12s\n", "path", "n", "nnz(K)", "nnz(L)",
-         "steps", "per step [s]", "run [s]", "ratio", "r.step", "max rel diff");
+  if (ida_rtol > 0 && selected(paths, "ida"))
+    printf("ida: rtol %g, atol %g (--ida-rtol)\n", ida_rtol, set.atol * ida_rtol / set.rtol);
+  printf("\n%-16s %5s %7s %7s %8s %13s %10s %7s %7s %12s %10s\n", "path", "n", "nnz(K)", "nnz(L)",
+         "steps", "per step [s]", "run [s]", "ratio", "r.step", "max rel diff", "positions");
   for (int p = 0; p < NPATH; p++) {
     const path_result *r = &res[p];
     if (!r->state) continue;
     if (r->state != 1) { printf("%-16s %5d %7d %7s  %s\n", PATHS[p].name, r->n, r->nnz, "-", r->note); continue; }
-    printf("%-16s %5d %7d %7s %8ld %13.4g %10.4g %7.2f %7.2f %12.3g", PATHS[p].name, r->n, r->nnz,
-           PATHS[p].eval == EVAL_IDA ? "-" : nl, r->steps, r->step_med, r->run_med,
-           r->run_med / best_run, r->step_med / best_step, r->max_rel);
+    printf("%-16s %5d %7d %7s %8ld %13.4g %10.4g %7.2f %7.2f %12.3g %10.3g", PATHS[p].name, r->n,
+           r->nnz, PATHS[p].eval == EVAL_IDA ? "-" : nl, r->steps, r->step_med, r->run_med,
+           r->run_med / best_run, r->step_med / best_step, r->max_rel, r->max_rel_pos);
     if (p == ref) printf("  (reference)");
     else if (r->worst_col >= 0 && r->max_rel > 0) printf("  (%s)", m->col_name[r->worst_col]);
     if (r->note[0]) printf("  %s", r->note);
@@ -321,7 +355,8 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
          "time of the paths that use %s.\n"
          "max rel diff: largest |difference| from the reference path over all outputs and output\n"
          "times, relative to the range of that output over the run (for a vector output, the largest\n"
-         "range of its components).  ida: the DAE in y = [q; v; lambda] (n = nq + nv + nc), dense\n"
+         "range of its components).  positions: the same over the position, orientation, angle,\n"
+         "deflection and modal outputs only.  ida: the DAE in y = [q; v; lambda] (n = nq + nv + nc), dense\n"
          "Jacobian by difference quotients, generated eval; its BDF steps are not %s steps.\n",
          set.integrator == MB_RK4 ? "rk4" : "dopri5", set.integrator == MB_RK4 ? "rk4" : "dopri5");
 
@@ -330,17 +365,17 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
     snprintf(tmp, sizeof tmp, "%s.part", csv_path);
     FILE *f = fopen(tmp, "w");
     if (!f) { fprintf(stderr, "%s: error: cannot write '%s'\n", argv[0], tmp); rc = 2; goto out; }
-    fprintf(f, "path,n,nnz_K,nnz_L,step_median_s,run_s,ratio,steps,max_rel_diff,step_ratio,status\n");
+    fprintf(f, "path,n,nnz_K,nnz_L,step_median_s,run_s,ratio,steps,max_rel_diff,step_ratio,status,max_rel_diff_positions\n");
     for (int p = 0; p < NPATH; p++) {
       const path_result *r = &res[p];
       if (!r->state) continue;
       const char *l = PATHS[p].eval == EVAL_IDA ? "-" : nl;
       if (r->state == 1)
-        fprintf(f, "%s,%d,%d,%s,%.6g,%.6g,%.4f,%ld,%.3g,%.4f,ok\n", PATHS[p].name, r->n, r->nnz, l,
-                r->step_med, r->run_med, r->run_med / best_run, r->steps, r->max_rel,
-                r->step_med / best_step);
+        fprintf(f, "%s,%d,%d,%s,%.6g,%.6g,%.4f,%ld,%.3g,%.4f,ok,%.3g\n", PATHS[p].name, r->n, r->nnz,
+                l, r->step_med, r->run_med, r->run_med / best_run, r->steps, r->max_rel,
+                r->step_med / best_step, r->max_rel_pos);
       else
-        fprintf(f, "%s,%d,%d,%s,,,,,,,%s\n", PATHS[p].name, r->n, r->nnz, l,
+        fprintf(f, "%s,%d,%d,%s,,,,,,,%s,\n", PATHS[p].name, r->n, r->nnz, l,
                 r->state == 2 ? "skipped" : "failed");
     }
     if (fclose(f) || rename(tmp, csv_path)) {

@@ -45,17 +45,34 @@ md_table() {
   awk -F, '
     NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
     NR == 2 {
-      print "| path | n | nnz(K) | nnz(L) | steps | per step [s] | run [s] | ratio (run) | ratio (per step) | max rel diff |"
-      print "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|"
+      print "| path | n | nnz(K) | nnz(L) | steps | per step [s] | run [s] | ratio (run) | ratio (per step) | max rel diff | positions |"
+      print "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"
     }
     {
       if ($c["status"] != "ok") {
-        printf "| %s | %s | %s | %s | %s | | | | | |\n", $c["path"], $c["n"], $c["nnz_K"], $c["nnz_L"], $c["status"]
+        printf "| %s | %s | %s | %s | %s | | | | | | |\n", $c["path"], $c["n"], $c["nnz_K"], $c["nnz_L"], $c["status"]
         next
       }
-      printf "| %s | %s | %s | %s | %s | %.3g | %.3g | %.2f | %.2f | %.1e |\n", $c["path"], $c["n"], $c["nnz_K"],
-        $c["nnz_L"], $c["steps"], $c["step_median_s"], $c["run_s"], $c["ratio"], $c["step_ratio"], $c["max_rel_diff"]
+      printf "| %s | %s | %s | %s | %s | %.3g | %.3g | %.2f | %.2f | %.1e | %.1e |\n", $c["path"], $c["n"], $c["nnz_K"],
+        $c["nnz_L"], $c["steps"], $c["step_median_s"], $c["run_s"], $c["ratio"], $c["step_ratio"], $c["max_rel_diff"],
+        $c["max_rel_diff_positions"]
     }' "$W/$1.csv"
+}
+
+# agree NAME MODEL [ARGS...]: one untimed run of the emitted path and IDA at tight
+# tolerances (TIGHT_RTOL, atol 1e-2 of it), CSV to $W/NAME.csv
+TIGHT_RTOL=1e-12
+TIGHT_ATOL=1e-14
+agree() {
+  name=$1
+  shift
+  say "$(show "$MBCC bench $* --paths generated+ldl,ida --rtol $TIGHT_RTOL --atol $TIGHT_ATOL --reps 1")"
+  if ! (cd "$W" && "$MBCC" bench "$@" --paths generated+ldl,ida --rtol $TIGHT_RTOL --atol $TIGHT_ATOL \
+        --reps 1 --csv "$name.csv" --quiet) >"$W/$name.txt" 2>"$W/$name.log"; then
+    cat "$W/$name.txt" "$W/$name.log" >&2
+    die "bench failed: $(show "$MBCC bench $*")"
+  fi
+  show "$MBCC bench $* --paths generated+ldl,ida --rtol $TIGHT_RTOL --atol $TIGHT_ATOL --reps 1" >"$W/$name.cmd"
 }
 
 # value of column COL for path PATH in run NAME (empty if it did not run)
@@ -70,6 +87,11 @@ bench chain "$ROOT/tests/models/hinged_chain20_rigid.yaml"
 bench flex0 "$ROOT/models/slider_crank_flexible.yaml"
 bench flex1 "$ROOT/models/slider_crank_flexible.yaml" --scene virtual1
 bench flex2 "$ROOT/models/slider_crank_flexible.yaml" --scene virtual2
+agree tight_rigid "$ROOT/models/slider_crank.yaml"
+agree tight_chain "$ROOT/tests/models/hinged_chain20_rigid.yaml"
+agree tight_flex0 "$ROOT/models/slider_crank_flexible.yaml"
+agree tight_flex1 "$ROOT/models/slider_crank_flexible.yaml" --scene virtual1
+agree tight_flex2 "$ROOT/models/slider_crank_flexible.yaml" --scene virtual2
 
 PATHS="generated+ldl generated+klu generated+dense generic+klu generic+dense ida"
 # the base of the Table 3 ratios: the first path that ran on the flexible model without virtual bodies
@@ -181,6 +203,35 @@ tmp=$OUT.part
   echo "(Its total energy is conserved to round-off: the range of that output over the run is"
   echo "about 1e-12 of its value, so \`max rel diff\`, relative to that range, is large there;"
   echo "the tip position agrees between the Dormand–Prince paths to the digits written.)"
+  echo
+  echo "## Agreement with IDA at tight tolerances"
+  echo
+  echo "At the models' own tolerances (rtol 1e-8 on the slider-cranks) the Dormand–Prince paths agree"
+  echo "with each other to round-off (the tables above), but IDA differs from them by up to about"
+  echo "1e-6 of an output's range. That difference is the two integrators' own error, not"
+  echo "a difference between the models they integrate: at rtol 1e-8 Dormand–Prince's global error"
+  echo "in position is itself about 2e-7 of the range on the flexible slider-crank (its distance"
+  echo "from IDA at rtol 1e-12), and BDF damps the rod's undamped 4.6 kHz mode unless its"
+  echo "tolerance is tight. So the agreement of the emitted path with an independent"
+  echo "general-purpose DAE solver is checked with both integrators at rtol $TIGHT_RTOL, atol $TIGHT_ATOL"
+  echo "(one untimed run each). \`positions\` is the largest difference over the position, angle,"
+  echo "deflection and modal outputs, the quantity of the issue #4 target (1e-9); \`every output\`"
+  echo "includes the energy."
+  echo
+  echo "| model | steps (generated+ldl) | steps (ida) | positions | every output (worst) |"
+  echo "|---|--:|--:|--:|--:|"
+  for v in "tight_rigid:rigid slider-crank" "tight_chain:20-segment chain (n = 239)" \
+           "tight_flex0:flexible slider-crank" "tight_flex1:same, 1 virtual body" \
+           "tight_flex2:same, 2 virtual bodies"; do
+    name=${v%%:*}
+    worst=$(awk '$1 == "ida" { w = $NF; sub(/^\(/, "", w); sub(/\)$/, "", w); print w }' "$W/$name.txt")
+    printf '| %s | %s | %s | %s | %s (%s) |\n' "${v#*:}" "$(val "$name" generated+ldl steps)" \
+      "$(val "$name" ida steps)" "$(val "$name" ida max_rel_diff_positions)" \
+      "$(val "$name" ida max_rel_diff)" "$worst"
+  done
+  echo
+  echo "Commands: \`$(cat "$W/tight_flex0.cmd")\` (and the same for the other models)."
+  echo "The chain's energy column is relative to a range of round-off, as explained above."
   echo
   echo "## The tables as printed"
   echo

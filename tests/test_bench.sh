@@ -6,6 +6,9 @@
 #   - every path that ran (ldl may be absent: "skipped") reports steps and
 #     times, the fastest run has ratio 1, the paths with the same integrator
 #     agree to 1e-9 of each output's range and IDA to 1e-5;
+#   - at rtol 1e-12 (both integrators' own errors far below 1e-9), IDA and the
+#     Dormand-Prince path agree to 1e-9 on the position outputs
+#     (max_rel_diff_positions) over 0.05 s;
 #   - --paths selects paths; bad options exit with status 2.
 # Runs mbcc from a scratch directory, so that nothing lands in the source tree.
 # Environment: MBCC (set by tests/run_tests.sh; default build/mbcc).
@@ -47,9 +50,23 @@ else
   err "mbcc bench --paths failed"
 fi
 
+# agreement on positions at tight tolerances, and --ida-rtol
+if "$MBCC" bench "$model" --end 0.05 --reps 1 --paths generated+klu,ida --rtol 1e-12 --atol 1e-14 \
+    --csv t.csv --quiet > tight.txt 2>&1; then
+  awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; if (!c["max_rel_diff_positions"]) { print "no positions column"; exit 1 } next }
+    $c["path"] == "ida" { seen = 1; if (!($c["max_rel_diff_positions"] <= 1e-9)) { print "ida positions " $c["max_rel_diff_positions"]; exit 1 } }
+    END { if (!seen) { print "no ida row"; exit 1 } }' t.csv > tight.log || err "tight tolerances: $(cat tight.log)"
+else
+  err "mbcc bench at rtol 1e-12 failed: $(tail -5 tight.txt)"
+fi
+"$MBCC" bench "$model" --end 0.005 --reps 1 --paths ida --ida-rtol 1e-10 --quiet > ir.txt 2>&1 &&
+  grep -q '^ida: rtol 1e-10, atol 1e-12' ir.txt || err "--ida-rtol: $(head -3 ir.txt)"
+
 # bad options
 "$MBCC" bench "$model" --reps 0 --quiet > /dev/null 2>&1
 [ $? = 2 ] || err "--reps 0 did not exit with status 2"
 "$MBCC" bench "$model" --paths generated+foo --quiet > /dev/null 2>&1
 [ $? = 2 ] || err "--paths generated+foo did not exit with status 2"
+"$MBCC" bench "$model" --ida-rtol 0 --quiet > /dev/null 2>&1
+[ $? = 2 ] || err "--ida-rtol 0 did not exit with status 2"
 exit $fail
