@@ -64,6 +64,13 @@ static void real_array(FILE *f, const char *name, const double *x, long n) {
   fprintf(f, "\n};\n");
 }
 
+/* the comment above ldl_block_rhs (both forms) */
+#define BLOCK_RHS_COMMENT                                                                      \
+  "/* the right side of K' from r, in place: g'_s = g_s - W g_r, f'_x = f_x - Dx^T Du^-T f_u.\n" \
+  " * Rows S and columns X change; the weld rows and the body's columns, which\n"                 \
+  " * ldl_block_back reads, do not.  Their unknowns are decoupled in K' (unit\n"                 \
+  " * diagonal): the solve gives them a value that ldl_block_back overwrites */\n"
+
 /* the block pivots' workspace: Du^-1 (36, then 6 unused), W = Eu Du^-1 (6 per S row) */
 static long block_work(const ldl_plan *p, int e) { return 42L + 6L * (p->esp[e + 1] - p->esp[e]); }
 
@@ -85,8 +92,8 @@ static void ml_max(const ldl_plan *p, int *rmax, long *dmax) {
   }
 }
 
-/* offset of the block pivots' workspace: after Lx, 1/d, x, r, t, best x, K', rr, d */
-static long block_base(const ldl_plan *p) { return p->nnzL + 5L * p->n + p->nnzR + 2L * p->n; }
+/* offset of the block pivots' workspace: after Lx, 1/d, x, r, t, best x, K', d */
+static long block_base(const ldl_plan *p) { return p->nnzL + 5L * p->n + p->nnzR + p->n; }
 
 /* offset of the massless bodies' part of the workspace: K1, r1, D scratch, blocks */
 static long ml_base(const ldl_plan *p) {
@@ -148,7 +155,8 @@ static const int *kc_of, *kc_map;
 static void kval(FILE *f, int q) {
   if (!kc_of) fprintf(f, "Kx[%d]", q);
   else if (kc_of[q] >= 0) fprintf(f, "Kc[%d]", kc_of[q]);
-  else fprintf(f, "Kx[%d]", kc_map[q]);
+  else if (kc_map[q] >= 0) fprintf(f, "Kx[%d]", kc_map[q]);
+  else fputs(kc_map[q] == -2 ? "1" : kc_map[q] == -3 ? "-1" : "0", f); /* a constant of K' */
 }
 
 /* the value of K_aug entry e (upper triangle, permuted) as a C expression */
@@ -374,78 +382,111 @@ static void emit_inv6(FILE *f) {
         "  return ldl_invn(6, A, X, amax);\n}\n\n", f);
 }
 
-/* "Kx[slot]" or "0" */
-static void kx_or_zero(FILE *f, int slot) {
-  if (slot >= 0) fprintf(f, "Kx[%d]", slot);
-  else fputs("0", f);
+/* the entry (i, j) of a block's n x n A in the closed forms below: "a<i><j>",
+ * or 0 when it is a structural zero (nz: the block's structure, row-major) */
+static int blk_nz(const int *nz, int n, int i, int j) { return nz[n * i + j]; }
+
+/* "+ a_ij a_kl - a_il a_kj" with the structural zeros dropped; 0 if both vanish */
+static int emit_minor(FILE *f, const int *nz, int n, int i, int k, int j, int l) {
+  int t1 = blk_nz(nz, n, i, j) && blk_nz(nz, n, k, l), t2 = blk_nz(nz, n, i, l) && blk_nz(nz, n, k, j);
+  if (t1) fprintf(f, "a%d%d * a%d%d", i, j, k, l);
+  if (t2) fprintf(f, "%sa%d%d * a%d%d", t1 ? " - " : "-", i, l, k, j);
+  return t1 || t2;
 }
 
-/* The diagonal blocks of a 6 x 6 A whose structure nz[36] is known (1 where
- * A can be nonzero): rows and columns i, j are in one block when A(i, j) or a
- * chain of such entries joins them.  A welded virtual body's D_u is
- * block-diagonal (its three point rows see only the translations, its three
- * angle rows only the rotations), and so is its inverse: comp[i] is i's block,
- * and A^-1(i, j) is zero unless comp[i] == comp[j].  Returns the number of
- * blocks. */
-static int inv_blocks(const int *nz, int comp[6]) {
-  int par[6], lab[6], nb = 0;
-  for (int i = 0; i < 6; i++) par[i] = i, lab[i] = -1;
-  for (int i = 0; i < 6; i++)
-    for (int j = 0; j < 6; j++)
-      if (nz[6 * i + j]) {
-        int a = i, b = j;
-        while (par[a] != a) a = par[a];
-        while (par[b] != b) b = par[b];
-        if (a != b) par[a < b ? b : a] = a < b ? a : b;
-      }
-  for (int i = 0; i < 6; i++) {
-    int a = i;
-    while (par[a] != a) a = par[a];
-    if (lab[a] < 0) lab[a] = nb++;
-    comp[i] = lab[a];
-  }
-  return nb;
-}
-
-/* W(s, i) = sum_c Eu(s, c) Du^-1(c, i) can be nonzero (eu: row s's slots in
- * the body's columns, -1 none; dinz: the structure of Du^-1) */
-static int w_nonzero(const int *eu, const int *dinz, int i) {
-  for (int c = 0; c < 6; c++)
-    if (eu[c] >= 0 && dinz[6 * c + i]) return 1;
-  return 0;
-}
-
-/* "X = A^-1" for the 6 x 6 A of structure nz, block by block (inv_blocks);
- * 'fail' is the statement run when a pivot is too small */
-static void emit_inv_blocked(FILE *f, const char *A, const char *X, const int *nz, const char *fail) {
-  int comp[6], nb = inv_blocks(nz, comp);
+/* "X = A^-1" for the 6 x 6 A whose entries are the Kx slots slot[36] (-1: a
+ * structural zero), block by block (inv_blocks): a 1 x 1 block by division,
+ * 2 x 2 and 3 x 3 blocks by their adjugate (a well-conditioned D_u block: a
+ * rotation or the identity up to signs), larger ones by ldl_invn.  A pivot
+ * (1 x 1), determinant (scaled by amax^n) or Gauss-Jordan pivot below 1e-12 of
+ * A's largest entry runs 'fail'.  Only the entries of X inside the blocks are
+ * written: the others are structural zeros, and every reader skips them. */
+static void emit_inv_blocked(FILE *f, const int *slot, const char *X, const char *fail) {
+  int nz[36], comp[6];
+  for (int i = 0; i < 36; i++) nz[i] = slot[i] >= 0;
+  int nb = ldl_inv_blocks(nz, comp);
   if (nb == 1) {
-    fprintf(f, "  if (ldl_inv6(%s, %s)) %s;\n", A, X, fail);
+    fputs("  {\n    mb_real A[36];\n", f);
+    for (int i = 0; i < 36; i++) {
+      fprintf(f, "    A[%d] = ", i);
+      if (slot[i] >= 0) fprintf(f, "Kx[%d];\n", slot[i]);
+      else fputs("0;\n", f);
+    }
+    fprintf(f, "    if (ldl_inv6(A, %s)) %s;\n  }\n", X, fail);
     return;
   }
-  fprintf(f, "  { /* %s is block-diagonal: %d blocks inverted apart */\n    mb_real amax = 0;\n", A, nb);
+  fprintf(f, "  { /* block-diagonal: %d blocks inverted apart */\n    mb_real amax = 0;\n", nb);
   for (int k = 0; k < 36; k++)
-    if (nz[k]) fprintf(f, "    if (fabs(%s[%d]) > amax) amax = fabs(%s[%d]);\n", A, k, A, k);
+    if (nz[k]) fprintf(f, "    if (fabs(Kx[%d]) > amax) amax = fabs(Kx[%d]);\n", slot[k], slot[k]);
   for (int c = 0; c < nb; c++) {
-    int mem[6], n = 0;
+    int mem[6], n = 0, bnz[36];
     for (int i = 0; i < 6; i++)
       if (comp[i] == c) mem[n++] = i;
+    for (int i = 0; i < n; i++)
+      for (int j = 0; j < n; j++) bnz[n * i + j] = nz[6 * mem[i] + mem[j]];
     if (n == 1) {
       int d = 7 * mem[0];
-      fprintf(f, "    if (!(fabs(%s[%d]) > 1e-12 * amax)) %s;\n    %s[%d] = 1 / %s[%d];\n", A, d, fail, X, d, A, d);
+      fprintf(f, "    if (!(fabs(Kx[%d]) > 1e-12 * amax)) %s;\n    %s[%d] = 1 / Kx[%d];\n", slot[d], fail, X, d,
+              slot[d]);
       continue;
     }
-    fprintf(f, "    {\n      mb_real a[%d], x[%d];\n", n * n, n * n);
+    fputs("    {\n", f);
+    if (n <= 3) {
+      for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++)
+          if (bnz[n * i + j]) fprintf(f, "      const mb_real a%d%d = Kx[%d];\n", i, j, slot[6 * mem[i] + mem[j]]);
+      /* cof[i][j]: the cofactor of a_ij */
+      int cnz[9];
+      for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++) {
+          if (n == 2) {
+            int ii = 1 - i, jj = 1 - j;
+            cnz[n * i + j] = bnz[n * ii + jj];
+            if (cnz[n * i + j]) fprintf(f, "      const mb_real c%d%d = %sa%d%d;\n", i, j, (i + j) % 2 ? "-" : "", ii, jj);
+            continue;
+          }
+          int i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+          cnz[n * i + j] = (bnz[n * i1 + j1] && bnz[n * i2 + j2]) || (bnz[n * i1 + j2] && bnz[n * i2 + j1]);
+          if (!cnz[n * i + j]) continue; /* a structural zero: not declared */
+          fprintf(f, "      const mb_real c%d%d = ", i, j);
+          emit_minor(f, bnz, n, i1, i2, j1, j2);
+          fputs(";\n", f);
+        }
+      fputs("      const mb_real det = ", f);
+      int any = 0;
+      for (int j = 0; j < n; j++)
+        if (bnz[j] && cnz[j]) {
+          fprintf(f, "%sa0%d * c0%d", any ? " + " : "", j, j);
+          any = 1;
+        }
+      fputs(any ? ";\n" : "0;\n", f);
+      fprintf(f, "      if (!(fabs(det) > 1e-12 * amax%s)) %s;\n", n == 2 ? " * amax" : " * amax * amax", fail);
+      fputs("      const mb_real r = 1 / det;\n", f);
+      /* A^-1 = adj(A) / det: X(i, j) = cof(j, i) / det */
+      for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++) {
+          fprintf(f, "      %s[%d] = ", X, 6 * mem[i] + mem[j]);
+          if (cnz[n * j + i]) fprintf(f, "c%d%d * r;\n", j, i);
+          else fputs("0;\n", f);
+        }
+      for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++)
+          if (bnz[n * i + j]) fprintf(f, "      (void)a%d%d;\n", i, j);
+      fputs("    }\n", f);
+      continue;
+    }
+    fprintf(f, "      mb_real a[%d], x[%d];\n", n * n, n * n);
     for (int i = 0; i < n; i++)
-      for (int j = 0; j < n; j++) fprintf(f, "      a[%d] = %s[%d];\n", n * i + j, A, 6 * mem[i] + mem[j]);
+      for (int j = 0; j < n; j++) {
+        int sl = slot[6 * mem[i] + mem[j]];
+        if (sl >= 0) fprintf(f, "      a[%d] = Kx[%d];\n", n * i + j, sl);
+        else fprintf(f, "      a[%d] = 0;\n", n * i + j);
+      }
     fprintf(f, "      if (ldl_invn(%d, a, x, amax)) %s;\n", n, fail);
     for (int i = 0; i < n; i++)
       for (int j = 0; j < n; j++) fprintf(f, "      %s[%d] = x[%d];\n", X, 6 * mem[i] + mem[j], n * i + j);
     fputs("    }\n", f);
   }
-  for (int i = 0; i < 6; i++)
-    for (int j = 0; j < 6; j++)
-      if (comp[i] != comp[j]) fprintf(f, "    %s[%d] = 0;\n", X, 6 * i + j);
   fputs("  }\n", f);
 }
 
@@ -476,72 +517,86 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
   for (int e = 0; e < p->nelim; e++) {
     int nz[36], comp[6];
     for (int i = 0; i < 36; i++) nz[i] = p->edu[e][i] >= 0;
-    inv_blocks(nz, comp);
+    ldl_inv_blocks(nz, comp);
     for (int i = 0; i < 36; i++) dinz[e][i] = comp[i / 6] == comp[i % 6];
+  }
+  /* the entries of Kc that a block's update reaches (their first update sets them) */
+  char *updated = calloc((size_t)nkc + 1, 1);
+  if (!updated) { free(src); free(dinz); return; }
+  for (int e = 0; e < p->nelim; e++) {
+    int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss, k = p->ekrp[e];
+    for (int si = 0; si < ns; si++)
+      for (int xi = 0; xi < nx; xi++, k++) {
+        const int *dx = p->edx + 6 * (xs + xi);
+        for (int i = 0; i < 6; i++)
+          if (dx[i] >= 0 && ldl_w_nonzero(p->eeu + 6 * (ss + si), dinz[e], i))
+            updated[kc_of[p->ekr[2 * k]]] = updated[kc_of[p->ekr[2 * k + 1]]] = 1;
+      }
   }
   fputs("/* Kc (the entries of K' the block pivots set) from Kx; returns 0, or 1 + a column\n"
         " * of a virtual body whose Du is singular */\n"
         "static int ldl_block_pivots(const mb_real *Kx, mb_real *work) {\n"
-        "  mb_real *Kc = work + LDL_KR, A[36], *Di, *W, v;\n"
-        "  /* the entries of K' that the blocks change, and the decoupled diagonals */\n", f);
+        "  mb_real *Kc = work + LDL_KR, *Di, *W, v;\n"
+        "  /* the entries of K' that no block changes (the others: at their first change) */\n", f);
   for (int k = 0; k < nkc; k++) {
+    if (updated[k]) continue;
     fprintf(f, "  Kc[%d] = ", k);
     if (src[k] >= 0) fprintf(f, "Kx[%d]", src[k]);
     else fputs(src[k] == -2 ? "1" : src[k] == -3 ? "-1" : "0", f);
     fputs(";\n", f);
   }
-  free(src);
   for (int e = 0; e < p->nelim; e++) {
     int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
     fprintf(f, "  /* block %d: Du^-1, W = Eu Du^-1, K'(s, x) -= (W Dx)(s, x) */\n", e);
     fprintf(f, "  Di = work + %ld;\n  W = Di + 42;\n", woff[e]);
-    for (int i = 0; i < 36; i++) {
-      fprintf(f, "  A[%d] = ", i);
-      kx_or_zero(f, p->edu[e][i]);
-      fputs(";\n", f);
-    }
     {
-      int nz[36];
       char fail[32];
-      for (int i = 0; i < 36; i++) nz[i] = p->edu[e][i] >= 0;
       snprintf(fail, sizeof fail, "return %d", 1 + p->eu[e][0]);
-      emit_inv_blocked(f, "A", "Di", nz, fail);
+      emit_inv_blocked(f, p->edu[e], "Di", fail);
     }
     int k = p->ekrp[e];
     for (int si = 0; si < ns; si++) {
       const int *eu = p->eeu + 6 * (ss + si);
       ldl_unknown_name(L, p->es[ss + si], name, sizeof name);
       fprintf(f, "  /* %s */\n", name);
-      for (int i = 0; i < 6; i++) {
-        fprintf(f, "  W[%d] = ", 6 * si + i);
+      for (int i = 0; i < 6; i++) { /* only the entries w_nonzero: the readers skip the others */
         int any = 0;
         for (int c = 0; c < 6; c++)
           if (eu[c] >= 0 && dinz[e][6 * c + i]) {
+            if (!any) fprintf(f, "  W[%d] = ", 6 * si + i);
             fprintf(f, "%sKx[%d] * Di[%d]", any ? " + " : "", eu[c], 6 * c + i);
             any = 1;
           }
-        if (!any) fputs("0", f);
-        fputs(";\n", f);
+        if (any) fputs(";\n", f);
       }
       for (int xi = 0; xi < nx; xi++, k++) {
         const int *dx = p->edx + 6 * (xs + xi);
         int any = 0;
         for (int i = 0; i < 6; i++)
-          if (dx[i] >= 0 && w_nonzero(eu, dinz[e], i)) {
+          if (dx[i] >= 0 && ldl_w_nonzero(eu, dinz[e], i)) {
             fprintf(f, "%sW[%d] * Kx[%d]", any ? " + " : "  v = ", 6 * si + i, dx[i]);
             any = 1;
           }
         if (!any) continue;
-        fprintf(f, ";\n  Kc[%d] -= v;\n  Kc[%d] -= v;\n", kc_of[p->ekr[2 * k]], kc_of[p->ekr[2 * k + 1]]);
+        fputs(";\n", f);
+        for (int h = 0; h < 2; h++) {
+          int kc = kc_of[p->ekr[2 * k + h]];
+          if (updated[kc] == 2) { fprintf(f, "  Kc[%d] -= v;\n", kc); continue; }
+          updated[kc] = 2; /* its first change: K'(s, x) = K(s, x) - v */
+          if (src[kc] >= 0) fprintf(f, "  Kc[%d] = Kx[%d] - v;\n", kc, src[kc]);
+          else if (src[kc] == -1) fprintf(f, "  Kc[%d] = -v;\n", kc);
+          else fprintf(f, "  Kc[%d] = %s - v;\n", kc, src[kc] == -2 ? "1" : "-1");
+        }
       }
     }
   }
+  free(src);
+  free(updated);
   fputs("  (void)v;\n  (void)W;\n  return 0;\n}\n\n", f);
 
-  fputs("/* rr = the right side of K' from r: g'_s = g_s - W g_r, f'_x = f_x - Dx^T Du^-T f_u */\n"
-        "static void ldl_block_rhs(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *rr) {\n"
-        "  const mb_real *Di, *W;\n  mb_real z[6];\n"
-        "  for (int i = 0; i < LDL_N; i++) rr[i] = r[i];\n", f);
+  fputs(BLOCK_RHS_COMMENT
+        "static void ldl_block_rhs(const mb_real *Kx, const mb_real *work, mb_real *r) {\n"
+        "  const mb_real *Di, *W;\n  mb_real z[6];\n", f);
   for (int e = 0; e < p->nelim; e++) {
     int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
     fprintf(f, "  /* block %d */\n  Di = work + %ld;\n  W = Di + 42;\n", e, woff[e]);
@@ -549,8 +604,8 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
       const int *eu = p->eeu + 6 * (ss + si);
       int any = 0;
       for (int c = 0; c < 6; c++)
-        if (w_nonzero(eu, dinz[e], c)) {
-          if (!any) fprintf(f, "  rr[%d] -= ", p->es[ss + si]);
+        if (ldl_w_nonzero(eu, dinz[e], c)) {
+          if (!any) fprintf(f, "  r[%d] -= ", p->es[ss + si]);
           fprintf(f, "%sW[%d] * r[%d]", any ? " + " : "", 6 * si + c, p->er[e][c]);
           any = 1;
         }
@@ -571,13 +626,12 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
       int any = 0;
       for (int i = 0; i < 6; i++)
         if (dx[i] >= 0) {
-          if (!any) fprintf(f, "  rr[%d] -= ", p->ex[xs + xi]);
+          if (!any) fprintf(f, "  r[%d] -= ", p->ex[xs + xi]);
           fprintf(f, "%sKx[%d] * z[%d]", any ? " + " : "", dx[i], i);
           any = 1;
         }
       if (any) fputs(";\n", f);
     }
-    for (int c = 0; c < 6; c++) fprintf(f, "  rr[%d] = rr[%d] = 0;\n", p->eu[e][c], p->er[e][c]);
   }
   fputs("  (void)Kx;\n  (void)W;\n}\n\n", f);
 
@@ -674,8 +728,9 @@ static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
   if (!src || !ekc) { free(src); free(ekc); return; }
   for (int q = 0; q < p->nnzR; q++)
     if (kc_of[q] >= 0) src[kc_of[q]] = p->Krmap[q], nkc = kc_of[q] + 1 > nkc ? kc_of[q] + 1 : nkc;
-  for (int k = 0; k < 2 * npair; k++) ekc[k] = kc_of[p->ekr[k]];
-  fputs("/* Kc entries of the corrected pairs (s, x), (x, s), block by block, s-major */\n", f);
+  for (int k = 0; k < 2 * npair; k++) ekc[k] = p->ekr[k] >= 0 ? kc_of[p->ekr[k]] : -1;
+  fputs("/* Kc entries of the corrected pairs (s, x), (x, s), block by block, s-major\n"
+        " * (-1: a pair whose correction is structurally zero) */\n", f);
   int_array(f, "ldl_ekc", ekc, 2L * npair);
   fprintf(f, "/* Kc = %s from Kx: a Kx slot, or -1: 0, -2: 1 (eliminated column),\n"
              " * -3: -1 (eliminated row) */\n",
@@ -706,14 +761,14 @@ static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
         "        for (int c = 0; c < 6; c++) w[i] += e[c] * Di[6 * c + i];\n      }\n"
         "      for (int xi = 0; xi < B->nx; xi++, k++) {\n"
         "        const int *dx = B->dx + 6 * xi;\n"
+        "        if (ldl_ekc[2 * k] < 0) continue; /* structurally zero */\n"
         "        mb_real v = 0;\n"
         "        for (int i = 0; i < 6; i++) if (dx[i] >= 0) v += w[i] * Kx[dx[i]];\n"
         "        Kc[ldl_ekc[2 * k]] -= v;\n"
         "        Kc[ldl_ekc[2 * k + 1]] -= v;\n"
         "      }\n    }\n  }\n  return 0;\n}\n\n", f);
-  fputs("/* rr = the right side of K' from r: g'_s = g_s - W g_r, f'_x = f_x - Dx^T Du^-T f_u */\n"
-        "static void ldl_block_rhs(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *rr) {\n"
-        "  for (int i = 0; i < LDL_N; i++) rr[i] = r[i];\n"
+  fputs(BLOCK_RHS_COMMENT
+        "static void ldl_block_rhs(const mb_real *Kx, const mb_real *work, mb_real *r) {\n"
         "  for (int e = 0; e < LDL_NBLOCK; e++) {\n"
         "    const ldl_block *B = &ldl_blocks[e];\n"
         "    const mb_real *Di = work + B->w, *W = Di + 42;\n"
@@ -721,7 +776,7 @@ static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
         "    for (int si = 0; si < B->ns; si++) {\n"
         "      mb_real v = 0;\n"
         "      for (int c = 0; c < 6; c++) v += W[6 * si + c] * r[B->r[c]];\n"
-        "      rr[B->s[si]] -= v;\n    }\n"
+        "      r[B->s[si]] -= v;\n    }\n"
         "    for (int i = 0; i < 6; i++) { /* z = Du^-T f_u */\n"
         "      z[i] = 0;\n"
         "      for (int c = 0; c < 6; c++) z[i] += Di[6 * c + i] * r[B->u[c]];\n    }\n"
@@ -729,8 +784,7 @@ static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
         "      const int *dx = B->dx + 6 * xi;\n"
         "      mb_real v = 0;\n"
         "      for (int i = 0; i < 6; i++) if (dx[i] >= 0) v += Kx[dx[i]] * z[i];\n"
-        "      rr[B->x[xi]] -= v;\n    }\n"
-        "    for (int c = 0; c < 6; c++) rr[B->u[c]] = rr[B->r[c]] = 0;\n  }\n}\n\n", f);
+        "      r[B->x[xi]] -= v;\n    }\n  }\n}\n\n", f);
   fputs("/* the eliminated unknowns of d from the others: a_u = Du^-1 (g_r - Dx a_x),\n"
         " * lambda_r = Du^-T (f_u - Eu^T lambda_s) */\n"
         "static void ldl_block_back(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *d) {\n"
@@ -1299,8 +1353,8 @@ static void emit_solve_pass(FILE *f, const ldl_plan *p, const char *rhs, const c
     fprintf(f, "%sr1 = %s;\n", ind, rhs);
   const char *kc = p->straight ? " work + LDL_KR," : "";
   if (p->nelim) {
-    fprintf(f, "%sldl_block_rhs(Kp, work, r1, rr); /* the block pivots' right side: K' */\n", ind);
-    fprintf(f, "%sldl_aug(%s,%s rr, t);\n", ind, p->straight ? "Kp" : "work + LDL_KR", kc);
+    fprintf(f, "%sldl_block_rhs(Kp, work, r1); /* the block pivots' right side: K' (in place) */\n", ind);
+    fprintf(f, "%sldl_aug(%s,%s r1, t);\n", ind, p->straight ? "Kp" : "work + LDL_KR", kc);
   } else {
     fprintf(f, "%sldl_aug(Kp, r1, t);\n", ind);
   }
@@ -1317,10 +1371,9 @@ static void emit_solve(FILE *f, const ldl_plan *p, const char *nm) {
   fprintf(f, "int %s_ldl_solve(const mb_real *Kx, mb_real *work, mb_real *b, mb_real *residual) {\n", nm);
   fputs("  const mb_real *Lx = work, *Dinv = work + LDL_DINV;\n"
         "  mb_real *x = work + LDL_X, *r = work + LDL_R, *t = work + LDL_T, *xb = work + LDL_XB;\n", f);
-  if (p->nelim) fputs("  mb_real *rr = work + LDL_RR;\n", f);
   if (staged) fputs("  mb_real *d = work + LDL_DD;\n", f);
   if (p->nml) fputs("  mb_real *r1 = work + LDL_R1;\n  const mb_real *Kp = work + LDL_K1;\n", f);
-  else fputs("  const mb_real *Kp = Kx;\n  const mb_real *r1;\n", f);
+  else fprintf(f, "  const mb_real *Kp = Kx;\n  %smb_real *r1;\n", p->nelim ? "" : "const ");
   if (!p->nw) {
     /* no weighted rows: the factors are those of K itself, and the first
        solution is the one refinement would start from */
@@ -1399,7 +1452,7 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
   fprintf(f, "#define LDL_N %d\n#define LDL_DINV %s_LDL_NNZL\n"
              "#define LDL_X (LDL_DINV + LDL_N)\n#define LDL_R (LDL_X + LDL_N)\n#define LDL_T (LDL_R + LDL_N)\n"
              "#define LDL_XB (LDL_T + LDL_N)\n#define LDL_PIVTOL 1e-14\n"
-             "#define LDL_KR (LDL_XB + LDL_N)\n#define LDL_RR (LDL_KR + %d)\n#define LDL_DD (LDL_RR + LDL_N)\n"
+             "#define LDL_KR (LDL_XB + LDL_N)\n#define LDL_DD (LDL_KR + %d)\n"
              "/* a solve whose relative residual is already this small is not refined */\n"
              "#define LDL_REFINE_TOL 1e-15\n"
              "#if defined(__GNUC__)\n#define LDL_NOINLINE __attribute__((noinline))\n#define LDL_MAYBE_UNUSED __attribute__((unused))\n#else\n#define LDL_NOINLINE\n#define LDL_MAYBE_UNUSED\n#endif\n",
@@ -1468,8 +1521,11 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
     int nkc = 0;
     for (int q = 0; q < p.nnzR; q++) kc[q] = p.straight ? -1 : nkc++;
     if (p.straight) {
-      for (int k = 0; k < 2 * p.ekrp[p.nelim]; k++) kc[p.ekr[k]] = 0; /* mark */
-      for (int q = 0; q < p.nnzR; q++) kc[q] = kc[q] == 0 || p.Krmap[q] < 0 ? nkc++ : -1;
+      for (int k = 0; k < 2 * p.ekrp[p.nelim]; k++)
+        if (p.ekr[k] >= 0) kc[p.ekr[k]] = 0; /* mark */
+      /* the others are Kx slots, or constants of K' (kval writes them as literals:
+         a virtual body's decoupled diagonals) */
+      for (int q = 0; q < p.nnzR; q++) kc[q] = kc[q] == 0 ? nkc++ : -1;
     }
     kc_of = kc;
     kc_map = p.Krmap;

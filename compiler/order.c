@@ -592,6 +592,56 @@ static void add_entry(int i, int j, int *mark, int *rows, int *nz) {
   (*nz)++;
 }
 
+/* The diagonal blocks of a 6 x 6 A whose structure nz[36] is known (1 where
+ * A can be nonzero): rows and columns i, j are in one block when A(i, j) or a
+ * chain of such entries joins them.  A welded virtual body's D_u is
+ * block-diagonal (its three point rows see only the translations, its three
+ * angle rows only the rotations), and so is its inverse: comp[i] is i's block,
+ * and A^-1(i, j) is zero unless comp[i] == comp[j].  Returns the number of
+ * blocks. */
+int ldl_inv_blocks(const int *nz, int comp[6]) {
+  int par[6], lab[6], nb = 0;
+  for (int i = 0; i < 6; i++) par[i] = i, lab[i] = -1;
+  for (int i = 0; i < 6; i++)
+    for (int j = 0; j < 6; j++)
+      if (nz[6 * i + j]) {
+        int a = i, b = j;
+        while (par[a] != a) a = par[a];
+        while (par[b] != b) b = par[b];
+        if (a != b) par[a < b ? b : a] = a < b ? a : b;
+      }
+  for (int i = 0; i < 6; i++) {
+    int a = i;
+    while (par[a] != a) a = par[a];
+    if (lab[a] < 0) lab[a] = nb++;
+    comp[i] = lab[a];
+  }
+  return nb;
+}
+
+/* W(s, i) = sum_c Eu(s, c) Du^-1(c, i) can be nonzero (eu: row s's slots in
+ * the body's columns, -1 none; dinz: the structure of Du^-1) */
+int ldl_w_nonzero(const int *eu, const int *dinz, int i) {
+  for (int c = 0; c < 6; c++)
+    if (eu[c] >= 0 && dinz[6 * c + i]) return 1;
+  return 0;
+}
+
+/* the correction (W Dx)(s, x) of block e can be nonzero (si, xi: positions in
+ * es and ex): some i with Dx(i, x) and W(s, i) structurally nonzero.  The pattern
+ * of K' holds only these pairs, so that a weld's block-diagonal D_u (point rows on
+ * the translations, angle rows on the rotations) adds no fill it cannot produce */
+static int elim_pair_nz(const ldl_plan *p, int e, int si, int xi) {
+  int nz[36], comp[6], dinz[36];
+  for (int i = 0; i < 36; i++) nz[i] = p->edu[e][i] >= 0;
+  ldl_inv_blocks(nz, comp);
+  for (int i = 0; i < 36; i++) dinz[i] = comp[i / 6] == comp[i % 6];
+  const int *dx = p->edx + 6 * xi, *eu = p->eeu + 6 * si;
+  for (int i = 0; i < 6; i++)
+    if (dx[i] >= 0 && ldl_w_nonzero(eu, dinz, i)) return 1;
+  return 0;
+}
+
 /* eliminated unknown (U or weld row): 1 body column, 2 row, else 0 */
 static int elim_kind(const ldl_plan *p, int i) {
   for (int e = 0; e < p->nelim; e++) {
@@ -623,10 +673,14 @@ static int elim_pattern(const mb_model *m, ldl_plan *p) {
           if (!kind[m->Ki[q]]) ADD(m->Ki[q]);
         for (int e = 0; e < ne; e++) {
           int xs = p->exp_[e], xe = p->exp_[e + 1], ss = p->esp[e], se = p->esp[e + 1];
-          if (in_list(p->ex + xs, xe - xs, j))
-            for (int k = ss; k < se; k++) ADD(p->es[k]);
-          if (in_list(p->es + ss, se - ss, j))
-            for (int k = xs; k < xe; k++) ADD(p->ex[k]);
+          for (int xi = xs; xi < xe; xi++)
+            if (p->ex[xi] == j)
+              for (int k = ss; k < se; k++)
+                if (elim_pair_nz(p, e, k, xi)) ADD(p->es[k]);
+          for (int si = ss; si < se; si++)
+            if (p->es[si] == j)
+              for (int k = xs; k < xe; k++)
+                if (elim_pair_nz(p, e, si, k)) ADD(p->ex[k]);
         }
       }
 #undef ADD
@@ -660,8 +714,9 @@ static int elim_pattern(const mb_model *m, ldl_plan *p) {
     p->ekrp[e] = k;
     for (int si = p->esp[e]; si < p->esp[e + 1]; si++)
       for (int xi = p->exp_[e]; xi < p->exp_[e + 1]; xi++) {
-        p->ekr[2 * k] = kslot(&mr, p->es[si], p->ex[xi]);
-        p->ekr[2 * k + 1] = kslot(&mr, p->ex[xi], p->es[si]);
+        int nz = elim_pair_nz(p, e, si, xi); /* else the pair is not corrected: -1 */
+        p->ekr[2 * k] = nz ? kslot(&mr, p->es[si], p->ex[xi]) : -1;
+        p->ekr[2 * k + 1] = nz ? kslot(&mr, p->ex[xi], p->es[si]) : -1;
         k++;
       }
   }
@@ -688,6 +743,7 @@ static int elim_values(const ldl_plan *p, const double *Kx, double *Kr) {
       lu6_solve_t(A, piv, w);
       for (int xi = 0; xi < nx; xi++, k++) {
         const int *dx = p->edx + 6 * (p->exp_[e] + xi);
+        if (p->ekr[2 * k] < 0) continue; /* structurally zero */
         double v = 0;
         for (int i = 0; i < 6; i++) v += w[i] * (dx[i] >= 0 ? Kx[dx[i]] : 0);
         Kr[p->ekr[2 * k]] -= v;

@@ -96,7 +96,8 @@ typedef struct {
   int (*edu)[36];    /* Kx slots of Du (row-major, -1: structurally zero) */
   int *edx;          /* Kx slots of Dx: 6 per column of X, at 6 exp_[e] */
   int *eeu;          /* Kx slots of Eu: 6 per row of S, at 6 esp[e] */
-  int *ekr;          /* Kr positions of K'(s, x) and K'(x, s): 2 per pair, at 2 (sum ns nx) */
+  int *ekr;          /* Kr positions of K'(s, x) and K'(x, s): 2 per pair, at 2 (sum ns nx);
+                        -1 where the correction is structurally zero */
   int *ekrp;         /* nelim + 1: start of body e in ekr (pairs) */
   int nnzR;
   int *Krp, *Kri, *Krmap;
@@ -128,6 +129,14 @@ typedef struct {
  * memory or CAMD failure; *p is then freed). */
 int ldl_plan_build(const lmodel *L, ldl_plan *p);
 void ldl_plan_free(ldl_plan *p);
+
+/* the diagonal blocks of a 6 x 6 matrix of structure nz[36] (1: can be nonzero):
+ * comp[i] the block of row and column i; returns the number of blocks.  Its
+ * inverse can be nonzero only inside them (see order.c) */
+int ldl_inv_blocks(const int *nz, int comp[6]);
+/* W(s, i) = (Eu Du^-1)(s, i) can be nonzero (eu: row s's slots in the body's
+ * columns, -1 none; dinz[36]: the structure of Du^-1) */
+int ldl_w_nonzero(const int *eu, const int *dinz, int i);
 
 /* `mbcc check`: the ordering, nnz(L), the flop count and the code form */
 void ldl_plan_report(const lmodel *L, FILE *out);
