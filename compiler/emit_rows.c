@@ -423,32 +423,36 @@ int emit_row_special(FILE *f, const lmodel *L, int r) {
     emit_row_common(f, L, r, mk, dV, dW, "0");
   } else {
     /* mb_prim_dot1: phi = ai . aj (ai axis a of marker 0, aj axis b of
-       marker 1), dW0 = ai x aj = -dW1, quad = (W0 x (W0 x ai)) . aj
-       + 2 (W0 x ai) . (W1 x aj) + ai . (W1 x (W1 x aj)) */
-    svec ai, aj, cr, wai, waj, qi, qj;
-    char p[EXPR], quad[EXPR];
+       marker 1), dW0 = ai x aj = -dW1, quad = s00 s01 + s11 s10 - 2 s01 s10
+       - phi |W0 - W1|^2 (s00 = W0.ai, s01 = W0.aj, s10 = W1.ai, s11 = W1.aj) */
+    svec ai, aj, cr, dw;
+    char p[EXPR], quad[EXPR], ph[EXPR], sc[4][EXPR];
     for (int i = 0; i < 3; i++) {
       memcpy(ai.e[i], mk[0].R[3 * i + R->a], EXPR);
       memcpy(aj.e[i], mk[1].R[3 * i + R->b], EXPR);
     }
     s_dot(t, &ai, &aj);
-    fprintf(f, "    phi[%d] = %s;\n", r, t);
+    fprintf(f, "    const mb_real ph = %s;\n    phi[%d] = ph;\n", t, r);
+    snprintf(ph, sizeof ph, "ph");
     s_cross(&cr, &ai, &aj);
     s_local(f, &cr, "cr", "    ");
-    s_cross(&wai, &mk[0].W, &ai);
-    s_local(f, &wai, "wai", "    ");
-    s_cross(&waj, &mk[1].W, &aj);
-    s_local(f, &waj, "waj", "    ");
-    s_cross(&qi, &mk[0].W, &wai);
-    s_local(f, &qi, "qi", "    ");
-    s_cross(&qj, &mk[1].W, &waj);
-    s_local(f, &qj, "qj", "    ");
-    s_dot(quad, &qi, &aj);
-    s_dot(t, &wai, &waj);
-    s_mul(t, "2", t);
-    s_add(quad, quad, t);
-    s_dot(p, &ai, &qj);
+    for (int k = 0; k < 4; k++) {
+      s_dot(sc[k], &mk[k / 2].W, k % 2 ? &aj : &ai);
+      if (is_atom(sc[k])) continue;
+      fprintf(f, "    const mb_real s%d%d = %s;\n", k / 2, k % 2, sc[k]);
+      snprintf(sc[k], EXPR, "s%d%d", k / 2, k % 2);
+    }
+    for (int i = 0; i < 3; i++) s_sub(dw.e[i], mk[0].W.e[i], mk[1].W.e[i]);
+    s_local(f, &dw, "dw", "    ");
+    s_mul(quad, sc[0], sc[1]);
+    s_mul(p, sc[3], sc[2]);
     s_add(quad, quad, p);
+    s_mul(p, sc[1], sc[2]);
+    s_mul(p, "2", p);
+    s_sub(quad, quad, p);
+    s_dot(t, &dw, &dw);
+    s_mul(p, ph, t);
+    s_sub(quad, quad, p);
     for (int s = 0; s < 2; s++) s_zero(&dV[s]);
     dW[0] = cr;
     for (int i = 0; i < 3; i++) s_neg(dW[1].e[i], cr.e[i]);

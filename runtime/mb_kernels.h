@@ -276,18 +276,21 @@ static inline void mb_wwa(const mb_real w[3], const mb_real a[3], mb_real out[3]
 
 /* dot-1: axis a of marker 0 perpendicular to axis b of marker 1: phi = a0 . b1 */
 static inline void mb_prim_dot1(const mb_marker *m0, const mb_marker *m1, int a, int b, mb_row *r) {
-  mb_real ai[3], aj[3], c[3], wa_i[3], wa_j[3], q_i[3], q_j[3];
+  mb_real ai[3], aj[3], c[3], dw[3];
   mb_row_zero(r);
   mb_col3(m0->R, a, ai);
   mb_col3(m1->R, b, aj);
   r->phi = mb_dot3(ai, aj);
   mb_cross3(ai, aj, c);
   for (int k = 0; k < 3; k++) { r->dW[0][k] = c[k]; r->dW[1][k] = -c[k]; }
-  mb_cross3(m0->W, ai, wa_i);
-  mb_cross3(m1->W, aj, wa_j);
-  mb_wwa(m0->W, ai, q_i);
-  mb_wwa(m1->W, aj, q_j);
-  r->quad = mb_dot3(q_i, aj) + 2 * mb_dot3(wa_i, wa_j) + mb_dot3(ai, q_j);
+  /* quad = (W0 x (W0 x ai)) . aj + 2 (W0 x ai) . (W1 x aj) + ai . (W1 x (W1 x aj)),
+     with (w x (w x u)) . v = (w.u)(w.v) - (w.w)(u.v) and (w0 x u) . (w1 x v) =
+     (w0.w1)(u.v) - (w0.v)(w1.u): four dot products and |W0 - W1|^2 instead of
+     six cross products (docs/formulation.md) */
+  mb_real s00 = mb_dot3(m0->W, ai), s01 = mb_dot3(m0->W, aj);
+  mb_real s10 = mb_dot3(m1->W, ai), s11 = mb_dot3(m1->W, aj);
+  for (int k = 0; k < 3; k++) dw[k] = m0->W[k] - m1->W[k];
+  r->quad = s00 * s01 + s11 * s10 - 2 * (s01 * s10) - r->phi * mb_dot3(dw, dw);
 }
 
 /* dot-2: axis a of marker 0 perpendicular to d = P1 - P0: phi = a0 . d - x(t)
