@@ -394,13 +394,81 @@ static int emit_minor(FILE *f, const int *nz, int n, int i, int k, int j, int l)
   return t1 || t2;
 }
 
+/* "X = A^-1" on the rows and columns mem[0..n) of a 6 x 6 A (n >= 2), which are
+ * one diagonal block of it (slot: A's Kx slots, -1 a structural zero): 2 x 2
+ * and 3 x 3 by the adjugate (a well-conditioned D_u block: a rotation or the
+ * identity up to signs), larger by ldl_invn.  The emitted code has 'amax' (A's
+ * largest entry) in scope; a determinant below 1e-12 amax^n or a Gauss-Jordan
+ * pivot below 1e-12 amax runs 'fail'. */
+static void emit_inv_small(FILE *f, const int *slot, const int *mem, int n, const char *X, const char *fail,
+                           int adjugate) {
+  int bnz[36];
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j < n; j++) bnz[n * i + j] = slot[6 * mem[i] + mem[j]] >= 0;
+  fputs("    {\n", f);
+  if (n > 3 || !adjugate) {
+    fprintf(f, "      mb_real a[%d], x[%d];\n", n * n, n * n);
+    for (int i = 0; i < n; i++)
+      for (int j = 0; j < n; j++) {
+        int sl = slot[6 * mem[i] + mem[j]];
+        if (sl >= 0) fprintf(f, "      a[%d] = Kx[%d];\n", n * i + j, sl);
+        else fprintf(f, "      a[%d] = 0;\n", n * i + j);
+      }
+    fprintf(f, "      if (ldl_invn(%d, a, x, amax)) %s;\n", n, fail);
+    for (int i = 0; i < n; i++)
+      for (int j = 0; j < n; j++) fprintf(f, "      %s[%d] = x[%d];\n", X, 6 * mem[i] + mem[j], n * i + j);
+    fputs("    }\n", f);
+    return;
+  }
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j < n; j++)
+      if (bnz[n * i + j]) fprintf(f, "      const mb_real a%d%d = Kx[%d];\n", i, j, slot[6 * mem[i] + mem[j]]);
+  /* cij: the cofactor of a_ij (structural zeros not declared) */
+  int cnz[9];
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j < n; j++) {
+      if (n == 2) {
+        int ii = 1 - i, jj = 1 - j;
+        cnz[n * i + j] = bnz[n * ii + jj];
+        if (cnz[n * i + j]) fprintf(f, "      const mb_real c%d%d = %sa%d%d;\n", i, j, (i + j) % 2 ? "-" : "", ii, jj);
+        continue;
+      }
+      int i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+      cnz[n * i + j] = (bnz[n * i1 + j1] && bnz[n * i2 + j2]) || (bnz[n * i1 + j2] && bnz[n * i2 + j1]);
+      if (!cnz[n * i + j]) continue;
+      fprintf(f, "      const mb_real c%d%d = ", i, j);
+      emit_minor(f, bnz, n, i1, i2, j1, j2);
+      fputs(";\n", f);
+    }
+  fputs("      const mb_real det = ", f);
+  int any = 0;
+  for (int j = 0; j < n; j++)
+    if (bnz[j] && cnz[j]) {
+      fprintf(f, "%sa0%d * c0%d", any ? " + " : "", j, j);
+      any = 1;
+    }
+  fputs(any ? ";\n" : "0;\n", f);
+  fprintf(f, "      if (!(fabs(det) > 1e-12 * amax%s)) %s;\n", n == 2 ? " * amax" : " * amax * amax", fail);
+  fputs("      const mb_real r = 1 / det;\n", f);
+  /* A^-1 = adj(A) / det: X(i, j) = cof(j, i) / det */
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j < n; j++) {
+      fprintf(f, "      %s[%d] = ", X, 6 * mem[i] + mem[j]);
+      if (cnz[n * j + i]) fprintf(f, "c%d%d * r;\n", j, i);
+      else fputs("0;\n", f);
+    }
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j < n; j++)
+      if (bnz[n * i + j]) fprintf(f, "      (void)a%d%d;\n", i, j);
+  fputs("    }\n", f);
+}
+
 /* "X = A^-1" for the 6 x 6 A whose entries are the Kx slots slot[36] (-1: a
- * structural zero), block by block (inv_blocks): a 1 x 1 block by division,
- * 2 x 2 and 3 x 3 blocks by their adjugate (a well-conditioned D_u block: a
- * rotation or the identity up to signs), larger ones by ldl_invn.  A pivot
- * (1 x 1), determinant (scaled by amax^n) or Gauss-Jordan pivot below 1e-12 of
- * A's largest entry runs 'fail'.  Only the entries of X inside the blocks are
- * written: the others are structural zeros, and every reader skips them. */
+ * structural zero), block by block (ldl_inv_blocks): a 1 x 1 block by division,
+ * larger ones by emit_inv_small; A whole by ldl_inv6 when it is one block.  A
+ * pivot (1 x 1) below 1e-12 of A's largest entry runs 'fail', as emit_inv_small's
+ * tests.  Only the entries of X inside the blocks are written: the others are
+ * structural zeros, and every reader skips them. */
 static void emit_inv_blocked(FILE *f, const int *slot, const char *X, const char *fail) {
   int nz[36], comp[6];
   for (int i = 0; i < 36; i++) nz[i] = slot[i] >= 0;
@@ -419,73 +487,117 @@ static void emit_inv_blocked(FILE *f, const int *slot, const char *X, const char
   for (int k = 0; k < 36; k++)
     if (nz[k]) fprintf(f, "    if (fabs(Kx[%d]) > amax) amax = fabs(Kx[%d]);\n", slot[k], slot[k]);
   for (int c = 0; c < nb; c++) {
-    int mem[6], n = 0, bnz[36];
+    int mem[6], n = 0;
     for (int i = 0; i < 6; i++)
       if (comp[i] == c) mem[n++] = i;
-    for (int i = 0; i < n; i++)
-      for (int j = 0; j < n; j++) bnz[n * i + j] = nz[6 * mem[i] + mem[j]];
     if (n == 1) {
       int d = 7 * mem[0];
       fprintf(f, "    if (!(fabs(Kx[%d]) > 1e-12 * amax)) %s;\n    %s[%d] = 1 / Kx[%d];\n", slot[d], fail, X, d,
               slot[d]);
       continue;
     }
-    fputs("    {\n", f);
-    if (n <= 3) {
-      for (int i = 0; i < n; i++)
-        for (int j = 0; j < n; j++)
-          if (bnz[n * i + j]) fprintf(f, "      const mb_real a%d%d = Kx[%d];\n", i, j, slot[6 * mem[i] + mem[j]]);
-      /* cof[i][j]: the cofactor of a_ij */
-      int cnz[9];
-      for (int i = 0; i < n; i++)
-        for (int j = 0; j < n; j++) {
-          if (n == 2) {
-            int ii = 1 - i, jj = 1 - j;
-            cnz[n * i + j] = bnz[n * ii + jj];
-            if (cnz[n * i + j]) fprintf(f, "      const mb_real c%d%d = %sa%d%d;\n", i, j, (i + j) % 2 ? "-" : "", ii, jj);
-            continue;
-          }
-          int i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
-          cnz[n * i + j] = (bnz[n * i1 + j1] && bnz[n * i2 + j2]) || (bnz[n * i1 + j2] && bnz[n * i2 + j1]);
-          if (!cnz[n * i + j]) continue; /* a structural zero: not declared */
-          fprintf(f, "      const mb_real c%d%d = ", i, j);
-          emit_minor(f, bnz, n, i1, i2, j1, j2);
-          fputs(";\n", f);
-        }
-      fputs("      const mb_real det = ", f);
-      int any = 0;
-      for (int j = 0; j < n; j++)
-        if (bnz[j] && cnz[j]) {
-          fprintf(f, "%sa0%d * c0%d", any ? " + " : "", j, j);
-          any = 1;
-        }
-      fputs(any ? ";\n" : "0;\n", f);
-      fprintf(f, "      if (!(fabs(det) > 1e-12 * amax%s)) %s;\n", n == 2 ? " * amax" : " * amax * amax", fail);
-      fputs("      const mb_real r = 1 / det;\n", f);
-      /* A^-1 = adj(A) / det: X(i, j) = cof(j, i) / det */
-      for (int i = 0; i < n; i++)
-        for (int j = 0; j < n; j++) {
-          fprintf(f, "      %s[%d] = ", X, 6 * mem[i] + mem[j]);
-          if (cnz[n * j + i]) fprintf(f, "c%d%d * r;\n", j, i);
-          else fputs("0;\n", f);
-        }
-      for (int i = 0; i < n; i++)
-        for (int j = 0; j < n; j++)
-          if (bnz[n * i + j]) fprintf(f, "      (void)a%d%d;\n", i, j);
-      fputs("    }\n", f);
-      continue;
+    emit_inv_small(f, slot, mem, n, X, fail, 1);
+  }
+  fputs("  }\n", f);
+}
+
+/* The block-triangular structure of a 6 x 6 A (slot[36]: Kx slots, -1 a
+ * structural zero): its strongly connected components comp[] under i -> j when
+ * A(i, j) can be nonzero, in an order blk[0..nb) in which every such entry
+ * goes from a block to itself or a later one (A is block upper triangular
+ * there); xnz[36] the structure of A^-1 (i reaches j).  Returns nb, or 0 when a
+ * 1 x 1 block's diagonal is a structural zero (A is singular in that form: the
+ * caller inverts A whole).  A massless slider's D_u (its prismatic rows) is
+ * [diag B; 0 C] with C 3 x 3: four blocks. */
+static int tri_structure(const int *slot, int comp[6], int blk[6], int xnz[36]) {
+  int reach[36];
+  for (int i = 0; i < 36; i++) reach[i] = slot[i] >= 0 || i % 7 == 0;
+  for (int k = 0; k < 6; k++)
+    for (int i = 0; i < 6; i++)
+      for (int j = 0; j < 6; j++)
+        if (reach[6 * i + k] && reach[6 * k + j]) reach[6 * i + j] = 1;
+  int nb = 0;
+  for (int i = 0; i < 6; i++) comp[i] = -1;
+  for (int i = 0; i < 6; i++) {
+    if (comp[i] >= 0) continue;
+    for (int j = i; j < 6; j++)
+      if (reach[6 * i + j] && reach[6 * j + i]) comp[j] = nb;
+    nb++;
+  }
+  /* a block after every block that reaches it */
+  int placed[6] = {0}, no = 0;
+  while (no < nb)
+    for (int c = 0; c < nb; c++) {
+      if (placed[c]) continue;
+      int ready = 1;
+      for (int i = 0; i < 6; i++)
+        for (int j = 0; j < 6; j++)
+          if (comp[j] == c && comp[i] != c && !placed[comp[i]] && reach[6 * i + j]) ready = 0;
+      if (ready) { placed[c] = 1; blk[no++] = c; }
     }
-    fprintf(f, "      mb_real a[%d], x[%d];\n", n * n, n * n);
-    for (int i = 0; i < n; i++)
-      for (int j = 0; j < n; j++) {
-        int sl = slot[6 * mem[i] + mem[j]];
-        if (sl >= 0) fprintf(f, "      a[%d] = Kx[%d];\n", n * i + j, sl);
-        else fprintf(f, "      a[%d] = 0;\n", n * i + j);
+  for (int i = 0; i < 6; i++) {
+    int single = 1;
+    for (int j = 0; j < 6; j++) single &= j == i || comp[j] != comp[i];
+    if (single && slot[7 * i] < 0) return 0;
+  }
+  for (int i = 0; i < 36; i++) xnz[i] = reach[i];
+  return nb;
+}
+
+/* X = A^-1 for the A of tri_structure, block by block from the last:
+ * X_kk = A_kk^-1 (1 x 1 by division, larger by emit_inv_small),
+ * X_kj = -X_kk T_kj with T_kj = sum over the later blocks l of A_kl X_lj.
+ * Only the structural nonzeros (xnz) of X are written.  'fail' runs when a
+ * block's pivot or determinant is below 1e-12 of A's largest entry (^n). */
+static void emit_inv_triangular(FILE *f, const int *slot, const char *X, const char *fail) {
+  int comp[6], blk[6], xnz[36];
+  int nb = tri_structure(slot, comp, blk, xnz);
+  fprintf(f, "  { /* block upper triangular in %d blocks: the diagonal ones inverted, the rest\n"
+             "       by substitution */\n    mb_real amax = 0;\n", nb);
+  for (int k = 0; k < 36; k++)
+    if (slot[k] >= 0) fprintf(f, "    if (fabs(Kx[%d]) > amax) amax = fabs(Kx[%d]);\n", slot[k], slot[k]);
+  for (int bi = nb - 1; bi >= 0; bi--) {
+    int c = blk[bi], mem[6], n = 0;
+    for (int i = 0; i < 6; i++)
+      if (comp[i] == c) mem[n++] = i;
+    if (n == 1) {
+      int d = 7 * mem[0];
+      fprintf(f, "    if (!(fabs(Kx[%d]) > 1e-12 * amax)) %s;\n    %s[%d] = 1 / Kx[%d];\n", slot[d], fail, X, d,
+              slot[d]);
+    } else {
+      emit_inv_small(f, slot, mem, n, X, fail, 0);
+    }
+    /* column j of a later block: T(p, j) = sum_q A(p, q) X(q, j) over q outside
+       this block, then X(i, j) = -sum_p X(i, p) T(p, j) */
+    for (int j = 0; j < 6; j++) {
+      if (comp[j] == c) continue;
+      int later = 0;
+      for (int b2 = bi + 1; b2 < nb; b2++) later |= blk[b2] == comp[j];
+      if (!later) continue;
+      int tnz[6] = {0};
+      for (int pi = 0; pi < n; pi++) {
+        int p = mem[pi], any = 0;
+        for (int q = 0; q < 6; q++)
+          if (comp[q] != c && slot[6 * p + q] >= 0 && xnz[6 * q + j]) {
+            if (!any) fprintf(f, "    const mb_real t%d_%d = ", p, j);
+            fprintf(f, "%sKx[%d] * %s[%d]", any ? " + " : "", slot[6 * p + q], X, 6 * q + j);
+            any = 1;
+          }
+        if (any) fputs(";\n", f);
+        tnz[pi] = any;
       }
-    fprintf(f, "      if (ldl_invn(%d, a, x, amax)) %s;\n", n, fail);
-    for (int i = 0; i < n; i++)
-      for (int j = 0; j < n; j++) fprintf(f, "      %s[%d] = x[%d];\n", X, 6 * mem[i] + mem[j], n * i + j);
-    fputs("    }\n", f);
+      for (int ii = 0; ii < n; ii++) {
+        int i = mem[ii], any = 0;
+        if (!xnz[6 * i + j]) continue;
+        fprintf(f, "    %s[%d] = -(", X, 6 * i + j);
+        for (int pi = 0; pi < n; pi++)
+          if (tnz[pi]) {
+            fprintf(f, "%s%s[%d] * t%d_%d", any ? " + " : "", X, 6 * i + mem[pi], mem[pi], j);
+            any = 1;
+          }
+        fputs(any ? ");\n" : "0);\n", f);
+      }
+    }
   }
   fputs("  }\n", f);
 }
@@ -844,9 +956,24 @@ static ml_view ml_body(const ldl_plan *p, int e) {
   return v;
 }
 
+/* the Kx slots of massless body e's Du with its rows at t = 0, and the structure
+ * of Du^-1 as ldl_mlN_fixed computes it (all 36 when Du is inverted whole);
+ * returns 1 when it is block triangular (emit_inv_triangular) */
+static int ml_fixed_du(const ldl_plan *p, int e, int slot[36], int xnz[36]) {
+  ml_view b = ml_body(p, e);
+  int comp[6], blk[6];
+  for (int i = 0; i < 6; i++)
+    for (int c = 0; c < 6; c++) slot[6 * i + c] = ml_du(p, e, b.pi[i], c);
+  if (tri_structure(slot, comp, blk, xnz) > 1) return 1;
+  for (int i = 0; i < 36; i++) xnz[i] = 1;
+  return 0;
+}
+
 /* ldl_mlN_fixed: ldl_ml_pivoting with the rows partial pivoting chose at t = 0
- * (plan mlpi0), every index a constant and every sum in the same order, so
- * that it gives the same numbers; it declines (returns 0) when those rows no
+ * (plan mlpi0), every index a constant and Du inverted by its block-triangular
+ * structure when it has one (emit_inv_triangular; the same numbers as the
+ * pivoting code's Gauss-Jordan up to rounding, every other sum in the same
+ * order, the structural zeros of Du^-1 skipped here and in the solves); it declines (returns 0) when those rows no
  * longer suit: Du singular, or |W| above LDL_ML_WMAX (the other rows, in
  * terms of the chosen ones, grow) */
 static void emit_ml_fixed_factor(FILE *f, const ldl_plan *p) {
@@ -860,21 +987,25 @@ static void emit_ml_fixed_factor(FILE *f, const ldl_plan *p) {
     fprintf(f, ";\n * 1, or 0 when they no longer suit and ldl_ml_pivoting must choose */\n"
                "static int ldl_ml%d_fixed(const mb_real *Kx, mb_real *work) {\n"
                "  mb_real *K1 = work + LDL_K1, *ws = work + %ld, *Di = ws + %d, *W = Di + 36;\n"
-               "  const mb_real Du[36] = {", e, b.w, r);
-    for (int i = 0; i < 6; i++)
-      for (int c = 0; c < 6; c++) {
-        int sl = ml_du(p, e, pi[i], c);
-        if (sl >= 0) fprintf(f, "%sKx[%d]", 6 * i + c ? ", " : "", sl);
-        else fprintf(f, "%s0", 6 * i + c ? ", " : "");
+               "  (void)K1;\n", e, b.w, r);
+    int slot[36], xnz[36];
+    if (ml_fixed_du(p, e, slot, xnz)) {
+      emit_inv_triangular(f, slot, "Di", "return 0");
+    } else {
+      fputs("  const mb_real Du[36] = {", f);
+      for (int i = 0; i < 36; i++) {
+        if (slot[i] >= 0) fprintf(f, "%sKx[%d]", i ? ", " : "", slot[i]);
+        else fprintf(f, "%s0", i ? ", " : "");
       }
-    fputs("};\n  (void)K1;\n  if (ldl_inv6(Du, Di)) return 0;\n", f);
+      fputs("};\n  if (ldl_inv6(Du, Di)) return 0;\n", f);
+    }
     for (int i = 0; i < r - 6; i++)
       for (int c = 0; c < 6; c++) {
         int any = 0;
         fprintf(f, "  W[%d] = ", 6 * i + c);
         for (int k = 0; k < 6; k++) {
           int sl = ml_du(p, e, pi[6 + i], k);
-          if (sl < 0) continue;
+          if (sl < 0 || !xnz[6 * k + c]) continue;
           fprintf(f, "%sKx[%d] * Di[%d]", any ? " + " : "", sl, 6 * k + c);
           any = 1;
         }
@@ -914,10 +1045,17 @@ static void emit_ml_fixed_rhs(FILE *f, const ldl_plan *p, int e) {
     for (int c = 0; c < 6; c++) fprintf(f, " - W[%d] * r[%d]", 6 * i + c, R[pi[c]]);
     fputs(";\n", f);
   }
+  int slot[36], xnz[36];
+  ml_fixed_du(p, e, slot, xnz);
   for (int c = 0; c < 6; c++) {
+    int any = 0;
     fprintf(f, "    z[%d] = ", c);
-    for (int k = 0; k < 6; k++) fprintf(f, "%sDi[%d] * r[%d]", k ? " + " : "", 6 * k + c, u[k]);
-    fputs(";\n", f);
+    for (int k = 0; k < 6; k++)
+      if (xnz[6 * k + c]) {
+        fprintf(f, "%sDi[%d] * r[%d]", any ? " + " : "", 6 * k + c, u[k]);
+        any = 1;
+      }
+    fputs(any ? ";\n" : "0;\n", f);
   }
   for (int y = 0; y < ny; y++) {
     int any = 0;
@@ -960,15 +1098,27 @@ static void emit_ml_fixed_back(FILE *f, const ldl_plan *p, int e) {
     }
     fputs(";\n", f);
   }
+  int slot[36], xnz[36];
+  ml_fixed_du(p, e, slot, xnz);
   for (int k = 0; k < 6; k++) {
+    int any = 0;
     fprintf(f, "    d[%d] = ", u[k]);
-    for (int c = 0; c < 6; c++) fprintf(f, "%sDi[%d] * y[%d]", c ? " + " : "", 6 * k + c, c);
-    fputs(";\n", f);
+    for (int c = 0; c < 6; c++)
+      if (xnz[6 * k + c]) {
+        fprintf(f, "%sDi[%d] * y[%d]", any ? " + " : "", 6 * k + c, c);
+        any = 1;
+      }
+    fputs(any ? ";\n" : "0;\n", f);
   }
   for (int c = 0; c < 6; c++) {
+    int any = 0;
     fprintf(f, "    d[%d] = ", R[pi[c]]);
-    for (int k = 0; k < 6; k++) fprintf(f, "%sDi[%d] * z[%d]", k ? " + " : "", 6 * k + c, k);
-    fputs(";\n", f);
+    for (int k = 0; k < 6; k++)
+      if (xnz[6 * k + c]) {
+        fprintf(f, "%sDi[%d] * z[%d]", any ? " + " : "", 6 * k + c, k);
+        any = 1;
+      }
+    fputs(any ? ";\n" : "0;\n", f);
   }
   for (int i = 0; i < r - 6; i++) fprintf(f, "    d[%d] = mu[%d];\n", R[pi[6 + i]], i);
   fprintf(f, "  } else {\n    ldl_ml_back_pivoting(&ldl_ml[%d], Kx, work, r, d);\n  }\n", e);
