@@ -1031,6 +1031,22 @@ static void emit_ml_fixed_factor(FILE *f, const ldl_plan *p) {
   }
 }
 
+/* "    <lhs> = sum Di[..] * <v>[..];" over the structural nonzeros xnz of Du^-1:
+ * row k of Du^-1 (by_row: Di[6 k + c] * v[c]) or column c (Di[6 k + c] * v[k]);
+ * vi maps the summation index to v's (NULL: itself) */
+static void emit_di_sum(FILE *f, const char *lhs, const int *xnz, int by_row, int kc, const char *v,
+                        const int *vi) {
+  int any = 0;
+  fprintf(f, "    %s = ", lhs);
+  for (int j = 0; j < 6; j++) {
+    int at = by_row ? 6 * kc + j : 6 * j + kc;
+    if (!xnz[at]) continue;
+    fprintf(f, "%sDi[%d] * %s[%d]", any ? " + " : "", at, v, vi ? vi[j] : j);
+    any = 1;
+  }
+  fputs(any ? ";\n" : "0;\n", f);
+}
+
 /* ldl_ml_rhs_pivoting of body e with its rows at t = 0, when the factorization used them */
 static void emit_ml_fixed_rhs(FILE *f, const ldl_plan *p, int e) {
   ml_view b = ml_body(p, e);
@@ -1048,14 +1064,9 @@ static void emit_ml_fixed_rhs(FILE *f, const ldl_plan *p, int e) {
   int slot[36], xnz[36];
   ml_fixed_du(p, e, slot, xnz);
   for (int c = 0; c < 6; c++) {
-    int any = 0;
-    fprintf(f, "    z[%d] = ", c);
-    for (int k = 0; k < 6; k++)
-      if (xnz[6 * k + c]) {
-        fprintf(f, "%sDi[%d] * r[%d]", any ? " + " : "", 6 * k + c, u[k]);
-        any = 1;
-      }
-    fputs(any ? ";\n" : "0;\n", f);
+    char lhs[16];
+    snprintf(lhs, sizeof lhs, "z[%d]", c);
+    emit_di_sum(f, lhs, xnz, 0, c, "r", u);
   }
   for (int y = 0; y < ny; y++) {
     int any = 0;
@@ -1100,25 +1111,14 @@ static void emit_ml_fixed_back(FILE *f, const ldl_plan *p, int e) {
   }
   int slot[36], xnz[36];
   ml_fixed_du(p, e, slot, xnz);
+  char lhs[32];
   for (int k = 0; k < 6; k++) {
-    int any = 0;
-    fprintf(f, "    d[%d] = ", u[k]);
-    for (int c = 0; c < 6; c++)
-      if (xnz[6 * k + c]) {
-        fprintf(f, "%sDi[%d] * y[%d]", any ? " + " : "", 6 * k + c, c);
-        any = 1;
-      }
-    fputs(any ? ";\n" : "0;\n", f);
+    snprintf(lhs, sizeof lhs, "d[%d]", u[k]);
+    emit_di_sum(f, lhs, xnz, 1, k, "y", NULL);
   }
   for (int c = 0; c < 6; c++) {
-    int any = 0;
-    fprintf(f, "    d[%d] = ", R[pi[c]]);
-    for (int k = 0; k < 6; k++)
-      if (xnz[6 * k + c]) {
-        fprintf(f, "%sDi[%d] * z[%d]", any ? " + " : "", 6 * k + c, k);
-        any = 1;
-      }
-    fputs(any ? ";\n" : "0;\n", f);
+    snprintf(lhs, sizeof lhs, "d[%d]", R[pi[c]]);
+    emit_di_sum(f, lhs, xnz, 0, c, "z", NULL);
   }
   for (int i = 0; i < r - 6; i++) fprintf(f, "    d[%d] = mu[%d];\n", R[pi[6 + i]], i);
   fprintf(f, "  } else {\n    ldl_ml_back_pivoting(&ldl_ml[%d], Kx, work, r, d);\n  }\n", e);
