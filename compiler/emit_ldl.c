@@ -626,12 +626,7 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
   /* the blocks' D_u structure, and with it which entries of D_u^-1 can be nonzero */
   int (*dinz)[36] = calloc((size_t)p->nelim + 1, sizeof *dinz);
   if (!dinz) return;
-  for (int e = 0; e < p->nelim; e++) {
-    int nz[36], comp[6];
-    for (int i = 0; i < 36; i++) nz[i] = p->edu[e][i] >= 0;
-    ldl_inv_blocks(nz, comp);
-    for (int i = 0; i < 36; i++) dinz[e][i] = comp[i / 6] == comp[i % 6];
-  }
+  for (int e = 0; e < p->nelim; e++) ldl_block_dinz(p, e, dinz[e]);
   /* the entries of Kc that a block's update reaches (their first update sets them) */
   char *updated = calloc((size_t)nkc + 1, 1);
   if (!updated) { free(src); free(dinz); return; }
@@ -1350,6 +1345,18 @@ static void emit_factor_entry(FILE *f, const lmodel *L, const ldl_plan *p, const
 
 /* ------------------------------------------------------------------ solve */
 
+
+/* start part *nparts of the forward or backward solve when there is none yet or
+ * the open one has passed LDL_CHUNK_FLOPS (closing it) */
+static void solve_part_open(FILE *f, const char *dir, const char *what, int *nparts, double *part_flops) {
+  if (*nparts && *part_flops <= LDL_CHUNK_FLOPS) return;
+  if (*nparts) fputs("}\n\n", f);
+  fprintf(f, "/* %s: %s, row by row (part %d) */\n", dir, what, *nparts);
+  fprintf(f, "static LDL_NOINLINE void ldl_%s%d(const mb_real *restrict Lx, mb_real *restrict t) {\n", dir, *nparts);
+  (*nparts)++;
+  *part_flops = 0;
+}
+
 static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan *p) {
   const mb_model *m = &L->m;
   int n = p->n, nv = p->nv;
@@ -1383,12 +1390,7 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
   for (int i = 0; i < n; i++) {
     int len = p->Rp[i + 1] - p->Rp[i];
     if (!len) continue;
-    if (nfwd == 0 || part_flops > LDL_CHUNK_FLOPS) {
-      if (nfwd) fputs("}\n\n", f);
-      fprintf(f, "/* forward: L y = t, row by row (part %d) */\n", nfwd);
-      fprintf(f, "static LDL_NOINLINE void ldl_forward%d(const mb_real *restrict Lx, mb_real *restrict t) {\n", nfwd++);
-      part_flops = 0;
-    }
+    solve_part_open(f, "forward", "L y = t", &nfwd, &part_flops);
     fprintf(f, "  t[%d] -= ", i);
     emit_sum(f, "Lx[%d] * t[%d]", p->Rpos + p->Rp[i], p->Rj + p->Rp[i], len);
     fputs(";\n", f);
@@ -1398,12 +1400,7 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
   for (int j = n - 1; j >= 0; j--) {
     int len = p->Lp[j + 1] - p->Lp[j];
     if (!len) continue;
-    if (nbwd == 0 || part_flops > LDL_CHUNK_FLOPS) {
-      if (nbwd) fputs("}\n\n", f);
-      fprintf(f, "/* backward: L^T x = z, row by row (part %d) */\n", nbwd);
-      fprintf(f, "static LDL_NOINLINE void ldl_backward%d(const mb_real *restrict Lx, mb_real *restrict t) {\n", nbwd++);
-      part_flops = 0;
-    }
+    solve_part_open(f, "backward", "L^T x = z", &nbwd, &part_flops);
     int *lq = malloc(sizeof(int) * (size_t)len);
     if (!lq) break;
     for (int k = 0; k < len; k++) lq[k] = p->Lp[j] + k;

@@ -631,11 +631,16 @@ int ldl_w_nonzero(const int *eu, const int *dinz, int i) {
  * es and ex): some i with Dx(i, x) and W(s, i) structurally nonzero.  The pattern
  * of K' holds only these pairs, so that a weld's block-diagonal D_u (point rows on
  * the translations, angle rows on the rotations) adds no fill it cannot produce */
-static int elim_pair_nz(const ldl_plan *p, int e, int si, int xi) {
-  int nz[36], comp[6], dinz[36];
+void ldl_block_dinz(const ldl_plan *p, int e, int dinz[36]) {
+  int nz[36], comp[6];
   for (int i = 0; i < 36; i++) nz[i] = p->edu[e][i] >= 0;
   ldl_inv_blocks(nz, comp);
   for (int i = 0; i < 36; i++) dinz[i] = comp[i / 6] == comp[i % 6];
+}
+
+static int elim_pair_nz(const ldl_plan *p, int e, int si, int xi) {
+  int dinz[36];
+  ldl_block_dinz(p, e, dinz);
   const int *dx = p->edx + 6 * xi, *eu = p->eeu + 6 * si;
   for (int i = 0; i < 6; i++)
     if (dx[i] >= 0 && ldl_w_nonzero(eu, dinz, i)) return 1;

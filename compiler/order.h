@@ -137,6 +137,8 @@ int ldl_inv_blocks(const int *nz, int comp[6]);
 /* W(s, i) = (Eu Du^-1)(s, i) can be nonzero (eu: row s's slots in the body's
  * columns, -1 none; dinz[36]: the structure of Du^-1) */
 int ldl_w_nonzero(const int *eu, const int *dinz, int i);
+/* dinz[36]: the structure of block pivot e's D_u^-1 (its D_u's diagonal blocks) */
+void ldl_block_dinz(const ldl_plan *p, int e, int dinz[36]);
 
 /* `mbcc check`: the ordering, nnz(L), the flop count and the code form */
 void ldl_plan_report(const lmodel *L, FILE *out);
