@@ -347,7 +347,12 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
            r->nnz, PATHS[p].eval == EVAL_IDA ? "-" : nl, r->steps, r->step_med, r->run_med,
            r->run_med / best_run, r->step_med / best_step, r->max_rel, r->max_rel_pos);
     if (p == ref) printf("  (reference)");
-    else if (r->worst_col >= 0 && r->max_rel > 0) printf("  (%s)", m->col_name[r->worst_col]);
+    else if (r->worst_col >= 0 && r->max_rel > 0) {
+      printf("  (%s", m->col_name[r->worst_col]);
+      if (r->worst_col_pos >= 0 && r->worst_col_pos != r->worst_col && r->max_rel_pos > 0)
+        printf("; positions: %s", m->col_name[r->worst_col_pos]);
+      printf(")");
+    }
     if (r->note[0]) printf("  %s", r->note);
     printf("\n");
   }
@@ -365,17 +370,19 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
     snprintf(tmp, sizeof tmp, "%s.part", csv_path);
     FILE *f = fopen(tmp, "w");
     if (!f) { fprintf(stderr, "%s: error: cannot write '%s'\n", argv[0], tmp); rc = 2; goto out; }
-    fprintf(f, "path,n,nnz_K,nnz_L,step_median_s,run_s,ratio,steps,max_rel_diff,step_ratio,status,max_rel_diff_positions\n");
+    fprintf(f, "path,n,nnz_K,nnz_L,step_median_s,run_s,ratio,steps,max_rel_diff,step_ratio,status,max_rel_diff_positions,worst_output,worst_output_positions\n");
     for (int p = 0; p < NPATH; p++) {
       const path_result *r = &res[p];
       if (!r->state) continue;
       const char *l = PATHS[p].eval == EVAL_IDA ? "-" : nl;
       if (r->state == 1)
-        fprintf(f, "%s,%d,%d,%s,%.6g,%.6g,%.4f,%ld,%.3g,%.4f,ok,%.3g\n", PATHS[p].name, r->n, r->nnz,
-                l, r->step_med, r->run_med, r->run_med / best_run, r->steps, r->max_rel,
-                r->step_med / best_step, r->max_rel_pos);
+        fprintf(f, "%s,%d,%d,%s,%.6g,%.6g,%.4f,%ld,%.3g,%.4f,ok,%.3g,%s,%s\n", PATHS[p].name, r->n,
+                r->nnz, l, r->step_med, r->run_med, r->run_med / best_run, r->steps, r->max_rel,
+                r->step_med / best_step, r->max_rel_pos,
+                r->worst_col >= 0 && r->max_rel > 0 ? m->col_name[r->worst_col] : "",
+                r->worst_col_pos >= 0 && r->max_rel_pos > 0 ? m->col_name[r->worst_col_pos] : "");
       else
-        fprintf(f, "%s,%d,%d,%s,,,,,,,%s,\n", PATHS[p].name, r->n, r->nnz, l,
+        fprintf(f, "%s,%d,%d,%s,,,,,,,%s,,,\n", PATHS[p].name, r->n, r->nnz, l,
                 r->state == 2 ? "skipped" : "failed");
     }
     if (fclose(f) || rename(tmp, csv_path)) {

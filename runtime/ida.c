@@ -1,6 +1,7 @@
 /* ida.c: the model's DAE F(t, y, y') = 0, y = [q; v; lambda], integrated by
  * SUNDIALS IDA with dense LU and a difference-quotient Jacobian (mb_ida.h). */
 #define _POSIX_C_SOURCE 199309L
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -103,6 +104,25 @@ static int map_flag(int flag) {
   }
 }
 
+/* Tolerances: rtol and atol on q and v.  The multipliers are out of the error test
+ * (IDASetSuppressAlg) but IDA's Newton test still weighs them; with atol alone, a
+ * multiplier that vanishes would have to converge to atol in absolute terms, below the
+ * round-off that the large multipliers leave in it (about eps * cond(K) * max|lambda|),
+ * and at rtol 1e-13 Newton never converges.  They get an absolute tolerance of
+ * sqrt(eps) times the largest initial multiplier (at least 1) instead. */
+static int set_tolerances(void *mem, const mb_settings *s, int ndiff, int nc, const double *lam0,
+                          SUNContext ctx) {
+  double big = 1;
+  for (int i = 0; i < nc; i++) big = fmax(big, fabs(lam0[i]));
+  N_Vector av = N_VNew_Serial(ndiff + nc, ctx);
+  if (!av) return IDA_MEM_FAIL;
+  double *a = N_VGetArrayPointer(av);
+  for (int i = 0; i < ndiff + nc; i++) a[i] = i < ndiff ? s->atol : fmax(s->atol, sqrt(DBL_EPSILON) * big);
+  int flag = IDASVtolerances(mem, s->rtol, av);
+  N_VDestroy(av);
+  return flag;
+}
+
 int mb_ida_simulate(const mb_model *m, const mb_settings *s, mb_output_fn out, void *user,
                     mb_stats *stats, double *fail_time) {
   double wall0 = now();
@@ -161,7 +181,7 @@ int mb_ida_simulate(const mb_model *m, const mb_settings *s, mb_output_fn out, v
   if (!mem) { st = MB_ERR_NOMEM; goto done; }
   flag = IDASetErrHandlerFn(mem, silent, NULL);
   if (!flag) flag = IDAInit(mem, residual, 0.0, yy, yp);
-  if (!flag) flag = IDASStolerances(mem, s->rtol, s->atol);
+  if (!flag) flag = set_tolerances(mem, s, nq + nv, nc, y + nq + nv, ctx);
   if (!flag) flag = IDASetUserData(mem, &c);
   if (!flag) flag = IDASetId(mem, id);
   /* lambda out of the error test: multipliers that vanish (e.g. reactions

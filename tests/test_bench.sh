@@ -9,6 +9,7 @@
 #   - at rtol 1e-12 (both integrators' own errors far below 1e-9), IDA and the
 #     Dormand-Prince path agree to 1e-9 on the position outputs
 #     (max_rel_diff_positions) over 0.05 s;
+#   - IDA at rtol 1e-13 converges on the flexible slider-crank and agrees there;
 #   - --paths selects paths; bad options exit with status 2.
 # Runs mbcc from a scratch directory, so that nothing lands in the source tree.
 # Environment: MBCC (set by tests/run_tests.sh; default build/mbcc).
@@ -58,6 +59,21 @@ if "$MBCC" bench "$model" --end 0.05 --reps 1 --paths generated+klu,ida --rtol 1
     END { if (!seen) { print "no ida row"; exit 1 } }' t.csv > tight.log || err "tight tolerances: $(cat tight.log)"
 else
   err "mbcc bench at rtol 1e-12 failed: $(tail -5 tight.txt)"
+fi
+# IDA at rtol 1e-13 on the flexible slider-crank: its multipliers' Newton weights
+# (runtime/ida.c, set_tolerances) let it converge where atol alone made it fail at
+# t = 0.0024; it agrees on positions, and the CSV names the worst position output
+flex="$root/models/slider_crank_flexible.yaml"
+if "$MBCC" bench "$flex" --end 0.01 --reps 1 --paths generated+ldl,ida --rtol 1e-12 --atol 1e-14 \
+    --ida-rtol 1e-13 --csv f.csv --quiet > flex.txt 2>&1; then
+  awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+    $c["path"] == "ida" { seen = 1
+      if ($c["status"] != "ok") { print "ida " $c["status"]; exit 1 }
+      if (!($c["max_rel_diff_positions"] <= 1e-9)) { print "ida positions " $c["max_rel_diff_positions"]; exit 1 }
+      if ($c["worst_output_positions"] !~ /^(crank_angle|slider_x|midspan)$/) { print "worst position output \"" $c["worst_output_positions"] "\""; exit 1 } }
+    END { if (!seen) { print "no ida row"; exit 1 } }' f.csv > flex.log || err "ida at rtol 1e-13: $(cat flex.log) $(cat flex.txt)"
+else
+  err "mbcc bench with --ida-rtol 1e-13 failed: $(tail -5 flex.txt)"
 fi
 "$MBCC" bench "$model" --end 0.005 --reps 1 --paths ida --ida-rtol 1e-10 --quiet > ir.txt 2>&1 &&
   grep -q '^ida: rtol 1e-10, atol 1e-12' ir.txt || err "--ida-rtol: $(head -3 ir.txt)"
