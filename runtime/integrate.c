@@ -65,12 +65,11 @@ int mb_sim_init(mb_sim *s, const mb_model *m, mb_solver *ls, const mb_settings *
   s->nu = calloc((size_t)m->nc + 1, sizeof(mb_real));
   s->y = calloc(ny + 1, sizeof(mb_real));
   s->ytmp = calloc(ny + 1, sizeof(mb_real));
-  s->acc = calloc(ny + 1, sizeof(double));
   for (int i = 0; i < 7; i++) s->k[i] = calloc(ny + 1, sizeof(mb_real));
   s->qsave = calloc((size_t)m->nq + 1, sizeof(mb_real));
   s->dv = calloc((size_t)m->n + 1, sizeof(mb_real));
   s->work = malloc(mb_model_worksize(m) + 16);
-  if (!s->q || !s->v || !s->Kx || !s->rhs || !s->x || !s->phi || !s->nu || !s->y || !s->ytmp || !s->acc ||
+  if (!s->q || !s->v || !s->Kx || !s->rhs || !s->x || !s->phi || !s->nu || !s->y || !s->ytmp ||
       !s->qsave || !s->dv || !s->work)
     return MB_ERR_NOMEM;
   for (int i = 0; i < 7; i++)
@@ -85,7 +84,7 @@ int mb_sim_init(mb_sim *s, const mb_model *m, mb_solver *ls, const mb_settings *
 
 void mb_sim_free(mb_sim *s) {
   free(s->q); free(s->v); free(s->Kx); free(s->rhs); free(s->x); free(s->phi); free(s->nu);
-  free(s->y); free(s->ytmp); free(s->acc); free(s->qsave); free(s->dv); free(s->work);
+  free(s->y); free(s->ytmp); free(s->qsave); free(s->dv); free(s->work);
   for (int i = 0; i < 7; i++) free(s->k[i]);
   memset(s, 0, sizeof *s);
 }
@@ -216,22 +215,14 @@ static const double DP_A[7][6] = {
 static const double DP_E[7] = {71.0 / 57600, 0, -71.0 / 16695, 71.0 / 1920, -17253.0 / 339200,
                                22.0 / 525, -1.0 / 40};
 
-/* acc = sum_j a_j k_j, stage by stage: the loops over i vectorize, and for each i
- * the terms are added in the order j = 0, 1, ... as a loop over j inside would */
-static void stage_sum(int ny, const double *a, mb_real *const *k, int nk, double *restrict acc) {
-  for (int i = 0; i < ny; i++) acc[i] = 0;
-  for (int j = 0; j < nk; j++) {
-    const mb_real *restrict kj = k[j];
-    double aj = a[j];
-    for (int i = 0; i < ny; i++) acc[i] += aj * kj[i];
+/* one explicit stage combination: ytmp = y + h sum a_j k_j */
+static void combine(int ny, const mb_real *y, double h, const double *a, mb_real *const *k, int nk,
+                    mb_real *out) {
+  for (int i = 0; i < ny; i++) {
+    double acc = 0;
+    for (int j = 0; j < nk; j++) acc += a[j] * k[j][i];
+    out[i] = y[i] + h * acc;
   }
-}
-
-/* one explicit stage combination: out = y + h sum a_j k_j */
-static void combine(int ny, const mb_real *restrict y, double h, const double *a, mb_real *const *k,
-                    int nk, double *restrict acc, mb_real *restrict out) {
-  stage_sum(ny, a, k, nk, acc);
-  for (int i = 0; i < ny; i++) out[i] = y[i] + h * acc[i];
 }
 
 int mb_sim_step_budget(mb_sim *s, double h) {
@@ -343,14 +334,14 @@ int mb_sim_run(mb_sim *s, mb_output_fn out, void *user) {
       h = hs < hmax * (1 + 1e-12) ? hs : hmax;
       if (hmax - h < 1e-9 * hs) h = hmax;
       static const double a2[1] = {0.5}, a3[2] = {0, 0.5}, a4[3] = {0, 0, 1};
-      combine(ny, s->y, h, a2, s->k, 1, s->acc, s->ytmp);
+      combine(ny, s->y, h, a2, s->k, 1, s->ytmp);
       if ((st = deriv(s, s->t + h / 2, s->ytmp, s->k[1]))) goto done;
-      combine(ny, s->y, h, a3, s->k, 2, s->acc, s->ytmp);
+      combine(ny, s->y, h, a3, s->k, 2, s->ytmp);
       if ((st = deriv(s, s->t + h / 2, s->ytmp, s->k[2]))) goto done;
-      combine(ny, s->y, h, a4, s->k, 3, s->acc, s->ytmp);
+      combine(ny, s->y, h, a4, s->k, 3, s->ytmp);
       if ((st = deriv(s, s->t + h, s->ytmp, s->k[3]))) goto done;
       static const double b[4] = {1.0 / 6, 1.0 / 3, 1.0 / 3, 1.0 / 6};
-      combine(ny, s->y, h, b, s->k, 4, s->acc, s->ytmp);
+      combine(ny, s->y, h, b, s->k, 4, s->ytmp);
       memcpy(s->q, s->ytmp, sizeof(mb_real) * (size_t)nq);
       memcpy(s->v, s->ytmp + nq, sizeof(mb_real) * (size_t)nv);
       s->t = (h == hmax) ? tout : s->t + h;
@@ -364,7 +355,7 @@ int mb_sim_run(mb_sim *s, mb_output_fn out, void *user) {
         double hh = fmin(h, hmax);
         if (hmax - hh < 1e-9 * set->output_step) hh = hmax;
         for (int j = 1; j < 7; j++) {
-          combine(ny, s->y, hh, DP_A[j], s->k, j, s->acc, s->ytmp);
+          combine(ny, s->y, hh, DP_A[j], s->k, j, s->ytmp);
           if ((st = deriv(s, s->t + DP_C[j] * hh, s->ytmp, s->k[j]))) {
             /* a failed stage (e.g. a singular matrix far from the path):
                retry with a smaller step before giving up */
@@ -376,9 +367,10 @@ int mb_sim_run(mb_sim *s, mb_output_fn out, void *user) {
         }
         /* ytmp holds the 5th-order solution (FSAL stage); error estimate */
         double err = 0;
-        stage_sum(ny, DP_E, s->k, 7, s->acc);
         for (int i = 0; i < ny; i++) {
-          double e = s->acc[i] * hh;
+          double e = 0;
+          for (int j = 0; j < 7; j++) e += DP_E[j] * s->k[j][i];
+          e *= hh;
           double sc = set->atol + set->rtol * fmax(fabs(s->y[i]), fabs(s->ytmp[i]));
           err += (e / sc) * (e / sc);
         }

@@ -51,17 +51,14 @@ static inline void mb_col3(const mb_real R[9], int k, mb_real a[3]) {
   a[0] = R[k]; a[1] = R[3 + k]; a[2] = R[6 + k];
 }
 
-/* Rotation matrix of Euler parameters p, normalized here (a state whose p drifted
- * off the unit sphere still gives a rotation).  Every entry is quadratic in p, so
- * e_i e_j = p_i p_j / |p|^2: one division and no square root. */
-static inline void mb_euler_to_A(const mb_real p[4], mb_real A[9]) {
-  mb_real s = 2 / (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3]);
-  mb_real e00 = p[0] * p[0], e11 = p[1] * p[1], e22 = p[2] * p[2], e33 = p[3] * p[3];
-  mb_real e01 = p[0] * p[1], e02 = p[0] * p[2], e03 = p[0] * p[3];
-  mb_real e12 = p[1] * p[2], e13 = p[1] * p[3], e23 = p[2] * p[3];
-  A[0] = s * (e00 + e11) - 1; A[1] = s * (e12 - e03); A[2] = s * (e13 + e02);
-  A[3] = s * (e12 + e03); A[4] = s * (e00 + e22) - 1; A[5] = s * (e23 - e01);
-  A[6] = s * (e13 - e02); A[7] = s * (e23 + e01); A[8] = s * (e00 + e33) - 1;
+/* Rotation matrix of Euler parameters p (normalized here, so that a state
+ * whose p drifted off the unit sphere still gives a rotation). */
+static inline void mb_euler_to_A(const mb_real p_in[4], mb_real A[9]) {
+  mb_real n = sqrt(p_in[0] * p_in[0] + p_in[1] * p_in[1] + p_in[2] * p_in[2] + p_in[3] * p_in[3]);
+  mb_real e0 = p_in[0] / n, e1 = p_in[1] / n, e2 = p_in[2] / n, e3 = p_in[3] / n;
+  A[0] = 2 * (e0 * e0 + e1 * e1) - 1; A[1] = 2 * (e1 * e2 - e0 * e3); A[2] = 2 * (e1 * e3 + e0 * e2);
+  A[3] = 2 * (e1 * e2 + e0 * e3); A[4] = 2 * (e0 * e0 + e2 * e2) - 1; A[5] = 2 * (e2 * e3 - e0 * e1);
+  A[6] = 2 * (e1 * e3 - e0 * e2); A[7] = 2 * (e2 * e3 + e0 * e1); A[8] = 2 * (e0 * e0 + e3 * e3) - 1;
 }
 
 /* pd = 1/2 L(p)^T w' : Euler-parameter rates from the body angular velocity */

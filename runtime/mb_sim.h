@@ -50,7 +50,6 @@ typedef struct {
   char fail_detail[160];    /* what failed */
   /* workspaces */
   mb_real *Kx, *rhs, *x, *phi, *nu, *y, *ytmp, *k[7], *qsave, *dv; /* nu: phid = D v - nu */
-  double *acc; /* ny: the stage sums of the explicit integrators */
   void *work;
   int factored_valid;       /* Kx factorization matches qsave */
 } mb_sim;
