@@ -469,6 +469,23 @@ static void emit_inv_small(FILE *f, const int *slot, const int *mem, int n, cons
  * pivot (1 x 1) below 1e-12 of A's largest entry runs 'fail', as emit_inv_small's
  * tests.  Only the entries of X inside the blocks are written: the others are
  * structural zeros, and every reader skips them. */
+/* the inverse of diagonal block (strongly connected component) c of D_u into X:
+ * a division for a 1x1 block, else emit_inv_small; returns the block's size */
+static int emit_inv_component(FILE *f, const int *slot, const int *comp, int c, const char *X,
+                              const char *fail, int adjugate) {
+  int mem[6], n = 0;
+  for (int i = 0; i < 6; i++)
+    if (comp[i] == c) mem[n++] = i;
+  if (n == 1) {
+    int d = 7 * mem[0];
+    fprintf(f, "    if (!(fabs(Kx[%d]) > 1e-12 * amax)) %s;\n    %s[%d] = 1 / Kx[%d];\n", slot[d], fail, X, d,
+            slot[d]);
+  } else {
+    emit_inv_small(f, slot, mem, n, X, fail, adjugate);
+  }
+  return n;
+}
+
 static void emit_inv_blocked(FILE *f, const int *slot, const char *X, const char *fail) {
   int nz[36], comp[6];
   for (int i = 0; i < 36; i++) nz[i] = slot[i] >= 0;
@@ -486,18 +503,7 @@ static void emit_inv_blocked(FILE *f, const int *slot, const char *X, const char
   fprintf(f, "  { /* block-diagonal: %d blocks inverted apart */\n    mb_real amax = 0;\n", nb);
   for (int k = 0; k < 36; k++)
     if (nz[k]) fprintf(f, "    if (fabs(Kx[%d]) > amax) amax = fabs(Kx[%d]);\n", slot[k], slot[k]);
-  for (int c = 0; c < nb; c++) {
-    int mem[6], n = 0;
-    for (int i = 0; i < 6; i++)
-      if (comp[i] == c) mem[n++] = i;
-    if (n == 1) {
-      int d = 7 * mem[0];
-      fprintf(f, "    if (!(fabs(Kx[%d]) > 1e-12 * amax)) %s;\n    %s[%d] = 1 / Kx[%d];\n", slot[d], fail, X, d,
-              slot[d]);
-      continue;
-    }
-    emit_inv_small(f, slot, mem, n, X, fail, 1);
-  }
+  for (int c = 0; c < nb; c++) emit_inv_component(f, slot, comp, c, X, fail, 1);
   fputs("  }\n", f);
 }
 
@@ -557,16 +563,9 @@ static void emit_inv_triangular(FILE *f, const int *slot, const char *X, const c
   for (int k = 0; k < 36; k++)
     if (slot[k] >= 0) fprintf(f, "    if (fabs(Kx[%d]) > amax) amax = fabs(Kx[%d]);\n", slot[k], slot[k]);
   for (int bi = nb - 1; bi >= 0; bi--) {
-    int c = blk[bi], mem[6], n = 0;
-    for (int i = 0; i < 6; i++)
-      if (comp[i] == c) mem[n++] = i;
-    if (n == 1) {
-      int d = 7 * mem[0];
-      fprintf(f, "    if (!(fabs(Kx[%d]) > 1e-12 * amax)) %s;\n    %s[%d] = 1 / Kx[%d];\n", slot[d], fail, X, d,
-              slot[d]);
-    } else {
-      emit_inv_small(f, slot, mem, n, X, fail, 0);
-    }
+    int c = blk[bi], mem[6], n = emit_inv_component(f, slot, comp, c, X, fail, 0);
+    for (int i = 0, k = 0; i < 6; i++)
+      if (comp[i] == c) mem[k++] = i;
     /* column j of a later block: T(p, j) = sum_q A(p, q) X(q, j) over q outside
        this block, then X(i, j) = -sum_p X(i, p) T(p, j) */
     for (int j = 0; j < 6; j++) {
