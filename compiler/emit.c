@@ -430,10 +430,23 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
     fprintf(f, "  mb_frame_rigid(q + %d, v + %d, &f[%d]); /* body '%s' */\n", L->body[b].qadr,
             L->body[b].vadr, b, L->body[b].name);
   fprintf(f, "\n  /* markers */\n");
+  /* a marker that is its body's frame is not stored when only the spherical
+     and dot-1 rows of emit_row_special read it (they read the frame); forces
+     and the other rows pass markers to kernels by address */
+  char *passed = calloc(m->nmarker ? (size_t)m->nmarker : 1, 1);
+  if (!passed) { fputs("out of memory\n", stderr); exit(1); }
+  for (int i = 0; i < m->nforce; i++) {
+    passed[L->force[i].m0] = 1;
+    if (L->force[i].m1 >= 0) passed[L->force[i].m1] = 1;
+  }
+  for (int r = 0; r < m->nrow; r++)
+    if (L->row[r].kind != MB_PRIM_SPH && L->row[r].kind != MB_PRIM_DOT1) passed[L->row[r].m0] = passed[L->row[r].m1] = 1;
   for (int k = 0; k < m->nmarker; k++) {
     const mb_markerdef *d = &L->marker[k];
     fprintf(f, "  /* %s */\n", L->marker_desc[k]);
-    if (d->body < 0) {
+    if (!passed[k] && d->body >= 0 && emit_marker_is_frame(L, k)) {
+      fprintf(f, "  /* the frame of body '%s' itself: the rows read f[%d] */\n", L->body[d->body].name, d->body);
+    } else if (d->body < 0) {
       fprintf(f, "  mb_marker_ground(markers[%d].s, markers[%d].C, &k[%d]);\n", k, k, k);
     } else if (d->node >= 0 && emit_node_static(&L->body[d->body], d->node)) {
       fprintf(f, "  /* node %d: its mode shapes vanish: a rigid marker (mb_marker_rigid) */\n", d->node);
@@ -445,6 +458,7 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
       emit_marker_special(f, L, k);
     }
   }
+  free(passed);
   fprintf(f, "\n  /* body forces: gravity and the quadratic-velocity (gyroscopic) terms */\n");
   for (int b = 0; b < m->nbody; b++) {
     const mb_body *B = &L->body[b];
@@ -550,6 +564,7 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
     fputs("  }\n", f);
   }
   fprintf(f, "\n  /* constraint rows: D in both triangles of K, gamma, phi, phid */\n");
+  emit_rows_shared(f, L);
   static const char *prim[] = {"", "sph", "dot1", "dot2", "dist", "rot", "trans"};
   for (int r = 0; r < m->nrow; r++) {
     const mb_rowdef *R = &L->row[r];

@@ -159,6 +159,14 @@ static void kval(FILE *f, int q) {
   else fputs(kc_map[q] == -2 ? "1" : kc_map[q] == -3 ? "-1" : "0", f); /* a constant of K' */
 }
 
+/* 1 if kval(q) writes a constant of K' (the decoupled diagonals of the block
+ * pivots' unknowns and rows), its value in *v */
+static int kconst(int q, double *v) {
+  if (!kc_of || kc_of[q] >= 0 || kc_map[q] >= 0) return 0;
+  *v = kc_map[q] == -2 ? 1 : kc_map[q] == -3 ? -1 : 0;
+  return 1;
+}
+
 /* the value of K_aug entry e (upper triangle, permuted) as a C expression */
 static void aug_value(FILE *f, const ldl_plan *p, int e) {
   int any = 0;
@@ -268,6 +276,15 @@ static void emit_factor_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
     for (int e = p->Up[k]; e < p->Up[k + 1]; e++) {
       if (p->Ui[e] == k) diag = e;
       else kent[p->Ui[e]] = e;
+    }
+    double dc;
+    if (p->Rp[k + 1] == p->Rp[k] && diag >= 0 && p->Us[diag] >= 0 && p->Tp[diag] == p->Tp[diag + 1] &&
+        kconst(p->Us[diag], &dc) && (dc == 1 || dc == -1)) {
+      /* a decoupled unknown: no entries in its row of L, a constant pivot */
+      fprintf(f, "  Dinv[%d] = %s;\n", k, dc > 0 ? "1" : "-1");
+      chunk_flops += 1;
+      for (int e = p->Up[k]; e < p->Up[k + 1]; e++) kent[p->Ui[e]] = -1;
+      continue;
     }
     fputs("  {\n", f);
     if (p->Rp[k + 1] > p->Rp[k]) {
@@ -1526,16 +1543,19 @@ static void emit_solve(FILE *f, const ldl_plan *p, const char *nm) {
     fputs("  if (!residual) { /* one pass: no residual, no refinement */\n", f);
     if (staged) {
       emit_solve_pass(f, p, "b", "    ");
-      fputs("    for (int i = 0; i < LDL_N; i++) b[i] = d[i];\n", f);
     } else {
       fputs("    for (int i = 0; i < LDL_N; i++) x[i] = 0;\n", f);
       emit_solve_pass(f, p, "b", "    ");
-      fputs("    ldl_scatter_add(t, x);\n"
-            "    for (int i = 0; i < LDL_N; i++) b[i] = x[i];\n", f);
+      fputs("    ldl_scatter_add(t, x);\n", f);
     }
-    fputs("    for (int i = 0; i < LDL_N; i++)\n"
-          "      if (!isfinite(b[i])) return MB_ERR_NONFINITE;\n"
-          "    return MB_OK;\n  }\n", f);
+    /* the copy and the finiteness test in one pass, without a branch per
+       entry: x - x is 0 for a finite x and NaN otherwise */
+    fprintf(f, "    int finite = 1;\n"
+               "    for (int i = 0; i < LDL_N; i++) {\n"
+               "      b[i] = %s[i];\n"
+               "      finite &= b[i] - b[i] == 0;\n"
+               "    }\n"
+               "    return finite ? MB_OK : MB_ERR_NONFINITE;\n  }\n", staged ? "d" : "x");
   }
   fputs("  mb_real knorm = ldl_knorm(Kx, work), bn = 0, best = 0, first = 0;\n"
         "  for (int i = 0; i < LDL_N; i++) {\n"

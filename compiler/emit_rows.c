@@ -281,6 +281,19 @@ typedef struct {
   int at_origin; /* rigid and s = 0: P = r exactly */
 } smark;
 
+/* marker k is its body's frame: on a rigid body (or a static node) at the
+ * frame's origin with the frame's axes, so P = r, V = rd, W = w, R = A and
+ * aP = aW = 0 exactly; rows read the frame itself */
+int emit_marker_is_frame(const lmodel *L, int k) {
+  const double *s;
+  if (!marker_rigid(L, k, &s)) return 0;
+  static const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  const mb_markerdef *d = &L->marker[k];
+  for (int i = 0; i < 9; i++)
+    if (d->C[i] != I[i]) return 0;
+  return s[0] == 0 && s[1] == 0 && s[2] == 0;
+}
+
 static void mark_view(const lmodel *L, int k, smark *m) {
   const mb_markerdef *d = &L->marker[k];
   const double *s = NULL;
@@ -289,6 +302,17 @@ static void mark_view(const lmodel *L, int k, smark *m) {
     for (int i = 0; i < 3; i++) lit(m->P.e[i], d->s[i]);
     for (int i = 0; i < 9; i++) lit(m->R[i], d->C[i]);
     s_zero(&m->V); s_zero(&m->W); s_zero(&m->aP); s_zero(&m->aW);
+    return;
+  }
+  if (emit_marker_is_frame(L, k)) {
+    int b = d->body;
+    s_names(&m->P, "f[%d].r", b);
+    s_names(&m->V, "f[%d].rd", b);
+    s_names(&m->W, "f[%d].w", b);
+    s_zero(&m->aP);
+    s_zero(&m->aW);
+    for (int i = 0; i < 9; i++) snprintf(m->R[i], EXPR, "f[%d].A[%d]", b, i);
+    m->rigid = m->at_origin = 1;
     return;
   }
   s_names(&m->P, "k[%d].P", k);
@@ -401,9 +425,124 @@ static void emit_row_common(FILE *f, const lmodel *L, int r, const smark mk[2], 
   }
 }
 
+/* --- dot-1 rows between two bodies' own axes ------------------------------
+ * When both markers of a dot-1 row take their axes from their bodies' frames
+ * (rigid body or static node, C = I), the row is a function of the relative
+ * rotation Rr = A0^T A1 (Rr[k][l] = a0k . a1l) and the body-axes angular
+ * velocities w0', w1'.  For axis i of body 0 and axis j of body 1, with A0 and
+ * A1 proper rotations (A^T (u x v) = A^T u x A^T v):
+ *   phi = Rr[i][j],
+ *   columns  c0 = A0^T (a0i x a1j) = e_i x Rr[:, j],
+ *            c1 = -A1^T (a0i x a1j) = e_j x Rr[i, :],
+ *   phid = c0 . w0' + c1 . w1',
+ *   s00 = W0 . a0i = w0'_i, s01 = W0 . a1j = w0' . Rr[:, j],
+ *   s10 = W1 . a0i = w1' . Rr[i, :], s11 = W1 . a1j = w1'_j,
+ * and mb_prim_dot1's quad from these.  The entries of Rr and |W0 - W1|^2 are
+ * shared by all such rows between the same two bodies (a weld's three, a
+ * revolute's two): about a third of the kernel's flops.  The numbers equal the
+ * kernel's up to rounding (A is orthonormal to rounding: mb_euler_to_A
+ * normalizes); test_generic and test_ldl compare the two paths. */
+
+/* body whose frame gives marker k its axes (on a body, rigid or a static
+ * node, C = I), or -1 */
+static int frame_axes(const lmodel *L, int k) {
+  static const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  const mb_markerdef *d = &L->marker[k];
+  if (d->body < 0 || !marker_rigid(L, k, NULL)) return -1;
+  for (int i = 0; i < 9; i++)
+    if (d->C[i] != I[i]) return -1;
+  return d->body;
+}
+
+static int dot1_frames(const lmodel *L, int r, int *b0, int *b1) {
+  const mb_rowdef *R = &L->row[r];
+  if (R->kind != MB_PRIM_DOT1) return 0;
+  *b0 = frame_axes(L, R->m0);
+  *b1 = frame_axes(L, R->m1);
+  return *b0 >= 0 && *b1 >= 0 && *b0 != *b1;
+}
+
+static void rel_name(char *o, int b0, int b1, int k, int l) { snprintf(o, EXPR, "rr%d_%d_%d%d", b0, b1, k, l); }
+
+void emit_rows_shared(FILE *f, const lmodel *L) {
+  const mb_model *m = &L->m;
+  int nb = m->nbody;
+  for (int b0 = 0; b0 < nb; b0++)
+    for (int b1 = 0; b1 < nb; b1++) {
+      int need[9] = {0}, any = 0, x0, x1;
+      for (int r = 0; r < m->nrow; r++) {
+        if (!dot1_frames(L, r, &x0, &x1) || x0 != b0 || x1 != b1) continue;
+        int i = L->row[r].a, j = L->row[r].b;
+        for (int k = 0; k < 3; k++) need[3 * k + j] = need[3 * i + k] = 1; /* column j, row i */
+        any = 1;
+      }
+      if (!any) continue;
+      fprintf(f, "  /* relative rotation A0^T A1 of body '%s' to body '%s' (the entries its dot-1 rows\n"
+                 "     use) and |w0 - w1|^2 */\n", L->body[b0].name, L->body[b1].name);
+      for (int k = 0; k < 3; k++)
+        for (int l = 0; l < 3; l++) {
+          if (!need[3 * k + l]) continue;
+          char nmv[EXPR];
+          rel_name(nmv, b0, b1, k, l);
+          fprintf(f, "  const mb_real %s = f[%d].A[%d] * f[%d].A[%d] + f[%d].A[%d] * f[%d].A[%d] + f[%d].A[%d] * f[%d].A[%d];\n",
+                  nmv, b0, k, b1, l, b0, 3 + k, b1, 3 + l, b0, 6 + k, b1, 6 + l);
+        }
+      fprintf(f, "  mb_real dd%d_%d;\n  {\n    mb_real dw[3] = {f[%d].w[0] - f[%d].w[0], f[%d].w[1] - f[%d].w[1], f[%d].w[2] - f[%d].w[2]};\n"
+                 "    dd%d_%d = dw[0] * dw[0] + dw[1] * dw[1] + dw[2] * dw[2];\n  }\n",
+              b0, b1, b0, b1, b0, b1, b0, b1, b0, b1);
+    }
+}
+
+static void emit_dot1_frames(FILE *f, const lmodel *L, int r, int b0, int b1) {
+  const mb_rowdef *R = &L->row[r];
+  int i = R->a, j = R->b;
+  svec colj, rowi, ei, ej, c0, c1, wl0, wl1;
+  char t[EXPR], p[EXPR], s01[EXPR], s10[EXPR], quad[EXPR], dd[EXPR];
+  for (int k = 0; k < 3; k++) {
+    rel_name(colj.e[k], b0, b1, k, j);
+    rel_name(rowi.e[k], b0, b1, i, k);
+  }
+  s_zero(&ei);
+  s_zero(&ej);
+  snprintf(ei.e[i], EXPR, "1");
+  snprintf(ej.e[j], EXPR, "1");
+  s_cross(&c0, &ei, &colj);
+  s_cross(&c1, &ej, &rowi);
+  s_names(&wl0, "f[%d].wl", b0);
+  s_names(&wl1, "f[%d].wl", b1);
+  fprintf(f, "  { /* from the relative rotation of bodies '%s' and '%s' */\n", L->body[b0].name, L->body[b1].name);
+  fprintf(f, "    phi[%d] = %s;\n", r, rowi.e[j]);
+  s_dot(t, &c0, &wl0);
+  s_dot(p, &c1, &wl1);
+  s_add(t, t, p);
+  fprintf(f, "    phid[%d] = %s;\n", r, t);
+  s_dot(s01, &wl0, &colj);
+  s_dot(s10, &wl1, &rowi);
+  fprintf(f, "    const mb_real s01 = %s, s10 = %s;\n", s01, s10);
+  /* quad = s00 s01 + s11 s10 - 2 s01 s10 - phi |W0 - W1|^2 */
+  snprintf(t, sizeof t, "f[%d].wl[%d] * s01 + f[%d].wl[%d] * s10 - 2 * (s01 * s10)", b0, i, b1, j);
+  snprintf(dd, sizeof dd, "dd%d_%d", b0, b1);
+  s_mul(p, rowi.e[j], dd);
+  s_sub(quad, t, p);
+  s_neg(t, quad);
+  fprintf(f, "    rhs[%d] = %s;\n", L->m.nv + r, t);
+  for (int s = 0; s < 2; s++) {
+    if (!emit_row_side_varies(L, r, s)) continue;
+    const svec *c = s ? &c1 : &c0;
+    const char *cs[6] = {"0", "0", "0", c->e[0], c->e[1], c->e[2]};
+    emit_row_stores(f, L, r, s, cs, "    ");
+  }
+  fputs("  }\n", f);
+}
+
 int emit_row_special(FILE *f, const lmodel *L, int r) {
   const mb_rowdef *R = &L->row[r];
   if (R->kind != MB_PRIM_SPH && R->kind != MB_PRIM_DOT1) return 0;
+  int b0, b1;
+  if (dot1_frames(L, r, &b0, &b1)) {
+    emit_dot1_frames(f, L, r, b0, b1);
+    return 1;
+  }
   smark mk[2];
   mark_view(L, R->m0, &mk[0]);
   mark_view(L, R->m1, &mk[1]);

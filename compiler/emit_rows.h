@@ -11,6 +11,12 @@
 int emit_node_static(const mb_body *B, int node);
 /* write marker k if it sits on a rigid body (or a static node); 0: not handled */
 int emit_marker_special(FILE *f, const lmodel *L, int k);
+/* 1 if marker k coincides with its body's frame (rigid body or static node,
+ * s = 0, C = I): the rows of emit_row_special read the frame, not the marker */
+int emit_marker_is_frame(const lmodel *L, int k);
+/* the values shared by the dot-1 rows between two bodies' own axes (entries
+ * of their relative rotation, |w0 - w1|^2), as locals before the rows */
+void emit_rows_shared(FILE *f, const lmodel *L);
 /* write row r if it is a spherical or dot-1 row; 0: not handled */
 int emit_row_special(FILE *f, const lmodel *L, int r);
 

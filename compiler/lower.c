@@ -583,10 +583,34 @@ static int entry_cmp(const void *a, const void *b) {
   return (x->row > y->row) - (x->row < y->row);
 }
 
+/* can marker md's point lie away from its body's frame origin?  A node
+ * marker can, unless every mode shape vanishes at the node and the node sits
+ * at the origin (the reference node of a body frame): then P = r exactly and
+ * a point row has no rotational columns there */
+static int marker_offset(const lmodel *L, const mb_markerdef *md) {
+  if (md->node < 0) return fabs(md->s[0]) + fabs(md->s[1]) + fabs(md->s[2]) > 0;
+  const mb_flex *f = L->body[md->body].flex;
+  const double *x = f->node_x + 3 * (size_t)md->node;
+  for (size_t i = 0; i < 3 * (size_t)f->nm; i++)
+    if (f->node_X[3 * (size_t)md->node * f->nm + i] != 0) return 1;
+  return x[0] != 0 || x[1] != 0 || x[2] != 0;
+}
+
+/* the marker's axes are A C exactly: on a rigid body, or on a node where all
+ * rotational mode shapes vanish */
+static int marker_axes_rigid(const lmodel *L, const mb_markerdef *md) {
+  if (md->body < 0) return 0;
+  if (md->node < 0) return 1;
+  const mb_flex *f = L->body[md->body].flex;
+  for (size_t i = 0; i < 3 * (size_t)f->nm; i++)
+    if (f->node_Psi[3 * (size_t)md->node * f->nm + i] != 0) return 0;
+  return 1;
+}
+
 /* which of a row's 6 columns on side s are structurally nonzero, and which constant */
 static void row_structure(const lmodel *L, const mb_rowdef *R, int s, int nz[6], int cst[6]) {
   const mb_markerdef *md = &L->marker[s ? R->m1 : R->m0];
-  int offset = md->node >= 0 || fabs(md->s[0]) + fabs(md->s[1]) + fabs(md->s[2]) > 0;
+  int offset = marker_offset(L, md);
   for (int j = 0; j < 6; j++) nz[j] = cst[j] = 0;
   switch (R->kind) {
   case MB_PRIM_SPH:
@@ -598,6 +622,20 @@ static void row_structure(const lmodel *L, const mb_rowdef *R, int s, int nz[6],
     if (offset) nz[3] = nz[4] = nz[5] = 1;
     break;
   case MB_PRIM_DOT1:
+    nz[3] = nz[4] = nz[5] = 1;
+    /* the side's rotational columns are A^T (ai x aj) (signed); with its own
+       axis a = A C e_a and C e_a = +-e_k, component k is (C e_a) . (C e_a x
+       A^T aj) = 0 exactly */
+    if (marker_axes_rigid(L, md)) {
+      int a = s ? R->b : R->a, k = -1, unit = 1;
+      for (int l = 0; l < 3; l++) {
+        double c = md->C[3 * l + a];
+        if (c == 1 || c == -1) k = k < 0 ? l : 3;
+        else if (c != 0) unit = 0;
+      }
+      if (unit && k >= 0 && k < 3) nz[3 + k] = 0;
+    }
+    break;
   case MB_PRIM_ROT:
     nz[3] = nz[4] = nz[5] = 1;
     break;
