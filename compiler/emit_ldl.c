@@ -151,9 +151,17 @@ void emit_ldl_fields(FILE *f, const char *nm, int emitted) {
  * all others straight from Kx (slot Krmap[q]); without, K' = K.  (The looped
  * code gathers all of K' into Kc instead: kc_of[q] = q.) */
 static const int *kc_of, *kc_map;
+/* with massless bodies (straight-line code): the K1 gather's sources (a Kx
+ * slot, or -1: 0, -2: 1, -3: -1, -4: computed), to write K1's constants as
+ * literals */
+static const int *k1_map;
+
+static int kconst(int q, double *v);
 
 static void kval(FILE *f, int q) {
-  if (!kc_of) fprintf(f, "Kx[%d]", q);
+  double c;
+  if (kconst(q, &c)) fputs(c == 1 ? "1" : c == -1 ? "-1" : "0", f);
+  else if (!kc_of) fprintf(f, "Kx[%d]", q);
   else if (kc_of[q] >= 0) fprintf(f, "Kc[%d]", kc_of[q]);
   else if (kc_map[q] >= 0) fprintf(f, "Kx[%d]", kc_map[q]);
   else fputs(kc_map[q] == -2 ? "1" : kc_map[q] == -3 ? "-1" : "0", f); /* a constant of K' */
@@ -162,9 +170,43 @@ static void kval(FILE *f, int q) {
 /* 1 if kval(q) writes a constant of K' (the decoupled diagonals of the block
  * pivots' unknowns and rows), its value in *v */
 static int kconst(int q, double *v) {
-  if (!kc_of || kc_of[q] >= 0 || kc_map[q] >= 0) return 0;
-  *v = kc_map[q] == -2 ? 1 : kc_map[q] == -3 ? -1 : 0;
+  int src = q;
+  if (kc_of) {
+    if (kc_of[q] >= 0) return 0;
+    src = kc_map[q];
+    if (src < 0) {
+      *v = src == -2 ? 1 : src == -3 ? -1 : 0;
+      return 1;
+    }
+  }
+  if (!k1_map || k1_map[src] >= 0 || k1_map[src] == -4) return 0;
+  *v = k1_map[src] == -2 ? 1 : k1_map[src] == -3 ? -1 : 0;
   return 1;
+}
+
+/* pivot k of K_aug is a decoupled unknown whose value the block pivots or the
+ * massless bodies recover (ldl_block_back, ldl_ml_back overwrite it): empty
+ * row and column of L, a constant diagonal +-1.  The solve leaves it out. */
+static int ldl_decoupled(const ldl_plan *p, int k) {
+  if (!p->straight || p->Rp[k + 1] != p->Rp[k] || p->Lp[k + 1] != p->Lp[k]) return 0;
+  int diag = -1;
+  for (int e = p->Up[k]; e < p->Up[k + 1]; e++)
+    if (p->Ui[e] == k) diag = e;
+  double c;
+  if (diag < 0 || p->Us[diag] < 0 || p->Tp[diag] != p->Tp[diag + 1] || !kconst(p->Us[diag], &c) ||
+      (c != 1 && c != -1))
+    return 0;
+  int u = p->perm[k];
+  for (int e = 0; e < p->nelim; e++)
+    for (int i = 0; i < 6; i++)
+      if (p->eu[e][i] == u || p->er[e][i] == u) return 1;
+  for (int e = 0; e < p->nml; e++) {
+    for (int i = 0; i < 6; i++)
+      if (p->mlu[e][i] == u) return 1;
+    for (int i = p->mlrp[e]; i < p->mlrp[e + 1]; i++)
+      if (p->mlR[i] == u) return 1;
+  }
+  return 0;
 }
 
 /* the value of K_aug entry e (upper triangle, permuted) as a C expression */
@@ -1383,6 +1425,7 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
   if (p->nelim) fputs("  (void)Kc;\n", f);
   for (int k = 0; k < n; k++) {
     int u = p->perm[k];
+    if (ldl_decoupled(p, k)) continue; /* recovered by ldl_block_back / ldl_ml_back */
     fprintf(f, "  t[%d] = r[%d]", k, u);
     if (u < nv)
       for (int w = 0; w < p->nw; w++)
@@ -1431,7 +1474,8 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
   fputs("static void ldl_lsolve(const mb_real *restrict Lx, const mb_real *restrict Dinv, mb_real *restrict t) {\n", f);
   for (int c = 0; c < nfwd; c++) fprintf(f, "  ldl_forward%d(Lx, t);\n", c);
   fputs("  /* diagonal: z = D^-1 y */\n", f);
-  for (int k = 0; k < n; k++) fprintf(f, "  t[%d] *= Dinv[%d];\n", k, k);
+  for (int k = 0; k < n; k++)
+    if (!ldl_decoupled(p, k)) fprintf(f, "  t[%d] *= Dinv[%d];\n", k, k);
   for (int c = 0; c < nbwd; c++) fprintf(f, "  ldl_backward%d(Lx, t);\n", c);
   if (p->nnzL == 0) fputs("  (void)Lx;\n", f);
   fputs("}\n\n", f);
@@ -1439,7 +1483,8 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
   if (p->nelim || p->nml) {
     fputs("/* x = P^T t */\n", f);
     fputs("static void ldl_scatter(const mb_real *t, mb_real *x) {\n", f);
-    for (int k = 0; k < n; k++) fprintf(f, "  x[%d] = t[%d];\n", p->perm[k], k);
+    for (int k = 0; k < n; k++)
+      if (!ldl_decoupled(p, k)) fprintf(f, "  x[%d] = t[%d];\n", p->perm[k], k);
     fputs("}\n\n", f);
   } else {
     fputs("/* x += P^T t */\n", f);
@@ -1697,13 +1742,14 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
     kc_map = p.Krmap;
     emit_blocks(f, L, &p);
   }
+  k1_map = p.nml && p.straight ? p.K1map : NULL;
   if (p.straight) emit_factor_straight(f, L, &p, nm);
   else emit_factor_looped(f, L, &p, nm);
   emit_factor_entry(f, L, &p, nm);
   if (p.straight) emit_solve_helpers_straight(f, L, &p);
   else emit_solve_helpers_looped(f, &p);
   emit_solve(f, &p, nm);
-  kc_of = kc_map = NULL;
+  kc_of = kc_map = k1_map = NULL;
   free(kc);
   fputs("static int ldl_factor_m(const mb_model *m, const mb_real *Kx, mb_real *work) {\n", f);
   fprintf(f, "  (void)m;\n  return %s_ldl_factor(Kx, work);\n}\n", nm);
