@@ -4,7 +4,7 @@
 # flexible slider-crank without, with 1 and with 2 virtual bodies, as tables
 # in the form of seed Tables 3 and 6, with the commands and the machine.
 # Called by `make bench` after `make all` (POSIX sh and awk).
-# Environment: MBCC (default build/mbcc), REPS (default 5), CHAIN_REPS (the chain's,
+# Environment: MBCC (default build/mbcc), REPS (default 5), CHAIN_REPS (the chain and the rigid slider-crank,
 # default 5 REPS), ROUNDS and IL_REPS (the interleaved virtual-body ratios: 11 rounds
 # of 3 repetitions), BENCH_NOTE (a line
 # about the machine for the document, e.g. that it was shared).  Work files
@@ -37,7 +37,7 @@ bench() {
   name=$1
   shift
   reps=$REPS
-  [ "$name" != chain ] || reps=$CHAIN_REPS
+  case $name in chain | rigid) reps=$CHAIN_REPS ;; esac
   say "$(show "$MBCC bench $* --reps $reps")"
   if ! (cd "$W" && "$MBCC" bench "$@" --reps "$reps" --csv "$name.csv" --quiet) >"$W/$name.txt" 2>"$W/$name.log"; then
     cat "$W/$name.txt" "$W/$name.log" >&2
@@ -223,7 +223,7 @@ tmp=$OUT.part
   echo "coordinate projection), so they take the same steps up to round-off (paths whose error"
   echo "estimates differ in the last digits can accept or reject a step differently, a few steps"
   echo "in 24000 on the flexible slider-crank; hence the per-step ratios). Per-step time is the median over"
-  echo "$REPS repetitions ($CHAIN_REPS on the chain, whose run is a few milliseconds) of (whole-run time / steps); the run time is the median whole-run time"
+  echo "$REPS repetitions ($CHAIN_REPS on the chain and the rigid slider-crank, whose runs are a few milliseconds) of (whole-run time / steps); the run time is the median whole-run time"
   echo "(solver set-up included). \`ratio (run)\` divides by the fastest run of the table,"
   echo "\`ratio (per step)\` by the fastest per-step time of the Dormand–Prince paths (IDA's BDF"
   echo "steps are other steps: compare IDA by its run time). \`max rel diff\` is the largest"
