@@ -284,13 +284,11 @@ typedef struct {
 /* marker k is its body's frame: on a rigid body (or a static node) at the
  * frame's origin with the frame's axes, so P = r, V = rd, W = w, R = A and
  * aP = aW = 0 exactly; rows read the frame itself */
+static int frame_axes(const lmodel *L, int k);
+
 int emit_marker_is_frame(const lmodel *L, int k) {
   const double *s;
-  if (!marker_rigid(L, k, &s)) return 0;
-  static const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-  const mb_markerdef *d = &L->marker[k];
-  for (int i = 0; i < 9; i++)
-    if (d->C[i] != I[i]) return 0;
+  if (frame_axes(L, k) < 0 || !marker_rigid(L, k, &s)) return 0;
   return s[0] == 0 && s[1] == 0 && s[2] == 0;
 }
 
