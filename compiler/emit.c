@@ -440,7 +440,7 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
     if (L->force[i].m1 >= 0) passed[L->force[i].m1] = 1;
   }
   for (int r = 0; r < m->nrow; r++)
-    if (L->row[r].kind != MB_PRIM_SPH && L->row[r].kind != MB_PRIM_DOT1) passed[L->row[r].m0] = passed[L->row[r].m1] = 1;
+    if (!emit_row_is_special(&L->row[r])) passed[L->row[r].m0] = passed[L->row[r].m1] = 1;
   for (int k = 0; k < m->nmarker; k++) {
     const mb_markerdef *d = &L->marker[k];
     fprintf(f, "  /* %s */\n", L->marker_desc[k]);

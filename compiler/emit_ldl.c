@@ -187,15 +187,20 @@ static int kconst(int q, double *v) {
 /* pivot k of K_aug is a decoupled unknown whose value the block pivots or the
  * massless bodies recover (ldl_block_back, ldl_ml_back overwrite it): empty
  * row and column of L, a constant diagonal +-1.  The solve leaves it out. */
-static int ldl_decoupled(const ldl_plan *p, int k) {
-  if (!p->straight || p->Rp[k + 1] != p->Rp[k] || p->Lp[k + 1] != p->Lp[k]) return 0;
+/* pivot k's value when it is a compile-time constant +-1: an empty row of L
+ * and a constant diagonal of K_aug (no weighted terms); else 0 */
+static int ldl_const_pivot(const ldl_plan *p, int k) {
+  if (p->Rp[k + 1] != p->Rp[k]) return 0;
   int diag = -1;
   for (int e = p->Up[k]; e < p->Up[k + 1]; e++)
     if (p->Ui[e] == k) diag = e;
   double c;
-  if (diag < 0 || p->Us[diag] < 0 || p->Tp[diag] != p->Tp[diag + 1] || !kconst(p->Us[diag], &c) ||
-      (c != 1 && c != -1))
-    return 0;
+  if (diag < 0 || p->Us[diag] < 0 || p->Tp[diag] != p->Tp[diag + 1] || !kconst(p->Us[diag], &c)) return 0;
+  return c == 1 ? 1 : c == -1 ? -1 : 0;
+}
+
+static int ldl_decoupled(const ldl_plan *p, int k) {
+  if (!p->straight || p->Lp[k + 1] != p->Lp[k] || !ldl_const_pivot(p, k)) return 0;
   int u = p->perm[k];
   for (int e = 0; e < p->nelim; e++)
     for (int i = 0; i < 6; i++)
@@ -319,9 +324,8 @@ static void emit_factor_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
       if (p->Ui[e] == k) diag = e;
       else kent[p->Ui[e]] = e;
     }
-    double dc;
-    if (p->Rp[k + 1] == p->Rp[k] && diag >= 0 && p->Us[diag] >= 0 && p->Tp[diag] == p->Tp[diag + 1] &&
-        kconst(p->Us[diag], &dc) && (dc == 1 || dc == -1)) {
+    int dc = ldl_const_pivot(p, k);
+    if (dc) {
       /* a decoupled unknown: no entries in its row of L, a constant pivot */
       fprintf(f, "  Dinv[%d] = %s;\n", k, dc > 0 ? "1" : "-1");
       chunk_flops += 1;

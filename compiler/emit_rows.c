@@ -138,11 +138,7 @@ static void s_local(FILE *f, svec *v, const char *name, const char *indent) {
  * marker at the node's position, the same numbers without the modal sums,
  * the rotation exponential and the zero modal columns (known at compile time) */
 int emit_node_static(const mb_body *B, int node) {
-  const mb_flex *fx = B->flex;
-  if (!fx || node < 0) return 0;
-  for (int i = 0; i < 3 * fx->nm; i++)
-    if (fx->node_X[3 * node * fx->nm + i] != 0 || fx->node_Psi[3 * node * fx->nm + i] != 0) return 0;
-  return 1;
+  return B->flex && node >= 0 && !lower_node_translates(B, node) && !lower_node_rotates(B, node);
 }
 
 /* a marker on a rigid body (or on a node whose mode shapes vanish there) */
@@ -533,9 +529,11 @@ static void emit_dot1_frames(FILE *f, const lmodel *L, int r, int b0, int b1) {
   fputs("  }\n", f);
 }
 
+int emit_row_is_special(const mb_rowdef *R) { return R->kind == MB_PRIM_SPH || R->kind == MB_PRIM_DOT1; }
+
 int emit_row_special(FILE *f, const lmodel *L, int r) {
   const mb_rowdef *R = &L->row[r];
-  if (R->kind != MB_PRIM_SPH && R->kind != MB_PRIM_DOT1) return 0;
+  if (!emit_row_is_special(R)) return 0;
   int b0, b1;
   if (dot1_frames(L, r, &b0, &b1)) {
     emit_dot1_frames(f, L, r, b0, b1);

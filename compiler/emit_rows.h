@@ -17,6 +17,9 @@ int emit_marker_is_frame(const lmodel *L, int k);
 /* the values shared by the dot-1 rows between two bodies' own axes (entries
  * of their relative rotation, |w0 - w1|^2), as locals before the rows */
 void emit_rows_shared(FILE *f, const lmodel *L);
+/* 1 if emit_row_special writes row R (spherical and dot-1 rows): it reads
+ * its markers' fields (or their frames), never a marker's address */
+int emit_row_is_special(const mb_rowdef *R);
 /* write row r if it is a spherical or dot-1 row; 0: not handled */
 int emit_row_special(FILE *f, const lmodel *L, int r);
 

@@ -583,28 +583,34 @@ static int entry_cmp(const void *a, const void *b) {
   return (x->row > y->row) - (x->row < y->row);
 }
 
+/* does node 'node' of flexible body B move with its modes: translate (X) or
+ * rotate (Psi)?  Shared with the emitter (emit_node_static) */
+static int node_shapes_nonzero(const mb_body *B, int node, int rotational) {
+  const mb_flex *f = B->flex;
+  const double *T = (rotational ? f->node_Psi : f->node_X) + 3 * (size_t)node * f->nm;
+  for (size_t i = 0; i < 3 * (size_t)f->nm; i++)
+    if (T[i] != 0) return 1;
+  return 0;
+}
+int lower_node_translates(const mb_body *B, int node) { return node_shapes_nonzero(B, node, 0); }
+int lower_node_rotates(const mb_body *B, int node) { return node_shapes_nonzero(B, node, 1); }
+
 /* can marker md's point lie away from its body's frame origin?  A node
- * marker can, unless every mode shape vanishes at the node and the node sits
- * at the origin (the reference node of a body frame): then P = r exactly and
- * a point row has no rotational columns there */
+ * marker can, unless every translational mode shape vanishes at the node and
+ * the node sits at the origin (the reference node of a body frame): then
+ * P = r exactly and a point row has no rotational columns there */
 static int marker_offset(const lmodel *L, const mb_markerdef *md) {
   if (md->node < 0) return fabs(md->s[0]) + fabs(md->s[1]) + fabs(md->s[2]) > 0;
-  const mb_flex *f = L->body[md->body].flex;
-  const double *x = f->node_x + 3 * (size_t)md->node;
-  for (size_t i = 0; i < 3 * (size_t)f->nm; i++)
-    if (f->node_X[3 * (size_t)md->node * f->nm + i] != 0) return 1;
-  return x[0] != 0 || x[1] != 0 || x[2] != 0;
+  const mb_body *B = &L->body[md->body];
+  const double *x = B->flex->node_x + 3 * (size_t)md->node;
+  return lower_node_translates(B, md->node) || x[0] != 0 || x[1] != 0 || x[2] != 0;
 }
 
 /* the marker's axes are A C exactly: on a rigid body, or on a node where all
  * rotational mode shapes vanish */
 static int marker_axes_rigid(const lmodel *L, const mb_markerdef *md) {
   if (md->body < 0) return 0;
-  if (md->node < 0) return 1;
-  const mb_flex *f = L->body[md->body].flex;
-  for (size_t i = 0; i < 3 * (size_t)f->nm; i++)
-    if (f->node_Psi[3 * (size_t)md->node * f->nm + i] != 0) return 0;
-  return 1;
+  return md->node < 0 || !lower_node_rotates(&L->body[md->body], md->node);
 }
 
 /* which of a row's 6 columns on side s are structurally nonzero, and which constant */

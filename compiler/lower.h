@@ -54,6 +54,10 @@ int lower_pattern(lmodel *L);
 /* Remove constraint rows whose keep[r] is 0, then rebuild the pattern. */
 int lower_remove_rows(lmodel *L, const int *keep);
 void lower_free(lmodel *L);
+/* 1 if some translational (X) / rotational (Psi) mode shape of flexible body B
+ * is nonzero at node 'node' */
+int lower_node_translates(const mb_body *B, int node);
+int lower_node_rotates(const mb_body *B, int node);
 
 /* Assembly analysis at t = 0 (assemble.c): Newton onto the position
  * constraints, redundant rows removed (warnings), consistent velocities,
