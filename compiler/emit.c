@@ -253,7 +253,7 @@ static int emit_cols(FILE *f, const lmodel *L, int k, const char *P, const char 
     emit_node_cols(f, L, k, dV, dW, indent);
     return 6 + B->nm;
   }
-  fprintf(f, "%smb_rigid_cols(&f[%d], %s, %s, %s, c);\n", indent, d->body, P, dV, dW);
+  fprintf(f, "%smb_rigid_cols(&f%d, %s, %s, %s, c);\n", indent, d->body, P, dV, dW);
   return 6;
 }
 
@@ -421,14 +421,18 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
           "void %s_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,\n"
           "    mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *phid, void *work) {\n"
           "  static const mb_real zero3[3] = {0, 0, 0};\n"
-          "  mb_frame f[%d];\n  mb_marker k[%d];\n  mb_row r;\n  mb_real c[6 + MB_MAX_MODES], x[3];\n"
+          "  mb_row r;\n  mb_real c[6 + MB_MAX_MODES], x[3];\n"
           "  (void)m; (void)work; (void)t; (void)x; (void)c; (void)r; (void)zero3;\n"
-          "  (void)Kx; (void)phi; (void)phid; (void)f; (void)k;\n",
-          nm, m->nbody ? m->nbody : 1, m->nmarker ? m->nmarker : 1);
+          "  (void)Kx; (void)phi; (void)phid;\n",
+          nm);
+  /* frames and markers are separate variables, not arrays: the C compiler
+     then drops the fields no row reads and keeps the rest compact, where an
+     array of markers had to live whole in the stack frame (about a kilobyte
+     more of L1 per evaluation on the flexible slider-crank) */
   fprintf(f, "\n  /* body frames */\n");
   for (int b = 0; b < m->nbody; b++)
-    fprintf(f, "  mb_frame_rigid(q + %d, v + %d, &f[%d]); /* body '%s' */\n", L->body[b].qadr,
-            L->body[b].vadr, b, L->body[b].name);
+    fprintf(f, "  mb_frame f%d;\n  mb_frame_rigid(q + %d, v + %d, &f%d); /* body '%s' */\n", b,
+            L->body[b].qadr, L->body[b].vadr, b, L->body[b].name);
   fprintf(f, "\n  /* markers */\n");
   /* a marker that is its body's frame is not stored when only the spherical
      and dot-1 rows of emit_row_special read it (they read the frame); forces
@@ -445,9 +449,12 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
     const mb_markerdef *d = &L->marker[k];
     fprintf(f, "  /* %s */\n", L->marker_desc[k]);
     if (!passed[k] && d->body >= 0 && emit_marker_is_frame(L, k)) {
-      fprintf(f, "  /* the frame of body '%s' itself: the rows read f[%d] */\n", L->body[d->body].name, d->body);
-    } else if (d->body < 0) {
-      fprintf(f, "  mb_marker_ground(markers[%d].s, markers[%d].C, &k[%d]);\n", k, k, k);
+      fprintf(f, "  /* the frame of body '%s' itself: the rows read f%d */\n", L->body[d->body].name, d->body);
+      continue;
+    }
+    fprintf(f, "  mb_marker k%d;\n", k);
+    if (d->body < 0) {
+      fprintf(f, "  mb_marker_ground(markers[%d].s, markers[%d].C, &k%d);\n", k, k, k);
     } else if (d->node >= 0 && emit_node_static(&L->body[d->body], d->node)) {
       fprintf(f, "  /* node %d: its mode shapes vanish: a rigid marker (mb_marker_rigid) */\n", d->node);
       emit_marker_special(f, L, k);
@@ -466,12 +473,12 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
     if (B->kind == MB_BODY_FLEXIBLE) {
       int nbk = 6 + B->nm;
       fprintf(f, "  {\n    mb_real AS[9], AS1[%d];\n    mb_flex_step cs;\n    flex%d_contract(q + %d, v + %d, &cs);\n"
-                 "    mb_flex_forces(&flex%d, &cs, &f[%d], q + %d, v + %d, (const mb_real[3])",
+                 "    mb_flex_forces(&flex%d, &cs, &f%d, q + %d, v + %d, (const mb_real[3])",
               3 * B->nm, b, B->qadr + 7, B->vadr + 6, b, b, B->qadr + 7, B->vadr + 6);
       vec(f, m->gravity, 3);
       fprintf(f, ", rhs + %d);\n", B->vadr);
       fprintf(f, "    /* the mass blocks that move (mb_flex_assemble without m I and Mff, set by init) */\n"
-                 "    mb_flex_mass_moving(&flex%d, &cs, &f[%d], AS, AS1);\n", b, b);
+                 "    mb_flex_mass_moving(&flex%d, &cs, &f%d, AS, AS1);\n", b, b);
       for (int i = 0; i < nbk * nbk; i++)
         if (B->mslotf[i] >= 0 && flex_mass_entry(B->flex, i / nbk, i % nbk) == 2) {
           char e[48];
@@ -493,7 +500,7 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
     } else {
       fprintf(f, "  mb_rigid_gyro((const mb_real[9])");
       vec(f, B->J, 9);
-      fprintf(f, ", f[%d].wl, rhs + %d);\n", b, B->vadr + 3);
+      fprintf(f, ", f%d.wl, rhs + %d);\n", b, B->vadr + 3);
     }
   }
   if (m->nforce) fprintf(f, "\n  /* force elements */\n");
@@ -515,10 +522,10 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
         num(f, d->vec[j]);
         fputs(";\n", f);
       }
-      if (d->body_frame) fprintf(f, "    mb_mul3(f[%d].A, val, val);\n", b0);
+      if (d->body_frame) fprintf(f, "    mb_mul3(f%d.A, val, val);\n", b0);
       {
         char P[32];
-        snprintf(P, sizeof P, "k[%d].P", d->m0);
+        snprintf(P, sizeof P, "k%d.P", d->m0);
         int n = emit_cols(f, L, d->m0, P, d->kind == MB_FORCE_POINT ? "val" : "zero3",
                           d->kind == MB_FORCE_POINT ? "zero3" : "val", "    ");
         add_cols(f, L->body[b0].vadr, n);
@@ -527,7 +534,7 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
     }
     case MB_FORCE_SPRING:
       fprintf(f, "    mb_real F0[3], F1[3];\n"
-                 "    mb_force_spring(&k[%d], &k[%d], &forces[%d].stiffness, &forces[%d].damping, ",
+                 "    mb_force_spring(&k%d, &k%d, &forces[%d].stiffness, &forces[%d].damping, ",
               d->m0, d->m1, k, k);
       num(f, d->L0);
       fputs(", ", f);
@@ -535,28 +542,28 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
       fputs(", F0, F1);\n", f);
       if (b0 >= 0) {
         char P[32];
-        snprintf(P, sizeof P, "k[%d].P", d->m0);
+        snprintf(P, sizeof P, "k%d.P", d->m0);
         add_cols(f, L->body[b0].vadr, emit_cols(f, L, d->m0, P, "F0", "zero3", "    "));
       }
       if (b1 >= 0) {
         char P[32];
-        snprintf(P, sizeof P, "k[%d].P", d->m1);
+        snprintf(P, sizeof P, "k%d.P", d->m1);
         add_cols(f, L->body[b1].vadr, emit_cols(f, L, d->m1, P, "F1", "zero3", "    "));
       }
       break;
     case MB_FORCE_FIELD:
       fprintf(f, "    mb_real F[3], T[3];\n"
-                 "    mb_force_field(&k[%d], &k[%d], forces[%d].d0, forces[%d].K, forces[%d].C, forces[%d].pre, F, T);\n",
+                 "    mb_force_field(&k%d, &k%d, forces[%d].d0, forces[%d].K, forces[%d].C, forces[%d].pre, F, T);\n",
               d->m0, d->m1, k, k, k, k);
       if (b0 >= 0)
         fputs("    mb_real mF[3] = {-F[0], -F[1], -F[2]}, mT[3] = {-T[0], -T[1], -T[2]};\n", f);
       if (b1 >= 0) {
         char P[32];
-        snprintf(P, sizeof P, "k[%d].P", d->m1);
+        snprintf(P, sizeof P, "k%d.P", d->m1);
         add_cols(f, L->body[b1].vadr, emit_cols(f, L, d->m1, P, "F", "T", "    "));
       }
       if (b0 >= 0) {
-        fprintf(f, "    mb_rigid_cols(&f[%d], k[%d].P, mF, mT, c); /* reaction at the same point */\n", b0, d->m1);
+        fprintf(f, "    mb_rigid_cols(&f%d, k%d.P, mF, mT, c); /* reaction at the same point */\n", b0, d->m1);
         add_cols(f, L->body[b0].vadr, 6);
       }
       break;
@@ -573,31 +580,31 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
     fputs(") */\n", f);
     if (emit_row_special(f, L, r)) continue;
     switch (R->kind) {
-    case MB_PRIM_SPH: fprintf(f, "  mb_prim_sph(&k[%d], &k[%d], %d, &r);\n", R->m0, R->m1, R->a); break;
-    case MB_PRIM_DOT1: fprintf(f, "  mb_prim_dot1(&k[%d], &k[%d], %d, %d, &r);\n", R->m0, R->m1, R->a, R->b); break;
-    case MB_PRIM_DOT2: fprintf(f, "  mb_prim_dot2(&k[%d], &k[%d], %d, zero3, &r);\n", R->m0, R->m1, R->a); break;
+    case MB_PRIM_SPH: fprintf(f, "  mb_prim_sph(&k%d, &k%d, %d, &r);\n", R->m0, R->m1, R->a); break;
+    case MB_PRIM_DOT1: fprintf(f, "  mb_prim_dot1(&k%d, &k%d, %d, %d, &r);\n", R->m0, R->m1, R->a, R->b); break;
+    case MB_PRIM_DOT2: fprintf(f, "  mb_prim_dot2(&k%d, &k%d, %d, zero3, &r);\n", R->m0, R->m1, R->a); break;
     case MB_PRIM_DIST:
-      fprintf(f, "  mb_prim_dist(&k[%d], &k[%d], ", R->m0, R->m1);
+      fprintf(f, "  mb_prim_dist(&k%d, &k%d, ", R->m0, R->m1);
       num(f, R->L);
       fputs(", &r);\n", f);
       break;
     case MB_PRIM_ROT:
-      fprintf(f, "  mb_profile_eval(&profiles[%d], t, x);\n  mb_prim_rot(&k[%d], &k[%d], x, &r);\n", R->profile, R->m0, R->m1);
+      fprintf(f, "  mb_profile_eval(&profiles[%d], t, x);\n  mb_prim_rot(&k%d, &k%d, x, &r);\n", R->profile, R->m0, R->m1);
       break;
     case MB_PRIM_TRANS:
-      fprintf(f, "  mb_profile_eval(&profiles[%d], t, x);\n  mb_prim_dot2(&k[%d], &k[%d], 2, x, &r);\n", R->profile, R->m0, R->m1);
+      fprintf(f, "  mb_profile_eval(&profiles[%d], t, x);\n  mb_prim_dot2(&k%d, &k%d, 2, x, &r);\n", R->profile, R->m0, R->m1);
       break;
     default: fprintf(f, "  /* unknown primitive %s */\n", prim[0]); break;
     }
-    fprintf(f, "  phi[%d] = r.phi;\n  phid[%d] = mb_row_phidot(&r, &k[%d], &k[%d]);\n"
-               "  rhs[%d] = mb_row_gamma(&r, &k[%d], &k[%d]);\n", r, r, R->m0, R->m1,
+    fprintf(f, "  phi[%d] = r.phi;\n  phid[%d] = mb_row_phidot(&r, &k%d, &k%d);\n"
+               "  rhs[%d] = mb_row_gamma(&r, &k%d, &k%d);\n", r, r, R->m0, R->m1,
             m->nv + r, R->m0, R->m1);
     for (int s = 0; s < 2; s++) {
       int mk = s ? R->m1 : R->m0;
       if (!emit_row_side_varies(L, r, s)) continue;
       static const char *const cs[6] = {"c[0]", "c[1]", "c[2]", "c[3]", "c[4]", "c[5]"};
       char P[32], dV[32], dW[32];
-      snprintf(P, sizeof P, "k[%d].P", mk);
+      snprintf(P, sizeof P, "k%d.P", mk);
       snprintf(dV, sizeof dV, "r.dV[%d]", s);
       snprintf(dW, sizeof dW, "r.dW[%d]", s);
       emit_cols(f, L, mk, P, dV, dW, "  ");

@@ -159,7 +159,7 @@ int emit_marker_special(FILE *f, const lmodel *L, int k) {
   /* mb_marker_rigid: u = A s, R = A C, P = r + u, V = rd + w x u, W = w,
      aP = w x (w x u), aW = 0 */
   char A[9][EXPR], p[EXPR], c[EXPR];
-  for (int i = 0; i < 9; i++) snprintf(A[i], EXPR, "f[%d].A[%d]", b, i);
+  for (int i = 0; i < 9; i++) snprintf(A[i], EXPR, "f%d.A[%d]", b, i);
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++) {
       char e[EXPR];
@@ -171,7 +171,7 @@ int emit_marker_special(FILE *f, const lmodel *L, int k) {
       lit(c, d->C[6 + j]);
       s_mul(p, A[3 * i + 2], c);
       s_add(e, e, p);
-      fprintf(f, "  k[%d].R[%d] = %s;\n", k, 3 * i + j, e);
+      fprintf(f, "  k%d.R[%d] = %s;\n", k, 3 * i + j, e);
     }
   svec u;
   for (int i = 0; i < 3; i++) {
@@ -187,17 +187,17 @@ int emit_marker_special(FILE *f, const lmodel *L, int k) {
   int moving = !(is_zero(u.e[0]) && is_zero(u.e[1]) && is_zero(u.e[2]));
   if (moving) {
     fprintf(f, "  {\n    mb_real u[3] = {%s, %s, %s}, wu[3];\n", u.e[0], u.e[1], u.e[2]);
-    fprintf(f, "    mb_cross3(f[%d].w, u, wu);\n    mb_cross3(f[%d].w, wu, k[%d].aP);\n", b, b, k);
+    fprintf(f, "    mb_cross3(f%d.w, u, wu);\n    mb_cross3(f%d.w, wu, k%d.aP);\n", b, b, k);
     for (int i = 0; i < 3; i++)
-      fprintf(f, "    k[%d].P[%d] = f[%d].r[%d] + u[%d];\n    k[%d].V[%d] = f[%d].rd[%d] + wu[%d];\n", k, i, b,
+      fprintf(f, "    k%d.P[%d] = f%d.r[%d] + u[%d];\n    k%d.V[%d] = f%d.rd[%d] + wu[%d];\n", k, i, b,
               i, i, k, i, b, i, i);
     fputs("  }\n", f);
   } else {
     for (int i = 0; i < 3; i++)
-      fprintf(f, "  k[%d].P[%d] = f[%d].r[%d];\n  k[%d].V[%d] = f[%d].rd[%d];\n  k[%d].aP[%d] = 0;\n", k, i, b,
+      fprintf(f, "  k%d.P[%d] = f%d.r[%d];\n  k%d.V[%d] = f%d.rd[%d];\n  k%d.aP[%d] = 0;\n", k, i, b,
               i, k, i, b, i, k, i);
   }
-  for (int i = 0; i < 3; i++) fprintf(f, "  k[%d].W[%d] = f[%d].w[%d];\n  k[%d].aW[%d] = 0;\n", k, i, b, i, k, i);
+  for (int i = 0; i < 3; i++) fprintf(f, "  k%d.W[%d] = f%d.w[%d];\n  k%d.aW[%d] = 0;\n", k, i, b, i, k, i);
   return 1;
 }
 
@@ -232,13 +232,13 @@ void emit_marker_node(FILE *f, const lmodel *L, int k) {
       fprintf(f, "    %s[%d] = %s;\n", nmv[s], i, e);
     }
   }
-  fprintf(f, "    mb_marker_node_sums(&f[%d], b, th, thd, Xwd, (const mb_real[9]){", d->body);
+  fprintf(f, "    mb_marker_node_sums(&f%d, b, th, thd, Xwd, (const mb_real[9]){", d->body);
   for (int i = 0; i < 9; i++) {
     char c[EXPR];
     lit(c, d->C[i]);
     fprintf(f, "%s%s", i ? ", " : "", c);
   }
-  fprintf(f, "}, &k[%d]);\n  }\n", k);
+  fprintf(f, "}, &k%d);\n  }\n", k);
 }
 
 void emit_node_cols(FILE *f, const lmodel *L, int k, const char *dV, const char *dW, const char *indent) {
@@ -248,7 +248,7 @@ void emit_node_cols(FILE *f, const lmodel *L, int k, const char *dV, const char 
   const double *X = fx->node_X + 3 * d->node * nm, *Psi = fx->node_Psi + 3 * d->node * nm;
   fprintf(f, "%s{ /* mb_node_cols_mk, node %d's shapes as constants */\n", indent, d->node);
   fprintf(f, "%s  mb_real lV[3], JtW[3];\n", indent);
-  fprintf(f, "%s  mb_node_cols_local(&f[%d], &k[%d], %s, %s, c, lV, JtW);\n", indent, d->body, k, dV, dW);
+  fprintf(f, "%s  mb_node_cols_local(&f%d, &k%d, %s, %s, c, lV, JtW);\n", indent, d->body, k, dV, dW);
   svec lv, jw;
   for (int i = 0; i < 3; i++) {
     snprintf(lv.e[i], EXPR, "lV[%d]", i);
@@ -300,21 +300,21 @@ static void mark_view(const lmodel *L, int k, smark *m) {
   }
   if (emit_marker_is_frame(L, k)) {
     int b = d->body;
-    s_names(&m->P, "f[%d].r", b);
-    s_names(&m->V, "f[%d].rd", b);
-    s_names(&m->W, "f[%d].w", b);
+    s_names(&m->P, "f%d.r", b);
+    s_names(&m->V, "f%d.rd", b);
+    s_names(&m->W, "f%d.w", b);
     s_zero(&m->aP);
     s_zero(&m->aW);
-    for (int i = 0; i < 9; i++) snprintf(m->R[i], EXPR, "f[%d].A[%d]", b, i);
+    for (int i = 0; i < 9; i++) snprintf(m->R[i], EXPR, "f%d.A[%d]", b, i);
     m->rigid = m->at_origin = 1;
     return;
   }
-  s_names(&m->P, "k[%d].P", k);
-  s_names(&m->V, "k[%d].V", k);
-  s_names(&m->W, "k[%d].W", k);
-  s_names(&m->aP, "k[%d].aP", k);
-  s_names(&m->aW, "k[%d].aW", k);
-  for (int i = 0; i < 9; i++) snprintf(m->R[i], EXPR, "k[%d].R[%d]", k, i);
+  s_names(&m->P, "k%d.P", k);
+  s_names(&m->V, "k%d.V", k);
+  s_names(&m->W, "k%d.W", k);
+  s_names(&m->aP, "k%d.aP", k);
+  s_names(&m->aW, "k%d.aW", k);
+  for (int i = 0; i < 9; i++) snprintf(m->R[i], EXPR, "k%d.R[%d]", k, i);
   if (marker_rigid(L, k, &s)) {
     m->rigid = 1;
     s_zero(&m->aW);
@@ -387,11 +387,11 @@ static void emit_row_common(FILE *f, const lmodel *L, int r, const smark mk[2], 
       /* mb_rigid_cols: [dV; A^T ((P - r) x dV + dW)] */
       svec u, x;
       char A[9][EXPR];
-      for (int i = 0; i < 9; i++) snprintf(A[i], EXPR, "f[%d].A[%d]", b, i);
+      for (int i = 0; i < 9; i++) snprintf(A[i], EXPR, "f%d.A[%d]", b, i);
       if (mk[s].at_origin) s_zero(&u);
       else
         for (int i = 0; i < 3; i++) {
-          snprintf(p, sizeof p, "f[%d].r[%d]", b, i);
+          snprintf(p, sizeof p, "f%d.r[%d]", b, i);
           s_sub(u.e[i], mk[s].P.e[i], p);
         }
       s_cross(&x, &u, &dV[s]);
@@ -478,10 +478,10 @@ void emit_rows_shared(FILE *f, const lmodel *L) {
           if (!need[3 * k + l]) continue;
           char nmv[EXPR];
           rel_name(nmv, b0, b1, k, l);
-          fprintf(f, "  const mb_real %s = f[%d].A[%d] * f[%d].A[%d] + f[%d].A[%d] * f[%d].A[%d] + f[%d].A[%d] * f[%d].A[%d];\n",
+          fprintf(f, "  const mb_real %s = f%d.A[%d] * f%d.A[%d] + f%d.A[%d] * f%d.A[%d] + f%d.A[%d] * f%d.A[%d];\n",
                   nmv, b0, k, b1, l, b0, 3 + k, b1, 3 + l, b0, 6 + k, b1, 6 + l);
         }
-      fprintf(f, "  mb_real dd%d_%d;\n  {\n    mb_real dw[3] = {f[%d].w[0] - f[%d].w[0], f[%d].w[1] - f[%d].w[1], f[%d].w[2] - f[%d].w[2]};\n"
+      fprintf(f, "  mb_real dd%d_%d;\n  {\n    mb_real dw[3] = {f%d.w[0] - f%d.w[0], f%d.w[1] - f%d.w[1], f%d.w[2] - f%d.w[2]};\n"
                  "    dd%d_%d = dw[0] * dw[0] + dw[1] * dw[1] + dw[2] * dw[2];\n  }\n",
               b0, b1, b0, b1, b0, b1, b0, b1, b0, b1);
     }
@@ -502,8 +502,8 @@ static void emit_dot1_frames(FILE *f, const lmodel *L, int r, int b0, int b1) {
   snprintf(ej.e[j], EXPR, "1");
   s_cross(&c0, &ei, &colj);
   s_cross(&c1, &ej, &rowi);
-  s_names(&wl0, "f[%d].wl", b0);
-  s_names(&wl1, "f[%d].wl", b1);
+  s_names(&wl0, "f%d.wl", b0);
+  s_names(&wl1, "f%d.wl", b1);
   fprintf(f, "  { /* from the relative rotation of bodies '%s' and '%s' */\n", L->body[b0].name, L->body[b1].name);
   fprintf(f, "    phi[%d] = %s;\n", r, rowi.e[j]);
   s_dot(t, &c0, &wl0);
@@ -514,7 +514,7 @@ static void emit_dot1_frames(FILE *f, const lmodel *L, int r, int b0, int b1) {
   s_dot(s10, &wl1, &rowi);
   fprintf(f, "    const mb_real s01 = %s, s10 = %s;\n", s01, s10);
   /* quad = s00 s01 + s11 s10 - 2 s01 s10 - phi |W0 - W1|^2 */
-  snprintf(t, sizeof t, "f[%d].wl[%d] * s01 + f[%d].wl[%d] * s10 - 2 * (s01 * s10)", b0, i, b1, j);
+  snprintf(t, sizeof t, "f%d.wl[%d] * s01 + f%d.wl[%d] * s10 - 2 * (s01 * s10)", b0, i, b1, j);
   snprintf(dd, sizeof dd, "dd%d_%d", b0, b1);
   s_mul(p, rowi.e[j], dd);
   s_sub(quad, t, p);

@@ -35,6 +35,10 @@ typedef struct mb_solver {
      last factorization with fresh pivots: with the pivot order of an earlier
      configuration a small u_ii says little; 0 when not estimated */
   double rcond;
+  /* set by a solver whose solve() itself returns MB_ERR_NONFINITE when the
+     solution holds a NaN or an Inf (ldl: the emitted solve tests it in its
+     last pass), so that its callers need not test again */
+  int checks_finite;
 } mb_solver;
 
 /* SuiteSparse KLU: analyze once, refactor per step, factor again (new pivots)

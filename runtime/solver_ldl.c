@@ -72,6 +72,7 @@ mb_solver *mb_solver_ldl(const mb_model *m) {
   l->base.destroy = ldl_destroy_fn;
   l->base.bad_pivot = -1;
   l->base.check_every = m->ldl_exact ? MB_LDL_CHECK_EVERY : 1;
+  l->base.checks_finite = 1; /* every emitted *_ldl_solve tests its result */
   l->m = m;
   l->Kx = calloc((size_t)m->nnz + 1, sizeof(mb_real));
   l->work = calloc(m->ldl_worksize + 1, sizeof(mb_real));
