@@ -155,6 +155,10 @@ static const int *kc_of, *kc_map;
  * slot, or -1: 0, -2: 1, -3: -1, -4: computed), to write K1's constants as
  * literals */
 static const int *k1_map;
+/* straight-line code: the entries of Kx that init sets once and eval never
+ * writes (+1 or -1: a rigid body's translational columns in a point row), 0
+ * for the others; they become literals too */
+static const signed char *kx_cst;
 
 static int kconst(int q, double *v);
 
@@ -179,8 +183,16 @@ static int kconst(int q, double *v) {
       return 1;
     }
   }
-  if (!k1_map || k1_map[src] >= 0 || k1_map[src] == -4) return 0;
-  *v = k1_map[src] == -2 ? 1 : k1_map[src] == -3 ? -1 : 0;
+  if (k1_map) {
+    if (k1_map[src] == -4) return 0;
+    if (k1_map[src] < 0) {
+      *v = k1_map[src] == -2 ? 1 : k1_map[src] == -3 ? -1 : 0;
+      return 1;
+    }
+    src = k1_map[src];
+  }
+  if (!kx_cst || !kx_cst[src]) return 0;
+  *v = kx_cst[src];
   return 1;
 }
 
@@ -1747,6 +1759,16 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
     emit_blocks(f, L, &p);
   }
   k1_map = p.nml && p.straight ? p.K1map : NULL;
+  signed char *cst = p.straight ? calloc((size_t)L->m.nnz + 1, 1) : NULL;
+  if (cst)
+    for (int r = 0; r < L->m.nrow; r++)
+      for (int s = 0; s < 2; s++)
+        for (int j = 0; j < 6; j++) {
+          const mb_rowdef *R = &L->row[r];
+          if (!R->constant[s][j] || R->slot[s][j] < 0) continue;
+          cst[R->slot[s][j]] = cst[R->slotT[s][j]] = (signed char)(s ? 1 : -1); /* as init writes them */
+        }
+  kx_cst = cst;
   if (p.straight) emit_factor_straight(f, L, &p, nm);
   else emit_factor_looped(f, L, &p, nm);
   emit_factor_entry(f, L, &p, nm);
@@ -1754,6 +1776,8 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
   else emit_solve_helpers_looped(f, &p);
   emit_solve(f, &p, nm);
   kc_of = kc_map = k1_map = NULL;
+  kx_cst = NULL;
+  free(cst);
   free(kc);
   fputs("static int ldl_factor_m(const mb_model *m, const mb_real *Kx, mb_real *work) {\n", f);
   fprintf(f, "  (void)m;\n  return %s_ldl_factor(Kx, work);\n}\n", nm);
