@@ -8,6 +8,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "support.h"
 #include "double_pendulum.h"
@@ -173,11 +174,39 @@ static void rk4_slider_crank(void **state) {
   trajectory_free(&b);
 }
 
+/* A NaN in the state reaches the solution of the first solve (the velocity
+ * projection's right side is -nu(q, v)); every solver's run must stop there
+ * with MB_ERR_NONFINITE at t = 0, never return the NaN as data.  The emitted
+ * LDL^T tests its own result (checks_finite: the integrator then skips its
+ * test), KLU and dense LU are tested by the integrator. */
+static void nonfinite_reported(void **state) {
+  (void)state;
+  const char *solvers[] = {"ldl", "klu", "dense"};
+  for (int i = 0; i < 3; i++) {
+    const mb_model *m = &slider_crank_model;
+    mb_settings s = model_settings(m);
+    mb_solver *ls = mb_solver_new(solvers[i], m);
+    assert_non_null(ls);
+    assert_int_equal(ls->checks_finite, !strcmp(solvers[i], "ldl"));
+    mb_sim sim;
+    assert_int_equal(mb_sim_init(&sim, m, ls, &s), MB_OK);
+    sim.v[m->nv - 1] = NAN;
+    int st = mb_sim_run(&sim, NULL, NULL);
+    printf("  %s: %s at t = %g\n", solvers[i], sim.fail_detail, sim.fail_time);
+    assert_int_equal(st, MB_ERR_NONFINITE);
+    assert_true(sim.fail_time == 0);
+    assert_non_null(strstr(sim.fail_detail, "non-finite"));
+    mb_sim_free(&sim);
+    ls->destroy(ls);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(klu_vs_dense),   cmocka_unit_test(generated_vs_generic),
       cmocka_unit_test(spatial_energy), cmocka_unit_test(double_pendulum_energy),
       cmocka_unit_test(rk4_pendulum),   cmocka_unit_test(rk4_slider_crank),
+      cmocka_unit_test(nonfinite_reported),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
