@@ -1234,9 +1234,11 @@ int ldl_plan_build(const lmodel *L, ldl_plan *p) {
   }
   if (!p->perm) goto fail;
   p->straight = p->flops <= p->budget;
-  /* the block pivots' own work (looped code in any case): LU of Du, a
-     transposed solve per S row and the product with Dx; per solve the right
-     side (W g_r, Dx^T Du^-T f_u) and the recovery (two 6 x 6 solves) */
+  /* the block pivots' own work with dense 6 x 6 blocks (the looped code's):
+     LU of Du, a transposed solve per S row and the product with Dx; per solve
+     the right side (W g_r, Dx^T Du^-T f_u) and the recovery (two 6 x 6
+     solves).  An upper bound: the straight-line code skips the structural
+     zeros of Du, Du^-1, W and Dx (a weld's Du is four blocks on the diagonal) */
   p->flops_block = 0;
   p->flops_block_solve = 0;
   p->flops_ml = 0;
@@ -1275,10 +1277,10 @@ void ldl_plan_report(const lmodel *L, FILE *out) {
             p.nmassless, p.nw);
   if (p.nml)
     fprintf(out, "  massless bodies   %d eliminated with 6 of their rows each, chosen by pivoting "
-                 "(%.0f flops per factorization, %.0f per solve)\n", p.nml, p.flops_ml, p.flops_ml_solve);
+                 "(at most %.0f flops per factorization, %.0f per solve)\n", p.nml, p.flops_ml, p.flops_ml_solve);
   if (p.nelim)
     fprintf(out, "  block pivots      %d welded virtual bodies eliminated with their weld rows "
-                 "(%.0f flops per factorization, %.0f per solve)\n", p.nelim, p.flops_block, p.flops_block_solve);
+                 "(at most %.0f flops per factorization, %.0f per solve)\n", p.nelim, p.flops_block, p.flops_block_solve);
   fprintf(out, "  nnz(L)            %ld (strictly lower; L + D + L^T has %ld)\n", p.nnzL, 2 * p.nnzL + p.n);
   fprintf(out, "  LDL^T flops       %.0f per factorization, %.0f per solve\n", p.flops, p.flops_solve);
   fprintf(out, "  LDL^T code        %s (flop budget %.0f)\n", p.straight ? "straight-line" : "looped", p.budget);

@@ -101,7 +101,7 @@ typedef struct {
   int *ekrp;         /* nelim + 1: start of body e in ekr (pairs) */
   int nnzR;
   int *Krp, *Kri, *Krmap;
-  double flops_block, flops_block_solve; /* the block pivots' flops (not in flops) */
+  double flops_block, flops_block_solve; /* the block pivots' flops, dense 6 x 6 (a bound; not in flops) */
 
   /* K_aug in the permuted numbering, upper triangle with the diagonal, CSC
    * with rows sorted: column k holds Ui[Up[k]..Up[k+1]) (last one may be k).
