@@ -30,6 +30,7 @@
  * The workspace (<M>_LDL_WORK mb_real) holds Lx (nnz(L)), 1/d (n), then x,
  * r, t and the best x of the refinement (n each). */
 #include <ctype.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -159,12 +160,73 @@ static const int *k1_map;
  * writes (+1 or -1: a rigid body's translational columns in a point row), 0
  * for the others; they become literals too */
 static const signed char *kx_cst;
+/* the space of the slots kput prints: 1 the block pivots' (K1 with massless
+ * bodies, else Kx), 0 Kx itself (the massless bodies' code) */
+static int kput_k1;
+/* straight-line block pivots: the entries of Kc known at compile time (a
+ * weld's translational rows: unit D_u and unit rows on both sides), kc_cst[k]
+ * set and the value in kc_val[k]; those are not stored, their readers get the
+ * literal */
+static char *kc_cst;
+static double *kc_val;
 
 static int kconst(int q, double *v);
 
+/* 1 if the slot of the block pivots' space (k1) or of Kx holds a compile-time
+ * constant (K1's constants, init's entries of Kx), its value in *v */
+static int slot_const(int slot, int k1, double *v) {
+  if (k1 && k1_map) {
+    int s = k1_map[slot];
+    if (s == -4) return 0;
+    if (s < 0) {
+      *v = s == -2 ? 1 : s == -3 ? -1 : 0;
+      return 1;
+    }
+    slot = s;
+  }
+  if (!kx_cst || !kx_cst[slot]) return 0;
+  *v = kx_cst[slot];
+  return 1;
+}
+
+/* "Kx[slot]" (space kput_k1), or its value when it is a compile-time constant */
+static void kput(FILE *f, int slot) {
+  double c;
+  if (slot_const(slot, kput_k1, &c)) num(f, c);
+  else fprintf(f, "Kx[%d]", slot);
+}
+
+/* one term "coef * v" of a sum: coef a C expression, or (known) the constant
+ * c, a factor 1 then dropped and a zero term left out; 'any': a term came
+ * before (then " + " or " - ").  The same products in the same order: a
+ * product with +-1 is exact, so the numbers do not change. */
+static void put_term(FILE *f, int *any, int known, double c, const char *coef, const char *v) {
+  if (known) {
+    if (c == 0) return;
+    fputs(*any ? (c < 0 ? " - " : " + ") : (c < 0 ? "-" : ""), f);
+    if (fabs(c) != 1) {
+      num(f, fabs(c));
+      fputs(" * ", f);
+    }
+    fputs(v, f);
+  } else {
+    fprintf(f, "%s%s * %s", *any ? " + " : "", coef, v);
+  }
+  *any = 1;
+}
+
+/* put_term with the slot's entry (space kput_k1) as the coefficient */
+static void put_kterm(FILE *f, int *any, int slot, const char *v) {
+  double c;
+  char coef[32];
+  int known = slot_const(slot, kput_k1, &c);
+  snprintf(coef, sizeof coef, "Kx[%d]", slot);
+  put_term(f, any, known, c, coef, v);
+}
+
 static void kval(FILE *f, int q) {
   double c;
-  if (kconst(q, &c)) fputs(c == 1 ? "1" : c == -1 ? "-1" : "0", f);
+  if (kconst(q, &c)) num(f, c);
   else if (!kc_of) fprintf(f, "Kx[%d]", q);
   else if (kc_of[q] >= 0) fprintf(f, "Kc[%d]", kc_of[q]);
   else if (kc_map[q] >= 0) fprintf(f, "Kx[%d]", kc_map[q]);
@@ -176,24 +238,18 @@ static void kval(FILE *f, int q) {
 static int kconst(int q, double *v) {
   int src = q;
   if (kc_of) {
-    if (kc_of[q] >= 0) return 0;
+    if (kc_of[q] >= 0) {
+      if (!kc_cst || !kc_cst[kc_of[q]]) return 0;
+      *v = kc_val[kc_of[q]];
+      return 1;
+    }
     src = kc_map[q];
     if (src < 0) {
       *v = src == -2 ? 1 : src == -3 ? -1 : 0;
       return 1;
     }
   }
-  if (k1_map) {
-    if (k1_map[src] == -4) return 0;
-    if (k1_map[src] < 0) {
-      *v = k1_map[src] == -2 ? 1 : k1_map[src] == -3 ? -1 : 0;
-      return 1;
-    }
-    src = k1_map[src];
-  }
-  if (!kx_cst || !kx_cst[src]) return 0;
-  *v = kx_cst[src];
-  return 1;
+  return slot_const(src, 1, v);
 }
 
 /* pivot k of K_aug is a decoupled unknown whose value the block pivots or the
@@ -486,8 +542,10 @@ static void emit_inv_small(FILE *f, const int *slot, const int *mem, int n, cons
     for (int i = 0; i < n; i++)
       for (int j = 0; j < n; j++) {
         int sl = slot[6 * mem[i] + mem[j]];
-        if (sl >= 0) fprintf(f, "      a[%d] = Kx[%d];\n", n * i + j, sl);
-        else fprintf(f, "      a[%d] = 0;\n", n * i + j);
+        fprintf(f, "      a[%d] = ", n * i + j);
+        if (sl >= 0) kput(f, sl);
+        else fputc('0', f);
+        fputs(";\n", f);
       }
     fprintf(f, "      if (ldl_invn(%d, a, x, amax)) %s;\n", n, fail);
     for (int i = 0; i < n; i++)
@@ -497,7 +555,11 @@ static void emit_inv_small(FILE *f, const int *slot, const int *mem, int n, cons
   }
   for (int i = 0; i < n; i++)
     for (int j = 0; j < n; j++)
-      if (bnz[n * i + j]) fprintf(f, "      const mb_real a%d%d = Kx[%d];\n", i, j, slot[6 * mem[i] + mem[j]]);
+      if (bnz[n * i + j]) {
+        fprintf(f, "      const mb_real a%d%d = ", i, j);
+        kput(f, slot[6 * mem[i] + mem[j]]);
+        fputs(";\n", f);
+      }
   /* cij: the cofactor of a_ij (structural zeros not declared) */
   int cnz[9];
   for (int i = 0; i < n; i++)
@@ -546,22 +608,34 @@ static void emit_inv_small(FILE *f, const int *slot, const int *mem, int n, cons
  * structural zeros, and every reader skips them. */
 /* the inverse of diagonal block (strongly connected component) c of D_u into X:
  * a division for a 1x1 block, else emit_inv_small; returns the block's size */
+/* A 1 x 1 block whose entry is a compile-time constant c != 0 (kput_k1's
+ * space) is X = 1 / c with no test (a unit pivot beside a rotation's entries);
+ * xk/xc (when not NULL) then get X's entry as known. */
 static int emit_inv_component(FILE *f, const int *slot, const int *comp, int c, const char *X,
-                              const char *fail, int adjugate) {
+                              const char *fail, int adjugate, char *xk, double *xc) {
   int mem[6], n = 0;
   for (int i = 0; i < 6; i++)
     if (comp[i] == c) mem[n++] = i;
   if (n == 1) {
     int d = 7 * mem[0];
-    fprintf(f, "    if (!(fabs(Kx[%d]) > 1e-12 * amax)) %s;\n    %s[%d] = 1 / Kx[%d];\n", slot[d], fail, X, d,
-            slot[d]);
+    double v;
+    if (slot_const(slot[d], kput_k1, &v) && v != 0) {
+      fprintf(f, "    %s[%d] = ", X, d);
+      num(f, 1 / v);
+      fputs("; /* a constant pivot */\n", f);
+      if (xk) { xk[d] = 1; xc[d] = 1 / v; }
+    } else {
+      fprintf(f, "    if (!(fabs(Kx[%d]) > 1e-12 * amax)) %s;\n    %s[%d] = 1 / Kx[%d];\n", slot[d], fail, X, d,
+              slot[d]);
+    }
   } else {
     emit_inv_small(f, slot, mem, n, X, fail, adjugate);
   }
   return n;
 }
 
-static void emit_inv_blocked(FILE *f, const int *slot, const char *X, const char *fail) {
+static void emit_inv_blocked(FILE *f, const int *slot, const char *X, const char *fail, char *xk,
+                             double *xc) {
   int nz[36], comp[6];
   for (int i = 0; i < 36; i++) nz[i] = slot[i] >= 0;
   int nb = ldl_inv_blocks(nz, comp);
@@ -569,17 +643,25 @@ static void emit_inv_blocked(FILE *f, const int *slot, const char *X, const char
     fputs("  {\n    mb_real A[36];\n", f);
     for (int i = 0; i < 36; i++) {
       fprintf(f, "    A[%d] = ", i);
-      if (slot[i] >= 0) fprintf(f, "Kx[%d];\n", slot[i]);
-      else fputs("0;\n", f);
+      if (slot[i] >= 0) kput(f, slot[i]);
+      else fputc('0', f);
+      fputs(";\n", f);
     }
     fprintf(f, "    if (ldl_inv6(A, %s)) %s;\n  }\n", X, fail);
     return;
   }
-  fprintf(f, "  { /* block-diagonal: %d blocks inverted apart */\n    mb_real amax = 0;\n", nb);
+  /* amax: the largest |entry|, the constants' part at compile time */
+  double cmax = 0, v;
   for (int k = 0; k < 36; k++)
-    if (nz[k]) fprintf(f, "    if (fabs(Kx[%d]) > amax) amax = fabs(Kx[%d]);\n", slot[k], slot[k]);
-  for (int c = 0; c < nb; c++) emit_inv_component(f, slot, comp, c, X, fail, 1);
-  fputs("  }\n", f);
+    if (nz[k] && slot_const(slot[k], kput_k1, &v) && fabs(v) > cmax) cmax = fabs(v);
+  fprintf(f, "  { /* block-diagonal: %d blocks inverted apart */\n    mb_real amax = ", nb);
+  num(f, cmax);
+  fputs(";\n", f);
+  for (int k = 0; k < 36; k++)
+    if (nz[k] && !slot_const(slot[k], kput_k1, &v))
+      fprintf(f, "    if (fabs(Kx[%d]) > amax) amax = fabs(Kx[%d]);\n", slot[k], slot[k]);
+  for (int c = 0; c < nb; c++) emit_inv_component(f, slot, comp, c, X, fail, 1, xk, xc);
+  fputs("    (void)amax;\n  }\n", f);
 }
 
 /* The block-triangular structure of a 6 x 6 A (slot[36]: Kx slots, -1 a
@@ -633,12 +715,18 @@ static int tri_structure(const int *slot, int comp[6], int blk[6], int xnz[36]) 
 static void emit_inv_triangular(FILE *f, const int *slot, const char *X, const char *fail) {
   int comp[6], blk[6], xnz[36];
   int nb = tri_structure(slot, comp, blk, xnz);
-  fprintf(f, "  { /* block upper triangular in %d blocks: the diagonal ones inverted, the rest\n"
-             "       by substitution */\n    mb_real amax = 0;\n", nb);
+  double cmax = 0, v;
   for (int k = 0; k < 36; k++)
-    if (slot[k] >= 0) fprintf(f, "    if (fabs(Kx[%d]) > amax) amax = fabs(Kx[%d]);\n", slot[k], slot[k]);
+    if (slot[k] >= 0 && slot_const(slot[k], kput_k1, &v) && fabs(v) > cmax) cmax = fabs(v);
+  fprintf(f, "  { /* block upper triangular in %d blocks: the diagonal ones inverted, the rest\n"
+             "       by substitution */\n    mb_real amax = ", nb);
+  num(f, cmax);
+  fputs(";\n", f);
+  for (int k = 0; k < 36; k++)
+    if (slot[k] >= 0 && !slot_const(slot[k], kput_k1, &v))
+      fprintf(f, "    if (fabs(Kx[%d]) > amax) amax = fabs(Kx[%d]);\n", slot[k], slot[k]);
   for (int bi = nb - 1; bi >= 0; bi--) {
-    int c = blk[bi], mem[6], n = emit_inv_component(f, slot, comp, c, X, fail, 0);
+    int c = blk[bi], mem[6], n = emit_inv_component(f, slot, comp, c, X, fail, 0, NULL, NULL);
     for (int i = 0, k = 0; i < 6; i++)
       if (comp[i] == c) mem[k++] = i;
     /* column j of a later block: T(p, j) = sum_q A(p, q) X(q, j) over q outside
@@ -653,9 +741,10 @@ static void emit_inv_triangular(FILE *f, const int *slot, const char *X, const c
         int p = mem[pi], any = 0;
         for (int q = 0; q < 6; q++)
           if (comp[q] != c && slot[6 * p + q] >= 0 && xnz[6 * q + j]) {
+            char xv[32];
             if (!any) fprintf(f, "    const mb_real t%d_%d = ", p, j);
-            fprintf(f, "%sKx[%d] * %s[%d]", any ? " + " : "", slot[6 * p + q], X, 6 * q + j);
-            any = 1;
+            snprintf(xv, sizeof xv, "%s[%d]", X, 6 * q + j);
+            put_kterm(f, &any, slot[6 * p + q], xv);
           }
         if (any) fputs(";\n", f);
         tnz[pi] = any;
@@ -683,13 +772,26 @@ static void emit_inv_triangular(FILE *f, const int *slot, const char *X, const c
 static void emit_reduced_rhs(FILE *f, const char *v, int i, int row, const int *slots,
                              const int *cols, int n) {
   fprintf(f, "  %s[%d] = r[%d]", v, i, row);
-  for (int k = 0; k < n; k++)
-    if (slots[6 * k + i] >= 0) fprintf(f, " - Kx[%d] * d[%d]", slots[6 * k + i], cols[k]);
+  for (int k = 0; k < n; k++) {
+    double c;
+    int sl = slots[6 * k + i];
+    if (sl < 0) continue;
+    if (!slot_const(sl, kput_k1, &c)) fprintf(f, " - Kx[%d] * d[%d]", sl, cols[k]);
+    else if (c == 1 || c == -1) fprintf(f, " %c d[%d]", c == 1 ? '-' : '+', cols[k]);
+    else if (c != 0) { fputs(" - ", f); num(f, c); fprintf(f, " * d[%d]", cols[k]); }
+  }
   fputs(";\n", f);
 }
 
+/* the value of Di entry idx of block e when known at compile time (a constant
+ * pivot), else the expression "Di[idx]" */
+typedef struct {
+  char k[36];   /* Di's entries known at compile time */
+  double c[36]; /* their values */
+} blk_known;
+
 static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, const long *woff) {
-  char name[512];
+  char name[512], ex[48], vx[48];
   int nkc = 0;
   for (int q = 0; q < p->nnzR; q++)
     if (kc_of[q] >= 0 && kc_of[q] + 1 > nkc) nkc = kc_of[q] + 1;
@@ -699,11 +801,18 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
     if (kc_of[q] >= 0) src[kc_of[q]] = p->Krmap[q];
   /* the blocks' D_u structure, and with it which entries of D_u^-1 can be nonzero */
   int (*dinz)[36] = calloc((size_t)p->nelim + 1, sizeof *dinz);
-  if (!dinz) return;
+  blk_known *dk = calloc((size_t)p->nelim + 1, sizeof *dk);
+  int nw = 0;
+  for (int e = 0; e < p->nelim; e++) nw += 6 * (p->esp[e + 1] - p->esp[e]);
+  char *wk = calloc((size_t)nw + 1, 1); /* W's entries known at compile time, per block at 6 esp[e] */
+  double *wc = calloc((size_t)nw + 1, sizeof(double));
+  kc_cst = calloc((size_t)nkc + 1, 1);
+  kc_val = calloc((size_t)nkc + 1, sizeof(double));
+  if (!dinz || !dk || !wk || !wc || !kc_cst || !kc_val) { free(src); free(dinz); free(dk); free(wk); free(wc); return; }
   for (int e = 0; e < p->nelim; e++) ldl_block_dinz(p, e, dinz[e]);
   /* the entries of Kc that a block's update reaches (their first update sets them) */
   char *updated = calloc((size_t)nkc + 1, 1);
-  if (!updated) { free(src); free(dinz); return; }
+  if (!updated) { free(src); free(dinz); free(dk); free(wk); free(wc); return; }
   for (int e = 0; e < p->nelim; e++) {
     int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss, k = p->ekrp[e];
     for (int si = 0; si < ns; si++)
@@ -714,71 +823,136 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
             updated[kc_of[p->ekr[2 * k]]] = updated[kc_of[p->ekr[2 * k + 1]]] = 1;
       }
   }
+  kput_k1 = 1;
   fputs("/* Kc (the entries of K' the block pivots set) from Kx; returns 0, or 1 + a column\n"
-        " * of a virtual body whose Du is singular */\n"
+        " * of a virtual body whose Du is singular.  Entries known at compile time (a\n"
+        " * weld's unit translational rows) are literals where they are read, not stored */\n"
         "static int ldl_block_pivots(const mb_real *Kx, mb_real *work) {\n"
         "  mb_real *Kc = work + LDL_KR, *Di, *W, v;\n"
         "  /* the entries of K' that no block changes (the others: at their first change) */\n", f);
   for (int k = 0; k < nkc; k++) {
+    double c;
     if (updated[k]) continue;
-    fprintf(f, "  Kc[%d] = ", k);
-    if (src[k] >= 0) fprintf(f, "Kx[%d]", src[k]);
-    else fputs(src[k] == -2 ? "1" : src[k] == -3 ? "-1" : "0", f);
-    fputs(";\n", f);
+    if (src[k] < 0 || slot_const(src[k], 1, &c)) { /* a constant of K' */
+      kc_cst[k] = 1;
+      kc_val[k] = src[k] >= 0 ? c : src[k] == -2 ? 1 : src[k] == -3 ? -1 : 0;
+      continue;
+    }
+    fprintf(f, "  Kc[%d] = Kx[%d];\n", k, src[k]);
   }
-  for (int e = 0; e < p->nelim; e++) {
+  for (int e = 0, w0 = 0; e < p->nelim; e++) {
     int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
     fprintf(f, "  /* block %d: Du^-1, W = Eu Du^-1, K'(s, x) -= (W Dx)(s, x) */\n", e);
     fprintf(f, "  Di = work + %ld;\n  W = Di + 42;\n", woff[e]);
     {
       char fail[32];
       snprintf(fail, sizeof fail, "return %d", 1 + p->eu[e][0]);
-      emit_inv_blocked(f, p->edu[e], "Di", fail);
+      emit_inv_blocked(f, p->edu[e], "Di", fail, dk[e].k, dk[e].c);
     }
     int k = p->ekrp[e];
     for (int si = 0; si < ns; si++) {
       const int *eu = p->eeu + 6 * (ss + si);
+      char *wki = wk + w0 + 6 * si;
+      double *wci = wc + w0 + 6 * si;
       ldl_unknown_name(L, p->es[ss + si], name, sizeof name);
       fprintf(f, "  /* %s */\n", name);
       for (int i = 0; i < 6; i++) { /* only the entries w_nonzero: the readers skip the others */
-        int any = 0;
-        for (int c = 0; c < 6; c++)
-          if (eu[c] >= 0 && dinz[e][6 * c + i]) {
-            if (!any) fprintf(f, "  W[%d] = ", 6 * si + i);
-            fprintf(f, "%sKx[%d] * Di[%d]", any ? " + " : "", eu[c], 6 * c + i);
+        int any = 0, known = 1;
+        double sum = 0, c;
+        for (int c6 = 0; c6 < 6; c6++)
+          if (eu[c6] >= 0 && dinz[e][6 * c6 + i]) {
             any = 1;
+            if (slot_const(eu[c6], 1, &c) && dk[e].k[6 * c6 + i]) sum += c * dk[e].c[6 * c6 + i];
+            else known = 0;
           }
-        if (any) fputs(";\n", f);
+        if (!any) continue;
+        if (known) { wki[i] = 1; wci[i] = sum; continue; } /* read as a literal */
+        fprintf(f, "  W[%d] = ", 6 * si + i);
+        any = 0;
+        for (int c6 = 0; c6 < 6; c6++)
+          if (eu[c6] >= 0 && dinz[e][6 * c6 + i]) {
+            int kn = dk[e].k[6 * c6 + i];
+            snprintf(vx, sizeof vx, "Di[%d]", 6 * c6 + i);
+            if (kn) { /* Di known: the term is Kx * constant, written constant * Kx */
+              snprintf(ex, sizeof ex, "Kx[%d]", eu[c6]);
+              if (slot_const(eu[c6], 1, &c)) snprintf(ex, sizeof ex, "%.17g", c);
+              put_term(f, &any, 1, dk[e].c[6 * c6 + i], "", ex);
+            } else {
+              put_kterm(f, &any, eu[c6], vx);
+            }
+          }
+        fputs(";\n", f);
       }
       for (int xi = 0; xi < nx; xi++, k++) {
         const int *dx = p->edx + 6 * (xs + xi);
-        int any = 0;
+        int any = 0, known = 1;
+        double vsum = 0, c;
         for (int i = 0; i < 6; i++)
           if (dx[i] >= 0 && ldl_w_nonzero(eu, dinz[e], i)) {
-            fprintf(f, "%sW[%d] * Kx[%d]", any ? " + " : "  v = ", 6 * si + i, dx[i]);
             any = 1;
+            if (wki[i] && slot_const(dx[i], 1, &c)) vsum += wci[i] * c;
+            else known = 0;
           }
         if (!any) continue;
-        fputs(";\n", f);
+        if (!known) {
+          fputs("  v = ", f);
+          any = 0;
+          for (int i = 0; i < 6; i++)
+            if (dx[i] >= 0 && ldl_w_nonzero(eu, dinz[e], i)) {
+              snprintf(ex, sizeof ex, "W[%d]", 6 * si + i);
+              if (wki[i]) { /* W known: constant * Kx */
+                snprintf(vx, sizeof vx, "Kx[%d]", dx[i]);
+                if (slot_const(dx[i], 1, &c)) snprintf(vx, sizeof vx, "%.17g", c);
+                put_term(f, &any, 1, wci[i], "", vx);
+              } else {
+                put_kterm(f, &any, dx[i], ex);
+              }
+            }
+          fputs(any ? ";\n" : "0;\n", f);
+        }
         for (int h = 0; h < 2; h++) {
           int kc = kc_of[p->ekr[2 * k + h]];
-          if (updated[kc] == 2) { fprintf(f, "  Kc[%d] -= v;\n", kc); continue; }
+          if (updated[kc] == 2) { /* a later change */
+            if (kc_cst[kc] && known) { kc_val[kc] -= vsum; continue; }
+            if (kc_cst[kc]) {
+              fprintf(f, "  Kc[%d] = ", kc);
+              num(f, kc_val[kc]);
+              fputs(" - v;\n", f);
+              kc_cst[kc] = 0;
+            } else if (known) {
+              fprintf(f, "  Kc[%d] -= ", kc);
+              num(f, vsum);
+              fputs(";\n", f);
+            } else {
+              fprintf(f, "  Kc[%d] -= v;\n", kc);
+            }
+            continue;
+          }
           updated[kc] = 2; /* its first change: K'(s, x) = K(s, x) - v */
-          if (src[kc] >= 0) fprintf(f, "  Kc[%d] = Kx[%d] - v;\n", kc, src[kc]);
-          else if (src[kc] == -1) fprintf(f, "  Kc[%d] = -v;\n", kc);
-          else fprintf(f, "  Kc[%d] = %s - v;\n", kc, src[kc] == -2 ? "1" : "-1");
+          double base;
+          int bknown = src[kc] < 0 || slot_const(src[kc], 1, &base);
+          if (src[kc] < 0) base = src[kc] == -2 ? 1 : src[kc] == -3 ? -1 : 0;
+          if (bknown && known) { kc_cst[kc] = 1; kc_val[kc] = base - vsum; continue; }
+          fprintf(f, "  Kc[%d] = ", kc);
+          if (!bknown) fprintf(f, "Kx[%d] - ", src[kc]);
+          else if (base != 0) { num(f, base); fputs(" - ", f); }
+          else fputc('-', f);
+          if (known) num(f, vsum);
+          else fputc('v', f);
+          fputs(";\n", f);
         }
       }
     }
+    w0 += 6 * ns;
   }
   free(src);
   free(updated);
-  fputs("  (void)v;\n  (void)W;\n  return 0;\n}\n\n", f);
+  fputs("  (void)v;\n  (void)W;\n  (void)Kc;\n  return 0;\n}\n\n", f);
 
   fputs(BLOCK_RHS_COMMENT
         "static void ldl_block_rhs(const mb_real *Kx, const mb_real *work, mb_real *r) {\n"
         "  const mb_real *Di, *W;\n  mb_real z[6];\n", f);
-  for (int e = 0; e < p->nelim; e++) {
+  for (int e = 0, w0 = 0; e < p->nelim; e++) {
     int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
     fprintf(f, "  /* block %d */\n  Di = work + %ld;\n  W = Di + 42;\n", e, woff[e]);
     for (int si = 0; si < ns; si++) {
@@ -787,8 +961,9 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
       for (int c = 0; c < 6; c++)
         if (ldl_w_nonzero(eu, dinz[e], c)) {
           if (!any) fprintf(f, "  r[%d] -= ", p->es[ss + si]);
-          fprintf(f, "%sW[%d] * r[%d]", any ? " + " : "", 6 * si + c, p->er[e][c]);
-          any = 1;
+          snprintf(ex, sizeof ex, "W[%d]", 6 * si + c);
+          snprintf(vx, sizeof vx, "r[%d]", p->er[e][c]);
+          put_term(f, &any, wk[w0 + 6 * si + c], wc[w0 + 6 * si + c], ex, vx);
         }
       if (any) fputs(";\n", f);
     }
@@ -797,8 +972,9 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
       fprintf(f, "  z[%d] = ", i);
       for (int c = 0; c < 6; c++)
         if (dinz[e][6 * c + i]) {
-          fprintf(f, "%sDi[%d] * r[%d]", any ? " + " : "", 6 * c + i, p->eu[e][c]);
-          any = 1;
+          snprintf(ex, sizeof ex, "Di[%d]", 6 * c + i);
+          snprintf(vx, sizeof vx, "r[%d]", p->eu[e][c]);
+          put_term(f, &any, dk[e].k[6 * c + i], dk[e].c[6 * c + i], ex, vx);
         }
       fputs(any ? ";\n" : "0;\n", f);
     }
@@ -808,13 +984,14 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
       for (int i = 0; i < 6; i++)
         if (dx[i] >= 0) {
           if (!any) fprintf(f, "  r[%d] -= ", p->ex[xs + xi]);
-          fprintf(f, "%sKx[%d] * z[%d]", any ? " + " : "", dx[i], i);
-          any = 1;
+          snprintf(vx, sizeof vx, "z[%d]", i);
+          put_kterm(f, &any, dx[i], vx);
         }
       if (any) fputs(";\n", f);
     }
+    w0 += 6 * ns;
   }
-  fputs("  (void)Kx;\n  (void)W;\n}\n\n", f);
+  fputs("  (void)Kx;\n  (void)W;\n  (void)Di;\n}\n\n", f);
 
   fputs("/* the eliminated unknowns of d from the others: a_u = Du^-1 (g_r - Dx a_x),\n"
         " * lambda_r = Du^-T (f_u - Eu^T lambda_s) */\n"
@@ -830,21 +1007,27 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
       fprintf(f, "  d[%d] = ", p->eu[e][c]);
       for (int i = 0; i < 6; i++)
         if (dinz[e][6 * c + i]) {
-          fprintf(f, "%sDi[%d] * y[%d]", any ? " + " : "", 6 * c + i, i);
-          any = 1;
+          snprintf(ex, sizeof ex, "Di[%d]", 6 * c + i);
+          snprintf(vx, sizeof vx, "y[%d]", i);
+          put_term(f, &any, dk[e].k[6 * c + i], dk[e].c[6 * c + i], ex, vx);
         }
       fprintf(f, "%s;\n  d[%d] = ", any ? "" : "0", p->er[e][c]);
       any = 0;
       for (int i = 0; i < 6; i++)
         if (dinz[e][6 * i + c]) {
-          fprintf(f, "%sDi[%d] * z[%d]", any ? " + " : "", 6 * i + c, i);
-          any = 1;
+          snprintf(ex, sizeof ex, "Di[%d]", 6 * i + c);
+          snprintf(vx, sizeof vx, "z[%d]", i);
+          put_term(f, &any, dk[e].k[6 * i + c], dk[e].c[6 * i + c], ex, vx);
         }
       fputs(any ? ";\n" : "0;\n", f);
     }
   }
-  fputs("  (void)Kx;\n}\n\n", f);
+  fputs("  (void)Kx;\n  (void)Di;\n}\n\n", f);
+  kput_k1 = 0;
   free(dinz);
+  free(dk);
+  free(wk);
+  free(wc);
 }
 
 static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
@@ -1739,12 +1922,24 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
     int_array(f, "ldl_Ki", m->Ki, m->nnz);
     fputc('\n', f);
   }
+  /* the compile-time constants: K1's (massless bodies) and init's entries of Kx */
+  k1_map = p.nml && p.straight ? p.K1map : NULL;
+  signed char *cst = p.straight ? calloc((size_t)L->m.nnz + 1, 1) : NULL;
+  if (cst)
+    for (int r = 0; r < L->m.nrow; r++)
+      for (int s = 0; s < 2; s++)
+        for (int j = 0; j < 6; j++) {
+          const mb_rowdef *R = &L->row[r];
+          if (!R->constant[s][j] || R->slot[s][j] < 0) continue;
+          cst[R->slot[s][j]] = cst[R->slotT[s][j]] = (signed char)(s ? 1 : -1); /* as init writes them */
+        }
+  kx_cst = cst;
   int *kc = NULL;
   inv6_emitted = 0;
   if (p.nml) emit_massless(f, L, &p);
   if (p.nelim) {
     kc = malloc(sizeof(int) * (size_t)(p.nnzR + 1));
-    if (!kc) { ldl_plan_free(&p); return 0; }
+    if (!kc) { free(cst); ldl_plan_free(&p); return 0; }
     int nkc = 0;
     for (int q = 0; q < p.nnzR; q++) kc[q] = p.straight ? -1 : nkc++;
     if (p.straight) {
@@ -1758,17 +1953,6 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
     kc_map = p.Krmap;
     emit_blocks(f, L, &p);
   }
-  k1_map = p.nml && p.straight ? p.K1map : NULL;
-  signed char *cst = p.straight ? calloc((size_t)L->m.nnz + 1, 1) : NULL;
-  if (cst)
-    for (int r = 0; r < L->m.nrow; r++)
-      for (int s = 0; s < 2; s++)
-        for (int j = 0; j < 6; j++) {
-          const mb_rowdef *R = &L->row[r];
-          if (!R->constant[s][j] || R->slot[s][j] < 0) continue;
-          cst[R->slot[s][j]] = cst[R->slotT[s][j]] = (signed char)(s ? 1 : -1); /* as init writes them */
-        }
-  kx_cst = cst;
   if (p.straight) emit_factor_straight(f, L, &p, nm);
   else emit_factor_looped(f, L, &p, nm);
   emit_factor_entry(f, L, &p, nm);
@@ -1778,6 +1962,10 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
   kc_of = kc_map = k1_map = NULL;
   kx_cst = NULL;
   free(cst);
+  free(kc_cst);
+  free(kc_val);
+  kc_cst = NULL;
+  kc_val = NULL;
   free(kc);
   fputs("static int ldl_factor_m(const mb_model *m, const mb_real *Kx, mb_real *work) {\n", f);
   fprintf(f, "  (void)m;\n  return %s_ldl_factor(Kx, work);\n}\n", nm);
