@@ -163,6 +163,11 @@ static const signed char *kx_cst;
 /* the space of the slots kput prints: 1 the block pivots' (K1 with massless
  * bodies, else Kx), 0 Kx itself (the massless bodies' code) */
 static int kput_k1;
+/* straight-line code with massless bodies: K1 is not gathered; a read of its
+ * slot q goes to Kx at the slot it was gathered from (k1_map[q] >= 0), to the
+ * K1 array only for the entries the massless bodies' elimination computes
+ * (-4), and constants are literals */
+static int k1_direct;
 /* straight-line block pivots: the entries of Kc known at compile time (a
  * weld's translational rows: unit D_u and unit rows on both sides), kc_cst[k]
  * set and the value in kc_val[k]; those are not stored, their readers get the
@@ -189,10 +194,26 @@ static int slot_const(int slot, int k1, double *v) {
   return 1;
 }
 
+/* where the straight-line code reads slot q of the block pivots' space (K1
+ * with massless bodies, else Kx), into buf */
+static void kname_buf(char *buf, size_t n, int q) {
+  int s = k1_direct && k1_map ? k1_map[q] : q;
+  if (!k1_direct || !k1_map || s >= 0) snprintf(buf, n, "Kx[%d]", s);
+  else if (s == -4) snprintf(buf, n, "K1[%d]", q);
+  else snprintf(buf, n, "%s", s == -2 ? "1" : s == -3 ? "-1" : "0");
+}
+
+static void kname(FILE *f, int q) {
+  char b[32];
+  kname_buf(b, sizeof b, q);
+  fputs(b, f);
+}
+
 /* "Kx[slot]" (space kput_k1), or its value when it is a compile-time constant */
 static void kput(FILE *f, int slot) {
   double c;
   if (slot_const(slot, kput_k1, &c)) num(f, c);
+  else if (kput_k1) kname(f, slot);
   else fprintf(f, "Kx[%d]", slot);
 }
 
@@ -220,16 +241,17 @@ static void put_kterm(FILE *f, int *any, int slot, const char *v) {
   double c;
   char coef[32];
   int known = slot_const(slot, kput_k1, &c);
-  snprintf(coef, sizeof coef, "Kx[%d]", slot);
+  if (kput_k1) kname_buf(coef, sizeof coef, slot);
+  else snprintf(coef, sizeof coef, "Kx[%d]", slot);
   put_term(f, any, known, c, coef, v);
 }
 
 static void kval(FILE *f, int q) {
   double c;
   if (kconst(q, &c)) num(f, c);
-  else if (!kc_of) fprintf(f, "Kx[%d]", q);
+  else if (!kc_of) kname(f, q);
   else if (kc_of[q] >= 0) fprintf(f, "Kc[%d]", kc_of[q]);
-  else if (kc_map[q] >= 0) fprintf(f, "Kx[%d]", kc_map[q]);
+  else if (kc_map[q] >= 0) kname(f, kc_map[q]);
   else fputs(kc_map[q] == -2 ? "1" : kc_map[q] == -3 ? "-1" : "0", f); /* a constant of K' */
 }
 
@@ -376,10 +398,10 @@ static void emit_factor_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
   for (int k = 0; k < n; k++) {
     if (k == 0 || chunk_flops > LDL_CHUNK_FLOPS) {
       if (k) fputs("  return 0;\n}\n\n", f);
-      fprintf(f, "static LDL_NOINLINE int ldl_factor_part%d(const mb_real *restrict Kx,%s mb_real *restrict Lx, "
+      fprintf(f, "static LDL_NOINLINE int ldl_factor_part%d(const mb_real *restrict Kx,%s%s mb_real *restrict Lx, "
                  "mb_real *restrict Dinv) {\n",
-              nchunk++, p->nelim ? " const mb_real *restrict Kc," : "");
-      fprintf(f, "  (void)Kx;\n%s  (void)Lx;\n", p->nelim ? "  (void)Kc;\n" : "");
+              nchunk++, p->nelim ? " const mb_real *restrict Kc," : "", k1_direct ? " const mb_real *restrict K1," : "");
+      fprintf(f, "  (void)Kx;\n%s%s  (void)Lx;\n", p->nelim ? "  (void)Kc;\n" : "", k1_direct ? "  (void)K1;\n" : "");
       chunk_flops = 0;
     }
     int u = p->perm[k];
@@ -443,7 +465,8 @@ static void emit_factor_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
   fputs("  mb_real *Lx = work, *Dinv = work + LDL_DINV;\n  int rc;\n", f);
   fputs("  /* the pivots in order, in parts */\n", f);
   for (int c = 0; c < nchunk; c++)
-    fprintf(f, "  if ((rc = ldl_factor_part%d(Kx,%s Lx, Dinv)) != 0) return rc;\n", c, p->nelim ? " Kc," : "");
+    fprintf(f, "  if ((rc = ldl_factor_part%d(Kx,%s%s Lx, Dinv)) != 0) return rc;\n", c, p->nelim ? " Kc," : "",
+            k1_direct ? " work + LDL_K1," : "");
   fputs("  (void)Lx;\n  (void)Dinv;\n  (void)rc;\n  return 0;\n}\n\n", f);
 }
 
@@ -625,8 +648,10 @@ static int emit_inv_component(FILE *f, const int *slot, const int *comp, int c, 
       fputs("; /* a constant pivot */\n", f);
       if (xk) { xk[d] = 1; xc[d] = 1 / v; }
     } else {
-      fprintf(f, "    if (!(fabs(Kx[%d]) > 1e-12 * amax)) %s;\n    %s[%d] = 1 / Kx[%d];\n", slot[d], fail, X, d,
-              slot[d]);
+      char a[32];
+      if (kput_k1) kname_buf(a, sizeof a, slot[d]);
+      else snprintf(a, sizeof a, "Kx[%d]", slot[d]);
+      fprintf(f, "    if (!(fabs(%s) > 1e-12 * amax)) %s;\n    %s[%d] = 1 / %s;\n", a, fail, X, d, a);
     }
   } else {
     emit_inv_small(f, slot, mem, n, X, fail, adjugate);
@@ -658,8 +683,11 @@ static void emit_inv_blocked(FILE *f, const int *slot, const char *X, const char
   num(f, cmax);
   fputs(";\n", f);
   for (int k = 0; k < 36; k++)
-    if (nz[k] && !slot_const(slot[k], kput_k1, &v))
-      fprintf(f, "    if (fabs(Kx[%d]) > amax) amax = fabs(Kx[%d]);\n", slot[k], slot[k]);
+    if (nz[k] && !slot_const(slot[k], kput_k1, &v)) {
+      char a[32];
+      kname_buf(a, sizeof a, slot[k]);
+      fprintf(f, "    if (fabs(%s) > amax) amax = fabs(%s);\n", a, a);
+    }
   for (int c = 0; c < nb; c++) emit_inv_component(f, slot, comp, c, X, fail, 1, xk, xc);
   fputs("    (void)amax;\n  }\n", f);
 }
@@ -776,7 +804,7 @@ static void emit_reduced_rhs(FILE *f, const char *v, int i, int row, const int *
     double c;
     int sl = slots[6 * k + i];
     if (sl < 0) continue;
-    if (!slot_const(sl, kput_k1, &c)) fprintf(f, " - Kx[%d] * d[%d]", sl, cols[k]);
+    if (!slot_const(sl, kput_k1, &c)) { fputs(" - ", f); kname(f, sl); fprintf(f, " * d[%d]", cols[k]); }
     else if (c == 1 || c == -1) fprintf(f, " %c d[%d]", c == 1 ? '-' : '+', cols[k]);
     else if (c != 0) { fputs(" - ", f); num(f, c); fprintf(f, " * d[%d]", cols[k]); }
   }
@@ -828,8 +856,9 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
         " * of a virtual body whose Du is singular.  Entries known at compile time (a\n"
         " * weld's unit translational rows) are literals where they are read, not stored */\n"
         "static int ldl_block_pivots(const mb_real *Kx, mb_real *work) {\n"
-        "  mb_real *Kc = work + LDL_KR, *Di, *W, v;\n"
-        "  /* the entries of K' that no block changes (the others: at their first change) */\n", f);
+        "  mb_real *Kc = work + LDL_KR, *Di, *W, v;\n", f);
+  if (k1_direct) fputs("  const mb_real *K1 = work + LDL_K1; /* the massless bodies' computed entries */\n  (void)K1;\n", f);
+  fputs("  /* the entries of K' that no block changes (the others: at their first change) */\n", f);
   for (int k = 0; k < nkc; k++) {
     double c;
     if (updated[k]) continue;
@@ -838,7 +867,9 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
       kc_val[k] = src[k] >= 0 ? c : src[k] == -2 ? 1 : src[k] == -3 ? -1 : 0;
       continue;
     }
-    fprintf(f, "  Kc[%d] = Kx[%d];\n", k, src[k]);
+    fprintf(f, "  Kc[%d] = ", k);
+    kname(f, src[k]);
+    fputs(";\n", f);
   }
   for (int e = 0, w0 = 0; e < p->nelim; e++) {
     int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
@@ -874,7 +905,7 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
             int kn = dk[e].k[6 * c6 + i];
             snprintf(vx, sizeof vx, "Di[%d]", 6 * c6 + i);
             if (kn) { /* Di known: the term is Kx * constant, written constant * Kx */
-              snprintf(ex, sizeof ex, "Kx[%d]", eu[c6]);
+              kname_buf(ex, sizeof ex, eu[c6]);
               if (slot_const(eu[c6], 1, &c)) snprintf(ex, sizeof ex, "%.17g", c);
               put_term(f, &any, 1, dk[e].c[6 * c6 + i], "", ex);
             } else {
@@ -901,7 +932,7 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
             if (dx[i] >= 0 && ldl_w_nonzero(eu, dinz[e], i)) {
               snprintf(ex, sizeof ex, "W[%d]", 6 * si + i);
               if (wki[i]) { /* W known: constant * Kx */
-                snprintf(vx, sizeof vx, "Kx[%d]", dx[i]);
+                kname_buf(vx, sizeof vx, dx[i]);
                 if (slot_const(dx[i], 1, &c)) snprintf(vx, sizeof vx, "%.17g", c);
                 put_term(f, &any, 1, wci[i], "", vx);
               } else {
@@ -934,7 +965,7 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
           if (src[kc] < 0) base = src[kc] == -2 ? 1 : src[kc] == -3 ? -1 : 0;
           if (bknown && known) { kc_cst[kc] = 1; kc_val[kc] = base - vsum; continue; }
           fprintf(f, "  Kc[%d] = ", kc);
-          if (!bknown) fprintf(f, "Kx[%d] - ", src[kc]);
+          if (!bknown) { kname(f, src[kc]); fputs(" - ", f); }
           else if (base != 0) { num(f, base); fputs(" - ", f); }
           else fputc('-', f);
           if (known) num(f, vsum);
@@ -952,6 +983,7 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
   fputs(BLOCK_RHS_COMMENT
         "static void ldl_block_rhs(const mb_real *Kx, const mb_real *work, mb_real *r) {\n"
         "  const mb_real *Di, *W;\n  mb_real z[6];\n", f);
+  if (k1_direct) fputs("  const mb_real *K1 = work + LDL_K1;\n  (void)K1;\n", f);
   for (int e = 0, w0 = 0; e < p->nelim; e++) {
     int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
     fprintf(f, "  /* block %d */\n  Di = work + %ld;\n  W = Di + 42;\n", e, woff[e]);
@@ -997,6 +1029,7 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
         " * lambda_r = Du^-T (f_u - Eu^T lambda_s) */\n"
         "static void ldl_block_back(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *d) {\n"
         "  const mb_real *Di;\n  mb_real y[6], z[6];\n", f);
+  if (k1_direct) fputs("  const mb_real *K1 = work + LDL_K1;\n  (void)K1;\n", f);
   for (int e = 0; e < p->nelim; e++) {
     int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
     fprintf(f, "  /* block %d */\n  Di = work + %ld;\n", e, woff[e]);
@@ -1490,16 +1523,16 @@ static void emit_massless(FILE *f, const lmodel *L, const ldl_plan *p) {
         "      for (int y = 0; y < ny; y++) K1[k1[2 * y]] -= w * dp[y];\n    }\n"
         "    for (int y = 0; y < ny; y++) K1[k1[2 * y + 1]] = K1[k1[2 * y]];\n  }\n  return 0;\n}\n\n", f);
   if (p->straight) emit_ml_fixed_factor(f, p);
-  fputs("/* K1 (work + LDL_K1) from Kx; returns 0, or 1 + a column of a massless body whose\n"
-        " * rows have lost rank 6 on it */\n"
+  fputs(p->straight ? "/* the entries of K1 (work + LDL_K1) the massless bodies' elimination computes (its\n"
+                     " * other entries are read from Kx or are literals); returns 0, or 1 + a column of a\n"
+                     " * massless body whose rows have lost rank 6 on it */\n"
+                   : "/* K1 (work + LDL_K1) from Kx; returns 0, or 1 + a column of a massless body whose\n"
+                     " * rows have lost rank 6 on it */\n", f);
+  fputs(
         "static int ldl_massless(const mb_real *Kx, mb_real *work) {\n"
         "  mb_real *K1 = work + LDL_K1;\n", f);
-  if (p->straight) { /* the gather with constant indices (the computed entries follow) */
-    for (int q = 0; q < p->nnz1; q++) {
-      int src = p->K1map[q];
-      if (src >= 0) fprintf(f, "  K1[%d] = Kx[%d];\n", q, src);
-      else if (src != -4) fprintf(f, "  K1[%d] = %s;\n", q, src == -2 ? "1" : src == -3 ? "-1" : "0");
-    }
+  if (p->straight) { /* no gather: the readers take K1's other entries from Kx or as literals */
+    fputs("  (void)K1;\n", f);
     for (int e = 0; e < p->nml; e++)
       fprintf(f, "  if (!ldl_ml%d_fixed(Kx, work)) {\n"
                  "    int rc = ldl_ml_pivoting(&ldl_ml[%d], Kx, work);\n    if (rc) return rc;\n  }\n", e, e);
@@ -1587,8 +1620,8 @@ static void emit_factor_entry(FILE *f, const lmodel *L, const ldl_plan *p, const
   fprintf(f, "int %s_ldl_factor(const mb_real *Kx, mb_real *work) {\n", nm);
   /* Kp: the matrix the rest works on (K, or K1 after the massless bodies) */
   if (p->nml)
-    fputs("  int rc1 = ldl_massless(Kx, work);\n  if (rc1) return rc1;\n"
-          "  const mb_real *Kp = work + LDL_K1;\n", f);
+    fprintf(f, "  int rc1 = ldl_massless(Kx, work);\n  if (rc1) return rc1;\n"
+               "  const mb_real *Kp = %s;\n", k1_direct ? "Kx; /* K1's gathered entries are read from Kx */" : "work + LDL_K1");
   else
     fputs("  const mb_real *Kp = Kx;\n", f);
   if (p->nelim) {
@@ -1619,9 +1652,10 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
   int n = p->n, nv = p->nv;
   /* t = P [r_top + D^T W r_bot; r_bot] */
   fputs("/* t = P [r_top + D^T W r_bot; r_bot]: the right side of K_aug, permuted */\n", f);
-  fprintf(f, "static void ldl_aug(const mb_real *Kx,%s const mb_real *r, mb_real *t) {\n",
-          p->nelim ? " const mb_real *Kc," : "");
+  fprintf(f, "static void ldl_aug(const mb_real *Kx,%s%s const mb_real *r, mb_real *t) {\n",
+          p->nelim ? " const mb_real *Kc," : "", k1_direct ? " const mb_real *K1," : "");
   if (p->nelim) fputs("  (void)Kc;\n", f);
+  if (k1_direct) fputs("  (void)K1;\n", f);
   for (int k = 0; k < n; k++) {
     int u = p->perm[k];
     if (ldl_decoupled(p, k)) continue; /* recovered by ldl_block_back / ldl_ml_back */
@@ -1758,12 +1792,12 @@ static void emit_solve_pass(FILE *f, const ldl_plan *p, const char *rhs, const c
     fprintf(f, "%sldl_ml_rhs(Kx, work, %s, r1); /* the massless bodies' right side: K1 */\n", ind, rhs);
   else
     fprintf(f, "%sr1 = %s;\n", ind, rhs);
-  const char *kc = p->straight ? " work + LDL_KR," : "";
+  const char *kc = p->straight ? " work + LDL_KR," : "", *k1 = k1_direct ? " work + LDL_K1," : "";
   if (p->nelim) {
     fprintf(f, "%sldl_block_rhs(Kp, work, r1); /* the block pivots' right side: K' (in place) */\n", ind);
-    fprintf(f, "%sldl_aug(%s,%s r1, t);\n", ind, p->straight ? "Kp" : "work + LDL_KR", kc);
+    fprintf(f, "%sldl_aug(%s,%s%s r1, t);\n", ind, p->straight ? "Kp" : "work + LDL_KR", kc, k1);
   } else {
-    fprintf(f, "%sldl_aug(Kp, r1, t);\n", ind);
+    fprintf(f, "%sldl_aug(Kp,%s r1, t);\n", ind, k1);
   }
   fprintf(f, "%sldl_lsolve(Lx, Dinv, t);\n", ind);
   if (staged) {
@@ -1779,7 +1813,8 @@ static void emit_solve(FILE *f, const ldl_plan *p, const char *nm) {
   fputs("  const mb_real *Lx = work, *Dinv = work + LDL_DINV;\n"
         "  mb_real *x = work + LDL_X, *r = work + LDL_R, *t = work + LDL_T, *xb = work + LDL_XB;\n", f);
   if (staged) fputs("  mb_real *d = work + LDL_DD;\n", f);
-  if (p->nml) fputs("  mb_real *r1 = work + LDL_R1;\n  const mb_real *Kp = work + LDL_K1;\n", f);
+  if (p->nml)
+    fprintf(f, "  mb_real *r1 = work + LDL_R1;\n  const mb_real *Kp = %s;\n", k1_direct ? "Kx" : "work + LDL_K1");
   else fprintf(f, "  const mb_real *Kp = Kx;\n  %smb_real *r1;\n", p->nelim ? "" : "const ");
   if (!p->nw) {
     /* no weighted rows: the factors are those of K itself, and the first
@@ -1924,6 +1959,7 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
   }
   /* the compile-time constants: K1's (massless bodies) and init's entries of Kx */
   k1_map = p.nml && p.straight ? p.K1map : NULL;
+  k1_direct = p.nml && p.straight;
   signed char *cst = p.straight ? calloc((size_t)L->m.nnz + 1, 1) : NULL;
   if (cst)
     for (int r = 0; r < L->m.nrow; r++)
@@ -1960,6 +1996,7 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
   else emit_solve_helpers_looped(f, &p);
   emit_solve(f, &p, nm);
   kc_of = kc_map = k1_map = NULL;
+  k1_direct = 0;
   kx_cst = NULL;
   free(cst);
   free(kc_cst);

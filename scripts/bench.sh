@@ -139,7 +139,7 @@ agree tight_flex2 "$ROOT/models/slider_crank_flexible.yaml" --scene virtual2
 # each: drift of a shared machine then falls on all three alike, and the median of
 # the per-round ratios is quoted with their range.  Separate `mbcc bench` runs,
 # minutes apart, differ by a few per cent on a shared machine.
-ROUNDS=${ROUNDS:-11}
+ROUNDS=${ROUNDS:-21}
 IL_REPS=${IL_REPS:-3}
 interleave() {
   say "interleaved: $ROUNDS rounds of the three flexible slider-crank executables, generated+ldl"
