@@ -445,9 +445,22 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
   }
   for (int r = 0; r < m->nrow; r++)
     if (!emit_row_is_special(&L->row[r])) passed[L->row[r].m0] = passed[L->row[r].m1] = 1;
+  /* read[k]: some row or force element reads marker k (a joint whose rows were
+     all removed as redundant leaves its markers unread: they are not computed) */
+  char *read = calloc(m->nmarker ? (size_t)m->nmarker : 1, 1);
+  if (!read) { fputs("out of memory\n", stderr); exit(1); }
+  for (int i = 0; i < m->nforce; i++) {
+    read[L->force[i].m0] = 1;
+    if (L->force[i].m1 >= 0) read[L->force[i].m1] = 1;
+  }
+  for (int r = 0; r < m->nrow; r++) read[L->row[r].m0] = read[L->row[r].m1] = 1;
   for (int k = 0; k < m->nmarker; k++) {
     const mb_markerdef *d = &L->marker[k];
     fprintf(f, "  /* %s */\n", L->marker_desc[k]);
+    if (!read[k]) {
+      fputs("  /* read by no row or force element: not computed */\n", f);
+      continue;
+    }
     if (!passed[k] && d->body >= 0 && emit_marker_is_frame(L, k)) {
       fprintf(f, "  /* the frame of body '%s' itself: the rows read f%d */\n", L->body[d->body].name, d->body);
       continue;
@@ -466,6 +479,7 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
     }
   }
   free(passed);
+  free(read);
   fprintf(f, "\n  /* body forces: gravity and the quadratic-velocity (gyroscopic) terms */\n");
   for (int b = 0; b < m->nbody; b++) {
     const mb_body *B = &L->body[b];
@@ -474,7 +488,7 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
       int nbk = 6 + B->nm;
       fprintf(f, "  {\n    mb_real AS[9], AS1[%d];\n    mb_flex_step cs;\n    flex%d_contract(q + %d, v + %d, &cs);\n"
                  "    mb_flex_forces(&flex%d, &cs, &f%d, q + %d, v + %d, (const mb_real[3])",
-              3 * B->nm, b, B->qadr + 7, B->vadr + 6, b, b, B->qadr + 7, B->vadr + 6);
+              B->nm ? 3 * B->nm : 1, b, B->qadr + 7, B->vadr + 6, b, b, B->qadr + 7, B->vadr + 6); /* ISO C: no zero-size array */
       vec(f, m->gravity, 3);
       fprintf(f, ", rhs + %d);\n", B->vadr);
       fprintf(f, "    /* the mass blocks that move (mb_flex_assemble without m I and Mff, set by init) */\n"

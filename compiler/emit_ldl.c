@@ -1365,6 +1365,7 @@ static void emit_ml_fixed_rhs(FILE *f, const ldl_plan *p, int e) {
     if (any) fputs(";\n", f);
   }
   for (int c = 0; c < 6; c++) fprintf(f, "    r1[%d] = 0;\n", u[c]);
+  fputs("    (void)z; /* unread when no column of Y meets the body's rows */\n", f);
   fprintf(f, "  } else {\n    ldl_ml_rhs_pivoting(&ldl_ml[%d], Kx, work, r, r1);\n  }\n", e);
 }
 
