@@ -434,34 +434,30 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
     fprintf(f, "  mb_frame f%d;\n  mb_frame_rigid(q + %d, v + %d, &f%d); /* body '%s' */\n", b,
             L->body[b].qadr, L->body[b].vadr, b, L->body[b].name);
   fprintf(f, "\n  /* markers */\n");
-  /* a marker that is its body's frame is not stored when only the spherical
-     and dot-1 rows of emit_row_special read it (they read the frame); forces
-     and the other rows pass markers to kernels by address */
-  char *passed = calloc(m->nmarker ? (size_t)m->nmarker : 1, 1);
-  if (!passed) { fputs("out of memory\n", stderr); exit(1); }
+  /* use[k]: 0 no row or force element reads marker k (a joint whose rows were
+     all removed as redundant): not computed; 1 only the spherical and dot-1
+     rows of emit_row_special read it (they read the frame when the marker is
+     its body's frame: then it is not stored); 2 forces or other rows pass it
+     to kernels by address */
+  char *use = calloc(m->nmarker ? (size_t)m->nmarker : 1, 1);
+  if (!use) { fputs("out of memory\n", stderr); exit(1); }
   for (int i = 0; i < m->nforce; i++) {
-    passed[L->force[i].m0] = 1;
-    if (L->force[i].m1 >= 0) passed[L->force[i].m1] = 1;
+    use[L->force[i].m0] = 2;
+    if (L->force[i].m1 >= 0) use[L->force[i].m1] = 2;
   }
-  for (int r = 0; r < m->nrow; r++)
-    if (!emit_row_is_special(&L->row[r])) passed[L->row[r].m0] = passed[L->row[r].m1] = 1;
-  /* read[k]: some row or force element reads marker k (a joint whose rows were
-     all removed as redundant leaves its markers unread: they are not computed) */
-  char *read = calloc(m->nmarker ? (size_t)m->nmarker : 1, 1);
-  if (!read) { fputs("out of memory\n", stderr); exit(1); }
-  for (int i = 0; i < m->nforce; i++) {
-    read[L->force[i].m0] = 1;
-    if (L->force[i].m1 >= 0) read[L->force[i].m1] = 1;
+  for (int r = 0; r < m->nrow; r++) {
+    char u = emit_row_is_special(&L->row[r]) ? 1 : 2;
+    if (use[L->row[r].m0] < u) use[L->row[r].m0] = u;
+    if (use[L->row[r].m1] < u) use[L->row[r].m1] = u;
   }
-  for (int r = 0; r < m->nrow; r++) read[L->row[r].m0] = read[L->row[r].m1] = 1;
   for (int k = 0; k < m->nmarker; k++) {
     const mb_markerdef *d = &L->marker[k];
     fprintf(f, "  /* %s */\n", L->marker_desc[k]);
-    if (!read[k]) {
+    if (!use[k]) {
       fputs("  /* read by no row or force element: not computed */\n", f);
       continue;
     }
-    if (!passed[k] && d->body >= 0 && emit_marker_is_frame(L, k)) {
+    if (use[k] == 1 && d->body >= 0 && emit_marker_is_frame(L, k)) {
       fprintf(f, "  /* the frame of body '%s' itself: the rows read f%d */\n", L->body[d->body].name, d->body);
       continue;
     }
@@ -478,8 +474,7 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
       emit_marker_special(f, L, k);
     }
   }
-  free(passed);
-  free(read);
+  free(use);
   fprintf(f, "\n  /* body forces: gravity and the quadratic-velocity (gyroscopic) terms */\n");
   for (int b = 0; b < m->nbody; b++) {
     const mb_body *B = &L->body[b];

@@ -811,8 +811,8 @@ static void emit_reduced_rhs(FILE *f, const char *v, int i, int row, const int *
   fputs(";\n", f);
 }
 
-/* the value of Di entry idx of block e when known at compile time (a constant
- * pivot), else the expression "Di[idx]" */
+/* the entries of a block's Du^-1 (Di) known at compile time: the inverses of
+ * its constant 1 x 1 pivots (emit_inv_component) */
 typedef struct {
   char k[36];   /* Di's entries known at compile time */
   double c[36]; /* their values */
