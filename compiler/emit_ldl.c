@@ -194,27 +194,27 @@ static int slot_const(int slot, int k1, double *v) {
   return 1;
 }
 
-/* where the straight-line code reads slot q of the block pivots' space (K1
- * with massless bodies, else Kx), into buf */
-static void kname_buf(char *buf, size_t n, int q) {
-  int s = k1_direct && k1_map ? k1_map[q] : q;
-  if (!k1_direct || !k1_map || s >= 0) snprintf(buf, n, "Kx[%d]", s);
+/* where the straight-line code reads slot q, into buf: of Kx (k1 = 0), or of
+ * the block pivots' space (k1 = 1: K1 with massless bodies, else Kx) */
+static void kname_buf(char *buf, size_t n, int q, int k1) {
+  int s = k1 && k1_direct && k1_map ? k1_map[q] : q;
+  if (!k1 || !k1_direct || !k1_map || s >= 0) snprintf(buf, n, "Kx[%d]", s);
   else if (s == -4) snprintf(buf, n, "K1[%d]", q);
   else snprintf(buf, n, "%s", s == -2 ? "1" : s == -3 ? "-1" : "0");
 }
 
 static void kname(FILE *f, int q) {
   char b[32];
-  kname_buf(b, sizeof b, q);
+  kname_buf(b, sizeof b, q, 1);
   fputs(b, f);
 }
 
 /* "Kx[slot]" (space kput_k1), or its value when it is a compile-time constant */
 static void kput(FILE *f, int slot) {
   double c;
+  char b[32];
   if (slot_const(slot, kput_k1, &c)) num(f, c);
-  else if (kput_k1) kname(f, slot);
-  else fprintf(f, "Kx[%d]", slot);
+  else { kname_buf(b, sizeof b, slot, kput_k1); fputs(b, f); }
 }
 
 /* one term "coef * v" of a sum: coef a C expression, or (known) the constant
@@ -241,8 +241,7 @@ static void put_kterm(FILE *f, int *any, int slot, const char *v) {
   double c;
   char coef[32];
   int known = slot_const(slot, kput_k1, &c);
-  if (kput_k1) kname_buf(coef, sizeof coef, slot);
-  else snprintf(coef, sizeof coef, "Kx[%d]", slot);
+  kname_buf(coef, sizeof coef, slot, kput_k1);
   put_term(f, any, known, c, coef, v);
 }
 
@@ -649,8 +648,7 @@ static int emit_inv_component(FILE *f, const int *slot, const int *comp, int c, 
       if (xk) { xk[d] = 1; xc[d] = 1 / v; }
     } else {
       char a[32];
-      if (kput_k1) kname_buf(a, sizeof a, slot[d]);
-      else snprintf(a, sizeof a, "Kx[%d]", slot[d]);
+      kname_buf(a, sizeof a, slot[d], kput_k1);
       fprintf(f, "    if (!(fabs(%s) > 1e-12 * amax)) %s;\n    %s[%d] = 1 / %s;\n", a, fail, X, d, a);
     }
   } else {
@@ -685,7 +683,7 @@ static void emit_inv_blocked(FILE *f, const int *slot, const char *X, const char
   for (int k = 0; k < 36; k++)
     if (nz[k] && !slot_const(slot[k], kput_k1, &v)) {
       char a[32];
-      kname_buf(a, sizeof a, slot[k]);
+      kname_buf(a, sizeof a, slot[k], kput_k1);
       fprintf(f, "    if (fabs(%s) > amax) amax = fabs(%s);\n", a, a);
     }
   for (int c = 0; c < nb; c++) emit_inv_component(f, slot, comp, c, X, fail, 1, xk, xc);
@@ -905,7 +903,7 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
             int kn = dk[e].k[6 * c6 + i];
             snprintf(vx, sizeof vx, "Di[%d]", 6 * c6 + i);
             if (kn) { /* Di known: the term is Kx * constant, written constant * Kx */
-              kname_buf(ex, sizeof ex, eu[c6]);
+              kname_buf(ex, sizeof ex, eu[c6], 1);
               if (slot_const(eu[c6], 1, &c)) snprintf(ex, sizeof ex, "%.17g", c);
               put_term(f, &any, 1, dk[e].c[6 * c6 + i], "", ex);
             } else {
@@ -932,7 +930,7 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
             if (dx[i] >= 0 && ldl_w_nonzero(eu, dinz[e], i)) {
               snprintf(ex, sizeof ex, "W[%d]", 6 * si + i);
               if (wki[i]) { /* W known: constant * Kx */
-                kname_buf(vx, sizeof vx, dx[i]);
+                kname_buf(vx, sizeof vx, dx[i], 1);
                 if (slot_const(dx[i], 1, &c)) snprintf(vx, sizeof vx, "%.17g", c);
                 put_term(f, &any, 1, wci[i], "", vx);
               } else {

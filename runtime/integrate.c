@@ -231,8 +231,9 @@ static void combine(int ny, const mb_real *y, double h, const double *a, mb_real
  * A loop over the stages for every state costs about three times as many
  * instructions.  The states go in pairs, two like statements that the C
  * compiler turns into one two-wide vector operation each (SLP at -O2); with
- * an odd ny the last pair writes out[ny], the spare element every stage
- * array has (mb_sim_init allocates ny + 1: y[ny] = k_j[ny] = 0, never read). */
+ * an odd ny the last pair reads and writes element ny, the spare one every
+ * stage array has (mb_sim_init allocates ny + 1; y[ny] and k_j[ny] stay 0,
+ * and the model never reads out[ny]). */
 #define DP_PAIRS(E)                                                                                \
   for (int i = 0; i < ny; i += 2) {                                                                \
     { const int l = i; out[l] = y[l] + h * (E); }                                                  \
