@@ -209,12 +209,19 @@ static void kname(FILE *f, int q) {
   fputs(b, f);
 }
 
-/* "Kx[slot]" (space kput_k1), or its value when it is a compile-time constant */
-static void kput(FILE *f, int slot) {
+/* into buf: kname_buf's name of the slot (space k1), or its value when it is
+ * a compile-time constant */
+static void kput_buf(char *buf, size_t n, int slot, int k1) {
   double c;
+  if (slot_const(slot, k1, &c)) snprintf(buf, n, "%.17g", c == 0 ? 0 : c);
+  else kname_buf(buf, n, slot, k1);
+}
+
+/* kput_buf of the slot in the space kput_k1, written to f */
+static void kput(FILE *f, int slot) {
   char b[32];
-  if (slot_const(slot, kput_k1, &c)) num(f, c);
-  else { kname_buf(b, sizeof b, slot, kput_k1); fputs(b, f); }
+  kput_buf(b, sizeof b, slot, kput_k1);
+  fputs(b, f);
 }
 
 /* one term "coef * v" of a sum: coef a C expression, or (known) the constant
@@ -903,8 +910,7 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
             int kn = dk[e].k[6 * c6 + i];
             snprintf(vx, sizeof vx, "Di[%d]", 6 * c6 + i);
             if (kn) { /* Di known: the term is Kx * constant, written constant * Kx */
-              kname_buf(ex, sizeof ex, eu[c6], 1);
-              if (slot_const(eu[c6], 1, &c)) snprintf(ex, sizeof ex, "%.17g", c);
+              kput_buf(ex, sizeof ex, eu[c6], 1);
               put_term(f, &any, 1, dk[e].c[6 * c6 + i], "", ex);
             } else {
               put_kterm(f, &any, eu[c6], vx);
@@ -930,8 +936,7 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
             if (dx[i] >= 0 && ldl_w_nonzero(eu, dinz[e], i)) {
               snprintf(ex, sizeof ex, "W[%d]", 6 * si + i);
               if (wki[i]) { /* W known: constant * Kx */
-                kname_buf(vx, sizeof vx, dx[i], 1);
-                if (slot_const(dx[i], 1, &c)) snprintf(vx, sizeof vx, "%.17g", c);
+                kput_buf(vx, sizeof vx, dx[i], 1);
                 put_term(f, &any, 1, wci[i], "", vx);
               } else {
                 put_kterm(f, &any, dx[i], ex);
