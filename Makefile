@@ -6,40 +6,56 @@ STD     := -std=c11
 ROOT    := $(CURDIR)
 LIBS    := -lyaml -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig -llapack -lblas -lm
 
-RT_SRC  := runtime/model_generic.c runtime/solver_select.c runtime/genalpha.c runtime/solver_klu.c runtime/solver_dense.c runtime/solver_generic.c runtime/solver_ldl.c \
-           runtime/integrate.c runtime/driver.c runtime/ida.c runtime/bench.c
-RT_HDR  := $(wildcard runtime/*.h)
-CC_SRC  := compiler/main.c compiler/reader.c compiler/diag.c compiler/lower.c compiler/fe.c compiler/flex.c \
-           compiler/assemble.c compiler/emit.c compiler/emit_rows.c compiler/order.c compiler/emit_ldl.c \
-           compiler/trade.c compiler/trade_metric.c
-CC_HDR  := $(wildcard compiler/*.h)
+# the runtime: core/ is freestanding (no allocation, no I/O: kernels, model
+# tables, the generic walker); hosted/ holds the integrators, solvers, CSV
+# driver and benchmarks that run on an operating system
+RT_INC  := -Iruntime/core -Iruntime/hosted
+RT_SRC  := runtime/core/model_generic.c \
+           $(addprefix runtime/hosted/,solver_select.c genalpha.c solver_klu.c solver_dense.c \
+             solver_generic.c solver_ldl.c integrate.c driver.c ida.c bench.c)
+# the compiler, one folder a stage: front (YAML -> IR), flex (FE models and
+# modal reduction), lower (IR -> coordinates, rows, pattern, assembly),
+# back (ordering, LDL^T plan, C emission), tools (trade)
+CC_DIRS := compiler/front compiler/flex compiler/lower compiler/back compiler/tools
+CC_INC  := -Icompiler $(addprefix -I,$(CC_DIRS)) $(RT_INC)
+CC_SRC  := compiler/main.c $(foreach d,$(CC_DIRS),$(wildcard $(d)/*.c))
 B       ?= build
+DEPFLAGS = -MMD -MP
 
 .PHONY: all test demo clean sanitize docs bench trade extremes
 all: $(B)/mbcc $(B)/libmbrt.a $(B)/libmbrt_float.a
 
-$(B)/rt/%.o: runtime/%.c $(RT_HDR)
-	@mkdir -p $(B)/rt
-	$(CC) $(STD) $(WARN) $(CFLAGS) -Iruntime -c $< -o $@
+# objects keep the source's folders: $(B)/rt/core/x.o, $(B)/cc/front/x.o
+$(B)/rt/%.o: runtime/%.c
+	@mkdir -p $(@D)
+	$(CC) $(STD) $(WARN) $(CFLAGS) $(DEPFLAGS) $(RT_INC) -c $< -o $@
 
 $(B)/libmbrt.a: $(patsubst runtime/%.c,$(B)/rt/%.o,$(RT_SRC))
 	rm -f $@ && ar rcs $@ $^
 
 # the single-precision runtime (mbcc compile --real float): the emitted LDL^T
 # only, since KLU, LAPACK and SUNDIALS work in double
-RT_FLOAT_SRC := runtime/model_generic.c runtime/solver_select.c runtime/solver_ldl.c \
-                runtime/integrate.c runtime/genalpha.c runtime/driver.c
-$(B)/rt-float/%.o: runtime/%.c $(RT_HDR)
-	@mkdir -p $(B)/rt-float
-	$(CC) $(STD) $(WARN) $(CFLAGS) -DMB_REAL_FLOAT -Iruntime -c $< -o $@
+RT_FLOAT_SRC := runtime/core/model_generic.c \
+                $(addprefix runtime/hosted/,solver_select.c solver_ldl.c integrate.c genalpha.c driver.c)
+$(B)/rt-float/%.o: runtime/%.c
+	@mkdir -p $(@D)
+	$(CC) $(STD) $(WARN) $(CFLAGS) $(DEPFLAGS) -DMB_REAL_FLOAT $(RT_INC) -c $< -o $@
 
 $(B)/libmbrt_float.a: $(patsubst runtime/%.c,$(B)/rt-float/%.o,$(RT_FLOAT_SRC))
 	rm -f $@ && ar rcs $@ $^
 
-$(B)/mbcc: $(CC_SRC) $(CC_HDR) $(B)/libmbrt.a
-	$(CC) $(STD) $(WARN) $(CFLAGS) -Icompiler -Iruntime -DMBCC_ROOT='"$(ROOT)"' \
-	  -DMBCC_RTLIB='"$(ROOT)/$(B)/libmbrt.a"' -DMBCC_GEN_CFLAGS='"$(CFLAGS)"' \
-	  $(CC_SRC) $(B)/libmbrt.a $(LIBS) -lcamd -o $@
+# where the built mbcc finds its templates, runtime headers and library
+CC_DEFS := -DMBCC_ROOT='"$(ROOT)"' -DMBCC_RTLIB='"$(ROOT)/$(B)/libmbrt.a"' -DMBCC_GEN_CFLAGS='"$(CFLAGS)"'
+$(B)/cc/%.o: compiler/%.c
+	@mkdir -p $(@D)
+	$(CC) $(STD) $(WARN) $(CFLAGS) $(DEPFLAGS) $(CC_INC) $(CC_DEFS) -c $< -o $@
+
+CC_OBJ := $(patsubst compiler/%.c,$(B)/cc/%.o,$(CC_SRC))
+$(B)/mbcc: $(CC_OBJ) $(B)/libmbrt.a
+	$(CC) $(CFLAGS) $(CC_OBJ) $(B)/libmbrt.a $(LIBS) -lcamd -o $@
+
+-include $(CC_OBJ:.o=.d) $(patsubst runtime/%.c,$(B)/rt/%.d,$(RT_SRC)) \
+         $(patsubst runtime/%.c,$(B)/rt-float/%.d,$(RT_FLOAT_SRC))
 
 demo: all
 	$(B)/mbcc run models/slider_crank.yaml

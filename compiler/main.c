@@ -332,9 +332,10 @@ static void settings_from_ir(const ir_sim *s, mb_settings *set) {
  * runtime library into 'exe'; 'extra' are more libraries (NULL-terminated) */
 int compile_generated(const char *dir, const char *name, const char *main_src, const char *exe,
                       char *const extra[], int quiet, int real_float) {
-  char src_c[8400], inc[8400], lib[8400];
+  char src_c[8400], inc[8400], inc_hosted[8400], lib[8400];
   snprintf(src_c, sizeof src_c, "%s/%s.c", dir, name);
-  snprintf(inc, sizeof inc, "-I%s/runtime", root_dir());
+  snprintf(inc, sizeof inc, "-I%s/runtime/core", root_dir());
+  snprintf(inc_hosted, sizeof inc_hosted, "-I%s/runtime/hosted", root_dir());
   const char *rtlib = getenv("MBCC_RTLIB");
   snprintf(lib, sizeof lib, "%s", rtlib && *rtlib ? rtlib : MBCC_RTLIB);
   if (real_float) {
@@ -352,7 +353,7 @@ int compile_generated(const char *dir, const char *name, const char *main_src, c
   ccargs[nc++] = "-std=c99";
   if (real_float) ccargs[nc++] = "-DMB_REAL_FLOAT";
   for (char *tok = strtok(flags, " "); tok && nc < 40; tok = strtok(NULL, " ")) ccargs[nc++] = tok;
-  char *rest[] = {inc, "-o", (char *)exe, src_c, (char *)main_src, lib, NULL};
+  char *rest[] = {inc, inc_hosted, "-o", (char *)exe, src_c, (char *)main_src, lib, NULL};
   for (int i = 0; rest[i]; i++) ccargs[nc++] = rest[i];
   for (int i = 0; extra && extra[i] && nc < 60; i++) ccargs[nc++] = extra[i];
   char *libs[] = {"-lklu", "-lamd", "-lcolamd", "-lbtf", "-lsuitesparseconfig", "-llapack",

@@ -107,7 +107,7 @@ method() {
 ## Method
 
 `mbcc trade M.yaml [--scene S]` answers, for one model, what each unit of speed costs
-in accuracy (compiler/trade.c; the pure parts in compiler/trade_metric.c).
+in accuracy (compiler/tools/trade.c; the pure parts in compiler/tools/trade_metric.c).
 
 **Reference.** The most accurate settings the study knows: the largest number of modes
 swept (`--modes`; `all` if listed), full inertia coupling, joints directly on the

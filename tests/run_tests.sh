@@ -48,7 +48,7 @@ for t in tests/test_*.c; do
     g=$(gen_name "$m"); d=$(gen_dir "$m")
     srcs+=("$d/$g.c"); incs+=("-I$d")
   done
-  if [ $ok = 1 ] && ! $CC -std=c11 -Wall -Wextra -Werror $CFLAGS -Iruntime -Icompiler -Itests "${incs[@]}" \
+  if [ $ok = 1 ] && ! $CC -std=c11 -Wall -Wextra -Werror $CFLAGS -Iruntime/core -Iruntime/hosted -Icompiler/front -Icompiler/flex -Icompiler/lower -Icompiler/back -Itests "${incs[@]}" \
         "$t" "${srcs[@]}" tests/support.c "$B/libmbrt.a" $LIBS -o "$B/tests/$name" 2> "$B/tests/$name.build.log"; then
     cat "$B/tests/$name.build.log"; echo "FAIL $name: does not build"; ok=0
   fi

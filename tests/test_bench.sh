@@ -61,7 +61,7 @@ else
   err "mbcc bench at rtol 1e-12 failed: $(tail -5 tight.txt)"
 fi
 # IDA at rtol 1e-13 on the flexible slider-crank: its multipliers' Newton weights
-# (runtime/ida.c, set_tolerances) let it converge where atol alone made it fail at
+# (runtime/hosted/ida.c, set_tolerances) let it converge where atol alone made it fail at
 # t = 0.0024; it agrees on positions, and the CSV names the worst position output
 flex="$root/models/slider_crank_flexible.yaml"
 if "$MBCC" bench "$flex" --end 0.01 --reps 1 --paths generated+ldl,ida --rtol 1e-12 --atol 1e-14 \

@@ -1,11 +1,11 @@
-/* test_fe.c: the beam finite elements and the modal reduction (compiler/fe.c):
+/* test_fe.c: the beam finite elements and the modal reduction (compiler/flex/fe.c):
  * Euler-Bernoulli convergence to the clamped-free closed form (h^4 with the
  * consistent mass, h^2 lumped), Timoshenko against Euler-Bernoulli and against
  * the simply supported Timoshenko closed form, Craig-Bampton against the full
  * FE model, mass normalization, lumped masses, axial modes, invariance under a
  * rotation of the model, the modal data file round trip and its diagnostics,
  * and the errors for bad FE data. */
-#include "../compiler/fe.c"
+#include "../compiler/flex/fe.c"
 
 #include <stdio.h>
 #include <stdlib.h>

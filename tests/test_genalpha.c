@@ -1,4 +1,4 @@
-/* test_genalpha.c: the implicit generalized-alpha integrator (runtime/genalpha.c).
+/* test_genalpha.c: the implicit generalized-alpha integrator (runtime/hosted/genalpha.c).
  *   - second-order convergence: fixed steps h, h/2, h/4 on the pendulum at
  *     90 degrees against a DOPRI5 solution at rtol 1e-11 (itself checked
  *     against the exact elliptic period in test_pendulum.c);

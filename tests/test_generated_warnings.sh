@@ -28,7 +28,7 @@ for f in "$root"/models/*.yaml "$root"/tests/models/*.yaml; do
     fi
     for c in "$d"/*.c; do
       case $c in */main.c) continue ;; esac
-      "$CC" -std=c99 -Wall -Wextra -Werror -pedantic -O1 -I"$root/runtime" -c "$c" -o "$tmp/x.o" > "$tmp/cc.log" 2>&1 ||
+      "$CC" -std=c99 -Wall -Wextra -Werror -pedantic -O1 -I"$root/runtime/core" -I"$root/runtime/hosted" -c "$c" -o "$tmp/x.o" > "$tmp/cc.log" 2>&1 ||
         err "$(basename "$f") ${args[*]}: $(grep -m1 error "$tmp/cc.log")"
       n=$((n + 1))
     done

@@ -1,4 +1,4 @@
-/* test_ida.c: the SUNDIALS IDA path (runtime/ida.c, the DAE in [q; v; lambda])
+/* test_ida.c: the SUNDIALS IDA path (runtime/hosted/ida.c, the DAE in [q; v; lambda])
  * against the built-in integrator and against closed-form kinematics:
  *   - the pendulum (m = 1 kg, l = 1 m, released at 90 degrees; models/pendulum.yaml)
  *     over 2 s: every output column (position, angle, energies, the pivot

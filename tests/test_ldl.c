@@ -1,4 +1,4 @@
-/* test_ldl.c: the emitted LDL^T (solver "ldl", compiler/emit_ldl.c).
+/* test_ldl.c: the emitted LDL^T (solver "ldl", compiler/back/emit_ldl.c).
  *   - for every shipped model and fd_all (virtual bodies, the massless
  *     slider: zero pivots without the augmented-Lagrangian term) at a few
  *     states near q0 with random velocities, random right sides and the

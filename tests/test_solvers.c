@@ -51,7 +51,7 @@ static void klu_vs_dense(void **state) {
 /* Generated code against the generic path: the same kernels with the same
  * tables, their compile-time zeros and ones folded; the dot-1 rows between two
  * bodies' own axes are written from the relative rotation A0^T A1 (identities
- * exact for orthonormal A, compiler/emit_rows.c).  So the two differ by
+ * exact for orthonormal A, compiler/back/emit_rows.c).  So the two differ by
  * round-off only, as KLU and dense LU do: 1e-9 of the range, as above (energy,
  * nearly constant, has the smallest range). */
 static void generated_vs_generic(void **state) {

@@ -1,4 +1,4 @@
-/* test_trade.c: `mbcc trade` (compiler/trade_metric.c, compiler/trade.c):
+/* test_trade.c: `mbcc trade` (compiler/tools/trade_metric.c, compiler/tools/trade.c):
  * - the error metric on synthetic data with hand-derived answers (ranges,
  *   vector columns sharing a scale, the fallbacks, RMS, NaN = failure);
  * - the Pareto front on a hand-drawn set (ties, failed runs) and, on random
@@ -13,7 +13,7 @@
  *   [0.5, 2]: the stricter run is accurate enough that the difference is the
  *   reference's error; with the default reference (rtol 1e-10) the true error
  *   is at most twice the reported one plus the CSV's print rounding (1e-11). */
-#include "../compiler/trade_metric.c"
+#include "../compiler/tools/trade_metric.c"
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -149,7 +149,7 @@ md "tests/extremes/models/beam_10khz.yaml: the hinged aluminium beam with all 49
 md "constrained modes up to 9.65 kHz, released under gravity, 0.05 s.  DOPRI5"
 md "is stable only for steps below about 3.3/ω_max = 5.4e-5 s whatever its"
 md "tolerance; the implicit generalized-α method (\`--integrator genalpha\`,"
-md "runtime/genalpha.c) takes the steps the accuracy needs, with the modal"
+md "runtime/hosted/genalpha.c) takes the steps the accuracy needs, with the modal"
 md "stiffness and damping in its Newton matrix on K's pattern.  The reference"
 md "is DOPRI5 at rtol 1e-9.  Statement: genalpha at rtol 1e-5 within 1e-3 of"
 md "the tip's range, in at least 10 times fewer steps than DOPRI5."

@@ -51,7 +51,7 @@ mb_solver *mb_solver_dense(const mb_model *m);
  * summing duplicates), then KLU (symbolic analysis reused while the assembled
  * pattern does not change) or LAPACK dense LU. */
 mb_solver *mb_solver_generic(const mb_model *m, int dense);
-/* the LDL^T emitted with the model (m->ldl_factor, compiler/emit_ldl.c); NULL
+/* the LDL^T emitted with the model (m->ldl_factor, compiler/back/emit_ldl.c); NULL
  * when the model has none */
 mb_solver *mb_solver_ldl(const mb_model *m);
 /* ldl's default check_every on models without weighted rows: the residual of one

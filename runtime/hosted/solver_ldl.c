@@ -1,5 +1,5 @@
 /* solver_ldl.c: K x = b with the LDL^T that the compiler emitted with the
- * model (m->ldl_factor / m->ldl_solve, compiler/emit_ldl.c): pattern,
+ * model (m->ldl_factor / m->ldl_solve, compiler/back/emit_ldl.c): pattern,
  * ordering and every index fixed at compile time.  This wrapper only holds
  * the workspace and the K that was factored (the solve reads it: the massless
  * bodies' right side, the residual and the refinement): a copy, or the

@@ -117,7 +117,7 @@ typedef struct mb_model {
   const char *const *col_name; /* their names */
   mb_eval_fn eval;
   void (*init)(const struct mb_model *m, mb_real *Kx); /* the constant entries of K */
-  /* the emitted LDL^T of K (solver "ldl", compiler/emit_ldl.c); NULL / 0 when the
+  /* the emitted LDL^T of K (solver "ldl", compiler/back/emit_ldl.c); NULL / 0 when the
    * model has none (the generic path).  factor: 0, or 1 + the unknown whose pivot
    * is zero or tiny; solve: K x = b in place with refinement on the exact system,
    * residual[0] = ||b - K x||_inf / (||K||_inf ||x||_inf + ||b||_inf), residual[1]

@@ -75,7 +75,7 @@ static void emit_flex_tables(FILE *f, const lmodel *L, int b);
 static void emit_flex_contract(FILE *f, const lmodel *L, int b);
 
 /* entry (i, l) of a flexible body's mass matrix from the moving blocks of
- * mb_flex_assemble (runtime/mb_flex.h): AS = A S~, AS1 = A S1, cs.J, cs.Gw */
+ * mb_flex_assemble (runtime/core/mb_flex.h): AS = A S~, AS1 = A S1, cs.J, cs.Gw */
 static void flex_moving_entry(char *e, size_t size, int i, int l) {
   int bi = i < 3 ? 0 : i < 6 ? 1 : 2, bl = l < 3 ? 0 : l < 6 ? 1 : 2;
   if (bi > bl) { int t = i; i = l; l = t; t = bi; bi = bl; bl = t; } /* symmetric */
@@ -320,9 +320,9 @@ static void emit_sum(FILE *f, const char *lhs, double c0, const double *coef, co
 }
 
 /* a flexible body's per-step contractions (mb_flex_contract in
- * runtime/mb_flex.h) straight-line: the invariants' nonzero entries as
+ * runtime/core/mb_flex.h) straight-line: the invariants' nonzero entries as
  * literal constants, zeros skipped (the tables are cleaned of rounding
- * residue in compiler/flex.c, so the generic path sums the same terms) */
+ * residue in compiler/flex/flex.c, so the generic path sums the same terms) */
 static void emit_flex_contract(FILE *f, const lmodel *L, int b) {
   const mb_body *B = &L->body[b];
   const mb_flex *x = B->flex;

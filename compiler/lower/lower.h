@@ -1,6 +1,6 @@
 /* lower.h: the lowered model: the IR turned into coordinates, markers,
  * constraint rows, force and output tables, and the fixed CSC pattern of
- * K = [M D^T; D 0] -- an mb_model (runtime/mb_model.h) that owns its tables,
+ * K = [M D^T; D 0] -- an mb_model (runtime/core/mb_model.h) that owns its tables,
  * plus where each entry came from (for diagnostics and generated comments). */
 #ifndef MBCC_LOWER_H
 #define MBCC_LOWER_H

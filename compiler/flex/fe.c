@@ -39,7 +39,7 @@
 #include "fe.h"
 
 /* LAPACK / BLAS (Fortran interfaces; one-character arguments, no hidden lengths,
- * as in runtime/solver_dense.c) */
+ * as in runtime/hosted/solver_dense.c) */
 void dpotrf_(const char *uplo, const int *n, double *a, const int *lda, int *info);
 void dpotrs_(const char *uplo, const int *n, const int *nrhs, const double *a, const int *lda,
              double *b, const int *ldb, int *info);

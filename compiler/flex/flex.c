@@ -76,7 +76,7 @@ int flex_build(const ir_flex *fx, const fe_modes *fm, flex_data *out, char *err,
   /* the shapes' rounding residue (an in-plane mode's out-of-plane entries
      come out of the eigensolver at 1e-30 and below) becomes exact zeros, as
      the invariants' below: the same tables for both paths, and the generated
-     code drops them (compiler/emit_rows.c, a node marker's modal sums) */
+     code drops them (compiler/back/emit_rows.c, a node marker's modal sums) */
   clean_table(out->node_X, n3 * (size_t)nn);
   clean_table(out->node_Psi, n3 * (size_t)nn);
   /* invariants: sums over the nodes' lumped masses m_k and rotary inertias J_k */
@@ -120,7 +120,7 @@ int flex_build(const ir_flex *fx, const fe_modes *fm, flex_data *out, char *err,
      largest entry, where the smallest true entries are above 1e-7 of it in
      the shipped models; entries below 1e-10 of the largest are set to zero,
      so that both paths use the same tables and the generated code can drop
-     them (compiler/emit.c, the flexible body's contractions) */
+     them (compiler/back/emit.c, the flexible body's contractions) */
   clean_table(out->S1, 3 * (size_t)nm);
   clean_table(out->E, 9 * (size_t)nm);
   clean_table(out->F, 9 * (size_t)nm * (size_t)nm);

@@ -166,7 +166,7 @@ static inline void mb_node_cols_mk(const mb_frame *f, const mb_flex *fx, int k, 
  *   S1wd = S1 wd,  Cw = CPsi wd.
  * mb_flex_contract computes them with loops over the tables (the generic
  * path); the generated code computes the same sums straight-line with the
- * invariants' nonzero entries as literal constants (compiler/emit.c). */
+ * invariants' nonzero entries as literal constants (compiler/back/emit.c). */
 typedef struct {
   mb_real S[3], J[9], S1wd[3], Cw[3];
   mb_real Fw[9 * MB_MAX_MODES]; /* Fw_j at Fw + 9 j (zero unless coupling is partial or full) */

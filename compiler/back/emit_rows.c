@@ -1,7 +1,7 @@
 /* emit_rows.c: the markers on rigid bodies and the spherical and dot-1 rows of
  * the generated evaluation, written out expression by expression.
  *
- * The kernels of runtime/mb_kernels.h (mb_marker_rigid, mb_prim_sph,
+ * The kernels of runtime/core/mb_kernels.h (mb_marker_rigid, mb_prim_sph,
  * mb_prim_dot1, mb_row_phidot, mb_row_gamma, mb_rigid_cols) are general: a
  * spherical row's Jacobian is a unit vector, a dot-1 row has no point terms,
  * a rigid marker's angular acceleration term is zero, a ground marker does
