@@ -86,6 +86,92 @@ static void flex_moving_entry(char *e, size_t size, int i, int l) {
   else snprintf(e, size, "0 /* constant block */");
 }
 
+static const char *force_kind_name(mb_force_kind kind) {
+  switch (kind) {
+  case MB_FORCE_POINT: return "MB_FORCE_POINT";
+  case MB_FORCE_TORQUE: return "MB_FORCE_TORQUE";
+  case MB_FORCE_SPRING: return "MB_FORCE_SPRING";
+  case MB_FORCE_FIELD: return "MB_FORCE_FIELD";
+  }
+  return "0";
+}
+
+static const char *law_kind_name(mb_law_kind kind) {
+  switch (kind) {
+  case MB_LAW_NONE: return "MB_LAW_NONE";
+  case MB_LAW_LINEAR: return "MB_LAW_LINEAR";
+  case MB_LAW_POWER: return "MB_LAW_POWER";
+  case MB_LAW_TABLE: return "MB_LAW_TABLE";
+  }
+  return "0";
+}
+
+/* what a force kind's parameters are, for the comment above them in force_prm */
+static const char *force_prm_layout(mb_force_kind kind) {
+  switch (kind) {
+  case MB_FORCE_POINT: return "force vector";
+  case MB_FORCE_TORQUE: return "torque vector";
+  case MB_FORCE_SPRING: return "free length, preload";
+  case MB_FORCE_FIELD: return "d0[3], K[36], C[36], preload[6]";
+  }
+  return "";
+}
+
+/* the force records (kind and addresses) and their pools: force_prm, force_laws */
+static void emit_force_tables(FILE *f, const lmodel *L) {
+  const mb_model *m = &L->m;
+  fprintf(f, "static const mb_forcedef forces[%d] = {\n", m->nforce);
+  for (int k = 0; k < m->nforce; k++) {
+    const mb_forcedef *d = &L->force[k];
+    const ir_force *F = &L->ir->forces[L->force_ir[k]];
+    fprintf(f, "  /* force '%s' (", F->name);
+    loc_comment(f, L, F->loc);
+    fprintf(f, ") */\n  {.kind = %s, .m0 = %d, .m1 = %d, .padr = %d, .pnum = %d", force_kind_name(d->kind),
+            d->m0, d->m1, d->padr, d->pnum);
+    if (d->lnum) fprintf(f, ", .ladr = %d, .lnum = %d", d->ladr, d->lnum);
+    if (d->snum) fprintf(f, ", .sadr = %d, .snum = %d", d->sadr, d->snum);
+    fprintf(f, ", .profile = %d", d->profile);
+    if (d->local) fputs(", .local = 1", f);
+    fputs("},\n", f);
+  }
+  fputs("};\n", f);
+  if (m->nforce_prm) {
+    fprintf(f, "static const mb_real force_prm[%d] = {\n", m->nforce_prm);
+    for (int k = 0; k < m->nforce; k++) {
+      const mb_forcedef *d = &L->force[k];
+      if (!d->pnum) continue;
+      fprintf(f, "  /* %d: force '%s': %s */", d->padr, L->ir->forces[L->force_ir[k]].name,
+              force_prm_layout(d->kind));
+      int group = d->kind == MB_FORCE_FIELD ? MB_FIELD_K : 0; /* d0 on a line of its own */
+      for (int i = 0; i < d->pnum; i++) {
+        fputs(i == 0 || (i >= group && (i - group) % 6 == 0) ? "\n  " : " ", f);
+        num(f, L->force_prm[d->padr + i]);
+        fputc(',', f);
+      }
+      fputc('\n', f);
+    }
+    fputs("};\n", f);
+  }
+  if (m->nforce_law) {
+    fprintf(f, "static const mb_law force_laws[%d] = {\n", m->nforce_law);
+    for (int k = 0; k < m->nforce; k++) {
+      const mb_forcedef *d = &L->force[k];
+      for (int l = 0; l < d->lnum; l++) {
+        const mb_law *law = &L->force_law[d->ladr + l];
+        fprintf(f, "  /* %d: force '%s', %s */\n  {.kind = %s", d->ladr + l,
+                L->ir->forces[L->force_ir[k]].name, l == MB_SPRING_STIFFNESS ? "stiffness" : "damping",
+                law_kind_name(law->kind));
+        if (law->coef != 0) { fputs(", .coef = ", f); num(f, law->coef); }
+        if (law->exponent != 0) { fputs(", .exponent = ", f); num(f, law->exponent); }
+        if (law->kind == MB_LAW_TABLE)
+          fprintf(f, ", .ntable = %d, .table = force%d_law%d_table", law->ntable, k, l);
+        fputs("},\n", f);
+      }
+    }
+    fputs("};\n", f);
+  }
+}
+
 /* the tables: bodies, markers, rows, forces, profiles, outputs */
 static void emit_tables(FILE *f, const lmodel *L) {
   const mb_model *m = &L->m;
@@ -107,13 +193,14 @@ static void emit_tables(FILE *f, const lmodel *L) {
   }
   for (int k = 0; k < m->nforce; k++) {
     const mb_forcedef *d = &L->force[k];
-    const mb_law *laws[2] = {&d->stiffness, &d->damping};
-    for (int l = 0; l < 2; l++)
-      if (laws[l]->kind == MB_LAW_TABLE) {
+    for (int l = 0; l < d->lnum; l++) {
+      const mb_law *law = &L->force_law[d->ladr + l];
+      if (law->kind == MB_LAW_TABLE) {
         char nm[64];
         snprintf(nm, sizeof nm, "force%d_law%d_table", k, l);
-        real_array(f, nm, laws[l]->table, 2 * laws[l]->ntable);
+        real_array(f, nm, law->table, 2 * law->ntable);
       }
+    }
   }
   if (m->nbody) {
     fprintf(f, "static const mb_body bodies[%d] = {\n", m->nbody);
@@ -174,34 +261,7 @@ static void emit_tables(FILE *f, const lmodel *L) {
     }
     fputs("};\n", f);
   }
-  if (m->nforce) {
-    fprintf(f, "static const mb_forcedef forces[%d] = {\n", m->nforce);
-    for (int k = 0; k < m->nforce; k++) {
-      const mb_forcedef *d = &L->force[k];
-      const ir_force *F = &L->ir->forces[L->force_ir[k]];
-      fprintf(f, "  /* force '%s' (", F->name);
-      loc_comment(f, L, F->loc);
-      fprintf(f, ") */\n  {%d, %d, %d, ", d->kind, d->m0, d->m1);
-      vec(f, d->vec, 3);
-      fprintf(f, ", %d, %d, ", d->body_frame, d->profile);
-      const mb_law *laws[2] = {&d->stiffness, &d->damping};
-      for (int l = 0; l < 2; l++) {
-        fprintf(f, "{%d, ", laws[l]->kind);
-        num(f, laws[l]->coef);
-        fputs(", ", f);
-        num(f, laws[l]->exponent);
-        if (laws[l]->kind == MB_LAW_TABLE)
-          fprintf(f, ", %d, force%d_law%d_table}, ", laws[l]->ntable, k, l);
-        else
-          fputs(", 0, 0}, ", f);
-      }
-      num(f, d->L0); fputs(", ", f); num(f, d->preload); fputs(", ", f);
-      vec(f, d->d0, 3); fputs(", ", f); vec(f, d->K, 36); fputs(", ", f); vec(f, d->C, 36); fputs(", ", f);
-      vec(f, d->pre, 6);
-      fputs("},\n", f);
-    }
-    fputs("};\n", f);
-  }
+  if (m->nforce) emit_force_tables(f, L);
   if (m->nprofile) {
     fprintf(f, "static const mb_profile profiles[%d] = {\n", m->nprofile);
     for (int k = 0; k < m->nprofile; k++) {
@@ -528,10 +588,10 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
       if (d->profile >= 0) fprintf(f, "    mb_profile_eval(&profiles[%d], t, x);\n    s = x[0];\n", d->profile);
       for (int j = 0; j < 3; j++) {
         fprintf(f, "    val[%d] = s * ", j);
-        num(f, d->vec[j]);
+        num(f, L->force_prm[d->padr + MB_POINT_VEC + j]);
         fputs(";\n", f);
       }
-      if (d->body_frame) fprintf(f, "    mb_mul3(f%d.A, val, val);\n", b0);
+      if (d->local) fprintf(f, "    mb_mul3(f%d.A, val, val);\n", b0);
       {
         char P[32];
         snprintf(P, sizeof P, "k%d.P", d->m0);
@@ -543,12 +603,8 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
     }
     case MB_FORCE_SPRING:
       fprintf(f, "    mb_real F0[3], F1[3];\n"
-                 "    mb_force_spring(&k%d, &k%d, &forces[%d].stiffness, &forces[%d].damping, ",
-              d->m0, d->m1, k, k);
-      num(f, d->L0);
-      fputs(", ", f);
-      num(f, d->preload);
-      fputs(", F0, F1);\n", f);
+                 "    mb_spring(&k%d, &k%d, force_prm + %d, force_laws + %d, F0, F1, 0);\n",
+              d->m0, d->m1, d->padr, d->ladr);
       if (b0 >= 0) {
         char P[32];
         snprintf(P, sizeof P, "k%d.P", d->m0);
@@ -562,8 +618,8 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
       break;
     case MB_FORCE_FIELD:
       fprintf(f, "    mb_real F[3], T[3];\n"
-                 "    mb_force_field(&k%d, &k%d, forces[%d].d0, forces[%d].K, forces[%d].C, forces[%d].pre, F, T);\n",
-              d->m0, d->m1, k, k, k, k);
+                 "    mb_field(&k%d, &k%d, force_prm + %d, F, T, 0);\n",
+              d->m0, d->m1, d->padr);
       if (b0 >= 0)
         fputs("    mb_real mF[3] = {-F[0], -F[1], -F[2]}, mT[3] = {-T[0], -T[1], -T[2]};\n", f);
       if (b1 >= 0) {
@@ -734,6 +790,10 @@ static void emit_source(FILE *f, const lmodel *L, const char *nm) {
           m->nbody ? "bodies" : "0", m->nmarker ? "markers" : "0", m->nrow ? "rows" : "0",
           m->nforce ? "forces" : "0", m->nprofile ? "profiles" : "0",
           m->noutput ? "outputs" : "0", m->njoint ? "joint_names" : "0");
+  if (m->nforce_prm || m->nforce_law)
+    fprintf(f, "  .force_prm = %s, .nforce_prm = %d, .force_law = %s, .nforce_law = %d,\n",
+            m->nforce_prm ? "force_prm" : "0", m->nforce_prm, m->nforce_law ? "force_laws" : "0",
+            m->nforce_law);
   fputs("  .gravity = ", f);
   vec(f, m->gravity, 3);
   fprintf(f, ",\n  .Kp = Kp, .Ki = %s, .q0 = %s, .v0 = %s, .modal_slot = %s,\n", m->nnz ? "Ki" : "0",
@@ -746,6 +806,8 @@ static void emit_source(FILE *f, const lmodel *L, const char *nm) {
 /* the model's simulation settings as C statements on an mb_settings 's' */
 static void settings_block(FILE *f, const ir_sim *s) {
   static const char *const integrators[] = {"MB_RK4", "MB_DOPRI5", "MB_GENALPHA", "MB_AUTO"};
+  _Static_assert(sizeof integrators / sizeof *integrators == INTEGRATOR_AUTO + 1,
+                 "one runtime integrator name per ir_integrator");
   fprintf(f, "  s.integrator = %s;\n", integrators[s->integrator]);
   const char *names[] = {"end_time", "output_step", "step", "rtol", "atol", "min_step", "max_step",
                          "alpha", "beta", "rho_inf"};

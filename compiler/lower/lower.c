@@ -10,6 +10,18 @@
 #include "diag.h"
 #include "lower.h"
 
+/* The IR's profile and law kinds are copied into the runtime's by value
+   (add_profile, the spring's laws): the two enumerations must agree. */
+_Static_assert((int)PROFILE_CONSTANT == (int)MB_PROFILE_CONSTANT &&
+                   (int)PROFILE_CONSTANT_VELOCITY == (int)MB_PROFILE_CONSTANT_VELOCITY &&
+                   (int)PROFILE_POLYNOMIAL == (int)MB_PROFILE_POLYNOMIAL &&
+                   (int)PROFILE_RAMP == (int)MB_PROFILE_RAMP && (int)PROFILE_SINE == (int)MB_PROFILE_SINE &&
+                   (int)PROFILE_TABLE == (int)MB_PROFILE_TABLE,
+               "ir_profile_kind and mb_profile_kind differ");
+_Static_assert((int)LAW_NONE == (int)MB_LAW_NONE && (int)LAW_LINEAR == (int)MB_LAW_LINEAR &&
+                   (int)LAW_POWER == (int)MB_LAW_POWER && (int)LAW_TABLE == (int)MB_LAW_TABLE,
+               "ir_law_kind and mb_law_kind differ");
+
 static char *xstrdup_printf(const char *fmt, const char *a, const char *b, const char *c) {
   char buf[512];
   snprintf(buf, sizeof buf, fmt, a, b, c);
@@ -63,11 +75,19 @@ static void natural_spline(const double *d, int n, double *m2) {
   }
 }
 
+/* n zeroed reals of the force parameter pool for force record d */
+static double *force_prm(lmodel *L, mb_forcedef *d, int n) {
+  d->padr = L->m.nforce_prm;
+  d->pnum = n;
+  L->m.nforce_prm += n;
+  return L->force_prm + d->padr;
+}
+
 static int add_profile(lmodel *L, const ir_profile *p, int driver, int force) {
   int k = L->m.nprofile++;
   mb_profile *P = &L->profile[k];
   memset(P, 0, sizeof *P);
-  P->kind = (int)p->kind; /* the IR and runtime enumerations agree */
+  P->kind = (mb_profile_kind)p->kind; /* the enumerations agree (asserted above) */
   for (int j = 0; j < 8; j++) P->c[j] = p->c[j];
   P->nc = p->nc;
   L->profile_driver[k] = driver;
@@ -135,7 +155,7 @@ static const char *joint_kind_name(ir_joint_kind k) {
   return n[k];
 }
 
-static void add_row(lmodel *L, int kind, int m0, int m1, int a, int b, const char *what,
+static void add_row(lmodel *L, mb_prim_kind kind, int m0, int m1, int a, int b, const char *what,
                     int joint, int driver, ir_loc loc, const char *elem, const char *ekind) {
   int r = L->m.nrow++;
   mb_rowdef *R = &L->row[r];
@@ -213,7 +233,7 @@ static int output_columns(const ir_output *o) {
   }
 }
 
-static const int out_kind_map[] = {
+static const mb_output_kind out_kind_map[] = {
     [OUT_POSITION] = MB_OUT_POSITION, [OUT_ORIENTATION] = MB_OUT_ORIENTATION,
     [OUT_ANGLE] = MB_OUT_ANGLE, [OUT_VELOCITY] = MB_OUT_VELOCITY,
     [OUT_ANGULAR_VELOCITY] = MB_OUT_ANGULAR_VELOCITY, [OUT_ACCELERATION] = MB_OUT_ACCELERATION,
@@ -249,6 +269,9 @@ lmodel *lower_model(const ir_model *ir) {
   L->row_loc = calloc((size_t)maxrow, sizeof(ir_loc));
   L->force = calloc((size_t)ir->nforces + 1, sizeof *L->force);
   L->force_ir = calloc((size_t)ir->nforces + 1, sizeof(int));
+  /* pools: at most the largest kind's parameters and laws per force */
+  L->force_prm = calloc((size_t)ir->nforces * MB_FIELD_NPRM + 1, sizeof *L->force_prm);
+  L->force_law = calloc((size_t)ir->nforces * MB_SPRING_NLAW + 1, sizeof *L->force_law);
   L->profile = calloc((size_t)maxprof, sizeof *L->profile);
   L->profile_driver = calloc((size_t)maxprof, sizeof(int));
   L->profile_force = calloc((size_t)maxprof, sizeof(int));
@@ -260,7 +283,7 @@ lmodel *lower_model(const ir_model *ir) {
   for (int k = 0; k < ir->noutputs; k++) ncols += output_columns(&ir->outputs[k]);
   L->col_name = calloc((size_t)ncols + 1, sizeof(char *));
   if (!L->body || !L->marker || !L->marker_desc || !L->row || !L->row_desc || !L->row_loc ||
-      !L->force || !L->force_ir || !L->profile || !L->profile_driver || !L->profile_force ||
+      !L->force || !L->force_ir || !L->force_prm || !L->force_law || !L->profile || !L->profile_driver || !L->profile_force ||
       !L->spline || !L->table || !L->output || !L->joint_name || !L->col_name || !L->modes ||
       !L->flexd || !L->mslotf || !L->body_name) {
     lower_free(L);
@@ -420,15 +443,17 @@ lmodel *lower_model(const ir_model *ir) {
     d->m1 = -1;
     switch (F->kind) {
     case FORCE_POINT_FORCE:
-    case FORCE_POINT_TORQUE:
+    case FORCE_POINT_TORQUE: {
       d->kind = F->kind == FORCE_POINT_FORCE ? MB_FORCE_POINT : MB_FORCE_TORQUE;
       d->m0 = add_marker(L, F->body[0] - 1, F->node[0], F->point[0], I3,
                          xstrdup_printf("force '%s', on body '%s'%s", F->name,
                                         ir->bodies[F->body[0]].name, ""));
-      memcpy(d->vec, F->vector, sizeof d->vec);
-      d->body_frame = F->frame == FRAME_BODY;
+      double *prm = force_prm(L, d, MB_POINT_NPRM);
+      memcpy(prm + MB_POINT_VEC, F->vector, 3 * sizeof *prm);
+      d->local = F->frame == FRAME_BODY;
       if (F->scale.kind != PROFILE_NONE) d->profile = add_profile(L, &F->scale, -1, e);
       break;
+    }
     case FORCE_SPRING_DAMPER:
     case FORCE_BUSHING:
     case FORCE_FIELD:
@@ -446,36 +471,45 @@ lmodel *lower_model(const ir_model *ir) {
         if (s) d->m1 = mk; else d->m0 = mk;
       }
       if (spring) {
-        const ir_law *laws[2] = {&F->stiffness, &F->damping};
-        mb_law *out[2] = {&d->stiffness, &d->damping};
-        for (int l = 0; l < 2; l++) {
-          out[l]->kind = (int)laws[l]->kind;
-          out[l]->coef = laws[l]->coef;
-          out[l]->exponent = laws[l]->exponent;
-          out[l]->ntable = laws[l]->ntable;
-          out[l]->table = laws[l]->table; /* owned by the IR, which outlives L */
+        double *prm = force_prm(L, d, MB_SPRING_NPRM);
+        const ir_law *laws[MB_SPRING_NLAW] = {[MB_SPRING_STIFFNESS] = &F->stiffness,
+                                              [MB_SPRING_DAMPING] = &F->damping};
+        d->ladr = L->m.nforce_law;
+        d->lnum = MB_SPRING_NLAW;
+        L->m.nforce_law += MB_SPRING_NLAW;
+        for (int l = 0; l < MB_SPRING_NLAW; l++) {
+          mb_law *out = &L->force_law[d->ladr + l];
+          out->kind = (mb_law_kind)laws[l]->kind;
+          out->coef = laws[l]->coef;
+          out->exponent = laws[l]->exponent;
+          out->ntable = laws[l]->ntable;
+          out->table = laws[l]->table; /* owned by the IR, which outlives L */
         }
-        d->L0 = F->free_length;
-        d->preload = F->preload;
-      } else if (F->kind == FORCE_BUSHING) {
+        prm[MB_SPRING_L0] = F->free_length;
+        prm[MB_SPRING_PRELOAD] = F->preload;
+        break;
+      }
+      double *prm = force_prm(L, d, MB_FIELD_NPRM);
+      double *K = prm + MB_FIELD_K, *C = prm + MB_FIELD_C, *pre = prm + MB_FIELD_PRE;
+      if (F->kind == FORCE_BUSHING) {
         for (int i = 0; i < 6; i++) {
-          d->K[7 * i] = F->k6[i];
-          d->C[7 * i] = F->c6[i];
-          d->pre[i] = F->preload6[i];
+          K[7 * i] = F->k6[i];
+          C[7 * i] = F->c6[i];
+          pre[i] = F->preload6[i];
         }
       } else if (F->kind == FORCE_FIELD) {
-        memcpy(d->K, F->K, sizeof d->K);
-        memcpy(d->C, F->C, sizeof d->C);
-        memcpy(d->pre, F->preload6, sizeof d->pre);
+        memcpy(K, F->K, 36 * sizeof *K);
+        memcpy(C, F->C, 36 * sizeof *C);
+        memcpy(pre, F->preload6, 6 * sizeof *pre);
       } else { /* beam: x from point 0 to point 1, clamped at marker 0 */
         const ir_beam *bm = &F->beam;
         double len = 0;
         for (int i = 0; i < 3; i++) len += (F->point[1][i] - F->point[0][i]) * (F->point[1][i] - F->point[0][i]);
         len = sqrt(len);
-        d->d0[0] = len;
+        prm[MB_FIELD_D0] = len;
         mb_beam_stiffness(len, bm->E, bm->G, bm->A, bm->Iy, bm->Iz, bm->J, bm->shear_y * bm->A,
-                          bm->shear_z * bm->A, d->K);
-        for (int i = 0; i < 36; i++) d->C[i] = F->damping_ratio * d->K[i];
+                          bm->shear_z * bm->A, K);
+        for (int i = 0; i < 36; i++) C[i] = F->damping_ratio * K[i];
       }
       break;
     }
@@ -562,6 +596,8 @@ lmodel *lower_model(const ir_model *ir) {
   m->marker = L->marker;
   m->row = L->row;
   m->force = L->force;
+  m->force_prm = L->force_prm;
+  m->force_law = L->force_law;
   m->profile = L->profile;
   m->output = L->output;
   m->q0 = L->q0;
@@ -843,7 +879,8 @@ void lower_free(lmodel *L) {
   for (int k = 0; k < L->m.nprofile; k++) { free(L->spline[k]); free(L->table[k]); }
   for (int c = 0; c < L->m.ncols; c++) free(L->col_name[c]);
   free(L->body); free(L->marker); free(L->marker_desc); free(L->row); free(L->row_desc);
-  free(L->row_loc); free(L->force); free(L->force_ir); free(L->profile);
+  free(L->row_loc); free(L->force); free(L->force_ir); free(L->force_prm); free(L->force_law);
+  free(L->profile);
   free(L->profile_driver); free(L->profile_force); free(L->spline); free(L->table);
   free(L->output); free(L->q0); free(L->v0); free(L->col_name); free(L->joint_name);
   free(L->Kp); free(L->Ki);

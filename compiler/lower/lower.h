@@ -16,6 +16,8 @@ typedef struct {
   mb_markerdef *marker;
   mb_rowdef *row;
   mb_forcedef *force;
+  double *force_prm;         /* m.nforce_prm reals (mb_forcedef.padr) */
+  mb_law *force_law;         /* m.nforce_law laws (mb_forcedef.ladr) */
   mb_profile *profile;
   mb_outputdef *output;
   int *Kp, *Ki;

@@ -161,13 +161,13 @@ static inline void mb_rigid_cols(const mb_frame *f, const mb_real P[3], const mb
 }
 
 /* --- time functions ------------------------------------------------------------- */
-enum {
+typedef enum {
   MB_PROFILE_CONSTANT = 1, MB_PROFILE_CONSTANT_VELOCITY, MB_PROFILE_POLYNOMIAL,
   MB_PROFILE_RAMP, MB_PROFILE_SINE, MB_PROFILE_TABLE
-};
+} mb_profile_kind;
 
 typedef struct {
-  int kind;
+  mb_profile_kind kind;
   mb_real c[8];
   int nc;
   int ntable;
@@ -227,8 +227,6 @@ static inline void mb_profile_eval(const mb_profile *p, mb_real t, mb_real x[3])
     x[2] = a * m0 + b * m1;
     break;
   }
-  default:
-    break;
   }
 }
 
@@ -348,132 +346,10 @@ static inline void mb_prim_rot(const mb_marker *m0, const mb_marker *m1, const m
 }
 
 /* Which primitive a row is: the generic path dispatches on this. */
-enum { MB_PRIM_SPH = 1, MB_PRIM_DOT1, MB_PRIM_DOT2, MB_PRIM_DIST, MB_PRIM_ROT, MB_PRIM_TRANS };
+typedef enum {
+  MB_PRIM_SPH = 1, MB_PRIM_DOT1, MB_PRIM_DOT2, MB_PRIM_DIST, MB_PRIM_ROT, MB_PRIM_TRANS
+} mb_prim_kind;
 
-/* --- force elements ---------------------------------------------------------------------- */
-enum { MB_LAW_NONE = 0, MB_LAW_LINEAR, MB_LAW_POWER, MB_LAW_TABLE };
-
-typedef struct {
-  int kind;
-  mb_real coef, exponent;
-  int ntable;
-  const mb_real *table; /* ntable pairs (x, F) */
-} mb_law;
-
-/* F(x) of a force law, and its integral from 0 to x (for potential energy) */
-static inline mb_real mb_law_eval(const mb_law *l, mb_real x, mb_real *energy) {
-  mb_real F = 0, E = 0;
-  switch (l->kind) {
-  case MB_LAW_LINEAR:
-    F = l->coef * x;
-    E = 0.5 * l->coef * x * x;
-    break;
-  case MB_LAW_POWER: {
-    mb_real ax = fabs(x), pw = pow(ax, l->exponent);
-    F = (x < 0 ? -1 : 1) * l->coef * pw;
-    E = l->coef * pw * ax / (l->exponent + 1);
-    break;
-  }
-  case MB_LAW_TABLE: { /* piecewise linear, extrapolated linearly */
-    const mb_real *d = l->table;
-    int n = l->ntable, k = 0;
-    while (k < n - 2 && x > d[2 * (k + 1)]) k++;
-    mb_real s = (d[2 * k + 3] - d[2 * k + 1]) / (d[2 * k + 2] - d[2 * k]);
-    F = d[2 * k + 1] + s * (x - d[2 * k]);
-    /* energy: integrate the same piecewise-linear curve from 0 to x by segments */
-    mb_real a = 0, b = x, sign = 1;
-    if (b < a) { a = x; b = 0; sign = -1; }
-    for (int j = 0; j <= n - 2; j++) {
-      mb_real lo = (j == 0) ? -INFINITY : d[2 * j], hi = (j == n - 2) ? INFINITY : d[2 * j + 2];
-      mb_real u0 = a > lo ? a : lo, u1 = b < hi ? b : hi;
-      if (u1 <= u0) continue;
-      mb_real sj = (d[2 * j + 3] - d[2 * j + 1]) / (d[2 * j + 2] - d[2 * j]);
-      mb_real f0 = d[2 * j + 1] + sj * (u0 - d[2 * j]), f1 = d[2 * j + 1] + sj * (u1 - d[2 * j]);
-      E += sign * 0.5 * (f0 + f1) * (u1 - u0);
-    }
-    break;
-  }
-  default:
-    break;
-  }
-  if (energy) *energy = E;
-  return F;
-}
-
-/* spring-damper between marker points: tension T = k(L - L0) + c(Ldot) + preload.
- * Writes the forces on marker 0 and marker 1 (global) and returns the potential energy. */
-static inline mb_real mb_force_spring(const mb_marker *m0, const mb_marker *m1, const mb_law *k,
-                                      const mb_law *c, mb_real L0, mb_real preload,
-                                      mb_real F0[3], mb_real F1[3]) {
-  mb_real d[3], dd[3], E = 0;
-  for (int j = 0; j < 3; j++) { d[j] = m1->P[j] - m0->P[j]; dd[j] = m1->V[j] - m0->V[j]; }
-  mb_real L = sqrt(mb_dot3(d, d));
-  mb_real n[3] = {d[0] / L, d[1] / L, d[2] / L};
-  mb_real x = L - L0, Ld = mb_dot3(n, dd);
-  mb_real T = mb_law_eval(k, x, &E) + mb_law_eval(c, Ld, 0) + preload;
-  for (int j = 0; j < 3; j++) { F0[j] = T * n[j]; F1[j] = -T * n[j]; }
-  return E + preload * x;
-}
-
-/* field: a general 6x6 stiffness and damping between two markers (bushing,
- * massless beam, field element).  In the axes R0 of marker 0, with
- * u = [R0^T (P1 - P0) - d0; th] (th: rotation vector of R0^T R1) and its rate
- * ud = [R0^T (V1 - V0 - W0 x (P1 - P0)); R0^T (W1 - W0)], the force and torque
- * on marker 1 at P1 are R0 (-K u - C ud + pre); the reaction acts on body 0
- * at the same point.  Returns 1/2 u^T K u - pre . u (exact potential for the
- * translations; for rotations when K's rotational part is isotropic). */
-static inline mb_real mb_force_field(const mb_marker *m0, const mb_marker *m1, const mb_real d0[3],
-                                     const mb_real K[36], const mb_real C[36], const mb_real pre[6],
-                                     mb_real F[3], mb_real T[3]) {
-  mb_real d[3], dd[3], wd[3], u[6], ud[6], Rr[9], f[6], wxd[3];
-  for (int j = 0; j < 3; j++) {
-    d[j] = m1->P[j] - m0->P[j];
-    wd[j] = m1->W[j] - m0->W[j];
-  }
-  mb_cross3(m0->W, d, wxd);
-  for (int j = 0; j < 3; j++) dd[j] = m1->V[j] - m0->V[j] - wxd[j];
-  mb_mul3t(m0->R, d, u);
-  for (int j = 0; j < 3; j++) u[j] -= d0[j];
-  mb_mul3t(m0->R, dd, ud);
-  /* relative rotation R0^T R1 and its rotation vector */
-  for (int i = 0; i < 3; i++)
-    for (int j = 0; j < 3; j++)
-      Rr[3 * i + j] = m0->R[i] * m1->R[j] + m0->R[3 + i] * m1->R[3 + j] + m0->R[6 + i] * m1->R[6 + j];
-  mb_real v[3] = {0.5 * (Rr[7] - Rr[5]), 0.5 * (Rr[2] - Rr[6]), 0.5 * (Rr[3] - Rr[1])};
-  mb_real sn = sqrt(mb_dot3(v, v)), cs = 0.5 * (Rr[0] + Rr[4] + Rr[8] - 1);
-  mb_real ang = atan2(sn, cs), fac = (sn > 1e-12) ? ang / sn : 1;
-  for (int j = 0; j < 3; j++) u[3 + j] = fac * v[j];
-  mb_mul3t(m0->R, wd, ud + 3);
-  mb_real E = 0;
-  for (int i = 0; i < 6; i++) {
-    f[i] = pre[i];
-    for (int j = 0; j < 6; j++) {
-      f[i] -= K[6 * i + j] * u[j] + C[6 * i + j] * ud[j];
-      E += 0.5 * u[i] * K[6 * i + j] * u[j];
-    }
-    E -= pre[i] * u[i];
-  }
-  mb_mul3(m0->R, f, F);
-  mb_mul3(m0->R, f + 3, T);
-  return E;
-}
-
-/* the 6x6 stiffness of a massless beam of length L clamped at marker 0 and
- * loaded at marker 1 (local x along the beam, y and z the section axes):
- * Euler-Bernoulli, or Timoshenko with shear flexibility phi = 12 E I / (G As L^2) */
-static inline void mb_beam_stiffness(mb_real L, mb_real E, mb_real G, mb_real A, mb_real Iy,
-                                     mb_real Iz, mb_real J, mb_real Asy, mb_real Asz, mb_real K[36]) {
-  mb_real py = Asy > 0 ? 12 * E * Iz / (G * Asy * L * L) : 0;
-  mb_real pz = Asz > 0 ? 12 * E * Iy / (G * Asz * L * L) : 0;
-  for (int i = 0; i < 36; i++) K[i] = 0;
-  K[0] = E * A / L;
-  K[7] = 12 * E * Iz / (L * L * L * (1 + py));
-  K[11] = K[31] = -6 * E * Iz / (L * L * (1 + py));
-  K[14] = 12 * E * Iy / (L * L * L * (1 + pz));
-  K[16] = K[26] = 6 * E * Iy / (L * L * (1 + pz));
-  K[21] = G * J / L;
-  K[28] = (4 + pz) * E * Iy / (L * (1 + pz));
-  K[35] = (4 + py) * E * Iz / (L * (1 + py));
-}
+/* the force elements' kernels: elements/ (one family a file, included by mb_model.h) */
 
 #endif

@@ -3,18 +3,27 @@
  * outputs) and the functions that evaluate it.  The generated code provides a
  * const mb_model whose eval is specialized straight-line code; the generic
  * path provides the same tables with eval = mb_generic_eval, which walks them.
- * Both call the kernels of mb_kernels.h, so they give the same numbers. */
+ * Both call the kernels of mb_kernels.h and elements/, so they give the same
+ * numbers.
+ *
+ * Force elements are records of a kind and addresses into pools, as in
+ * MuJoCo's model arrays: force_prm (reals), force_law (force laws) and a
+ * state pool.  Each kind's kernel header (elements/mb_*.h) names the offsets
+ * of its parameters; the record holds no union of every kind's fields. */
 #ifndef MB_MODEL_H
 #define MB_MODEL_H
 
 #include <stddef.h>
 #include "mb_flex.h"
+#include "elements/mb_field.h"
+#include "elements/mb_force_point.h"
+#include "elements/mb_spring.h"
 
-enum { MB_BODY_RIGID = 1, MB_BODY_VIRTUAL = 2, MB_BODY_FLEXIBLE = 3 };
+typedef enum { MB_BODY_RIGID = 1, MB_BODY_VIRTUAL = 2, MB_BODY_FLEXIBLE = 3 } mb_body_kind;
 
 typedef struct {
   const char *name;
-  int kind;
+  mb_body_kind kind;
   mb_real mass;
   mb_real J[9];      /* inertia about the centre of mass, body axes */
   int qadr, vadr;    /* first position / velocity coordinate */
@@ -32,7 +41,7 @@ typedef struct {
 } mb_markerdef;
 
 typedef struct {
-  int kind;          /* MB_PRIM_* */
+  mb_prim_kind kind;
   int m0, m1;        /* markers */
   int a, b;          /* SPH: component in a; DOT1: axes a of m0, b of m1; DOT2/TRANS: axis a of m0 */
   mb_real L;         /* DIST: length */
@@ -46,29 +55,34 @@ typedef struct {
   int driver;        /* the source driver (effort), or -1 */
 } mb_rowdef;
 
-enum { MB_FORCE_POINT = 1, MB_FORCE_TORQUE, MB_FORCE_SPRING, MB_FORCE_FIELD };
+typedef enum {
+  MB_FORCE_POINT = 1, /* elements/mb_force_point.h */
+  MB_FORCE_TORQUE,    /* elements/mb_force_point.h */
+  MB_FORCE_SPRING,    /* elements/mb_spring.h */
+  MB_FORCE_FIELD      /* elements/mb_field.h: fields, bushings, beams */
+} mb_force_kind;
 
 typedef struct {
-  int kind;
-  int m0, m1;        /* POINT/TORQUE: m0 only; SPRING/FIELD: both */
-  mb_real vec[3];    /* POINT/TORQUE: value */
-  int body_frame;    /* POINT/TORQUE: 1 when vec is in body axes */
-  int profile;       /* POINT/TORQUE: scale profile, or -1 */
-  mb_law stiffness, damping; /* SPRING */
-  mb_real L0, preload;       /* SPRING */
-  mb_real d0[3];             /* FIELD: undeformed offset of marker 1 in marker 0's axes */
-  mb_real K[36], C[36], pre[6]; /* FIELD (bushings and beams too): 6x6 row-major */
+  mb_force_kind kind;
+  int m0, m1;        /* markers; m1 = -1 for one-marker kinds (point force, torque) */
+  int padr, pnum;    /* reals in force_prm (layout: the kind's MB_<KIND>_* offsets) */
+  int ladr, lnum;    /* force laws in force_law (spring: stiffness, damping) */
+  int sadr, snum;    /* internal state (e.g. a tyre's slip relaxation) in the caller's
+                        force state of mb_model.nforce_state reals: reserved, no kind
+                        has state yet (snum = 0) */
+  int profile;       /* time function scaling the element (point force, torque), or -1 */
+  int local;         /* point force, torque: 1 when the vector is in marker 0's body axes */
 } mb_forcedef;
 
-enum {
+typedef enum {
   MB_OUT_POSITION = 1, MB_OUT_ORIENTATION, MB_OUT_ANGLE, MB_OUT_VELOCITY, MB_OUT_ANGULAR_VELOCITY,
   MB_OUT_ACCELERATION, MB_OUT_ANGULAR_ACCELERATION, MB_OUT_REACTION, MB_OUT_EFFORT,
   MB_OUT_KINETIC_ENERGY, MB_OUT_POTENTIAL_ENERGY, MB_OUT_TOTAL_ENERGY, MB_OUT_DEFLECTION,
   MB_OUT_MODAL, MB_OUT_MOMENTUM
-};
+} mb_output_kind;
 
 typedef struct {
-  int kind;
+  mb_output_kind kind;
   int body;          /* or -1 */
   mb_real s[3];      /* point in body axes (position/velocity/acceleration) */
   mb_real axis[3];   /* ANGLE: axis in body axes; the angle is of u about it */
@@ -106,6 +120,10 @@ typedef struct mb_model {
   const mb_markerdef *marker;
   const mb_rowdef *row;
   const mb_forcedef *force;
+  const mb_real *force_prm;    /* parameter pool of the force elements (mb_forcedef.padr) */
+  const mb_law *force_law;     /* force-law pool (mb_forcedef.ladr) */
+  int nforce_prm, nforce_law;
+  int nforce_state;            /* reals of force-element state (none yet: 0) */
   const mb_profile *profile;
   const mb_outputdef *output;
   const char *const *joint_name;

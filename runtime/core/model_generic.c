@@ -113,7 +113,6 @@ static void row_eval(const mb_model *m, const mb_rowdef *rd, const mb_marker *MK
     mb_profile_eval(&m->profile[rd->profile], t, x);
     mb_prim_dot2(m0, m1, 2, x, r);
     break;
-  default: mb_row_zero(r); break;
   }
 }
 
@@ -146,13 +145,13 @@ static mb_real forces_eval(const mb_model *m, mb_real t, const mb_real *q, const
     const mb_forcedef *d = &m->force[e];
     const mb_marker *m0 = &MK[d->m0];
     int b0 = m->marker[d->m0].body;
+    const mb_real *prm = m->force_prm + d->padr;
     switch (d->kind) {
     case MB_FORCE_POINT:
     case MB_FORCE_TORQUE: {
       mb_real s = 1, x[3], val[3];
       if (d->profile >= 0) { mb_profile_eval(&m->profile[d->profile], t, x); s = x[0]; }
-      for (int j = 0; j < 3; j++) val[j] = s * d->vec[j];
-      if (d->body_frame && b0 >= 0) mb_mul3(F[b0].A, val, val);
+      mb_point_vector(prm, s, d->local && b0 >= 0 ? F[b0].A : 0, val);
       if (d->kind == MB_FORCE_POINT)
         add_wrench(m, F, MK, d->m0, q, val, zero, f);
       else
@@ -162,7 +161,7 @@ static mb_real forces_eval(const mb_model *m, mb_real t, const mb_real *q, const
     case MB_FORCE_SPRING: {
       mb_real F0[3], F1[3];
       const mb_marker *m1 = &MK[d->m1];
-      E += mb_force_spring(m0, m1, &d->stiffness, &d->damping, d->L0, d->preload, F0, F1);
+      E += mb_spring(m0, m1, prm, m->force_law + d->ladr, F0, F1, 0);
       add_wrench(m, F, MK, d->m0, q, F0, zero, f);
       add_wrench(m, F, MK, d->m1, q, F1, zero, f);
       break;
@@ -170,14 +169,12 @@ static mb_real forces_eval(const mb_model *m, mb_real t, const mb_real *q, const
     case MB_FORCE_FIELD: {
       mb_real Fv[3], T[3], mF[3], mT[3];
       const mb_marker *m1 = &MK[d->m1];
-      E += mb_force_field(m0, m1, d->d0, d->K, d->C, d->pre, Fv, T);
+      E += mb_field(m0, m1, prm, Fv, T, 0);
       for (int j = 0; j < 3; j++) { mF[j] = -Fv[j]; mT[j] = -T[j]; }
       add_wrench(m, F, MK, d->m1, q, Fv, T, f);
       add_wrench_at(m, F, b0, m1->P, mF, mT, f); /* reaction at the same point */
       break;
     }
-    default:
-      break;
     }
   }
   return E;
@@ -352,13 +349,13 @@ void mb_model_energy(const mb_model *m, mb_real t, const mb_real *q, const mb_re
   /* force elements: their potential (the forces themselves are not needed) */
   for (int e = 0; e < m->nforce; e++) {
     const mb_forcedef *d = &m->force[e];
-    if (d->kind == MB_FORCE_SPRING) {
-      mb_real F0[3], F1[3];
-      U += mb_force_spring(&MK[d->m0], &MK[d->m1], &d->stiffness, &d->damping, d->L0, d->preload,
-                           F0, F1);
-    } else if (d->kind == MB_FORCE_FIELD) {
-      mb_real Fv[3], Tq[3];
-      U += mb_force_field(&MK[d->m0], &MK[d->m1], d->d0, d->K, d->C, d->pre, Fv, Tq);
+    const mb_real *prm = m->force_prm + d->padr;
+    mb_real F0[3], F1[3];
+    switch (d->kind) {
+    case MB_FORCE_POINT:
+    case MB_FORCE_TORQUE: break; /* applied loads: no potential */
+    case MB_FORCE_SPRING: U += mb_spring(&MK[d->m0], &MK[d->m1], prm, m->force_law + d->ladr, F0, F1, 0); break;
+    case MB_FORCE_FIELD: U += mb_field(&MK[d->m0], &MK[d->m1], prm, F0, F1, 0); break;
     }
   }
   (void)t;
@@ -388,7 +385,7 @@ void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_r
   mb_real kin = 0, pot = 0;
   int need_energy = 0;
   for (int k = 0; k < m->noutput; k++) {
-    int kind = m->output[k].kind;
+    mb_output_kind kind = m->output[k].kind;
     if (kind == MB_OUT_KINETIC_ENERGY || kind == MB_OUT_POTENTIAL_ENERGY ||
         kind == MB_OUT_TOTAL_ENERGY)
       need_energy = 1;
@@ -533,7 +530,6 @@ void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_r
     case MB_OUT_KINETIC_ENERGY: val[0] = kin; nval = 1; break;
     case MB_OUT_POTENTIAL_ENERGY: val[0] = pot; nval = 1; break;
     case MB_OUT_TOTAL_ENERGY: val[0] = kin + pot; nval = 1; break;
-    default: nval = 0; break;
     }
     if (o->component >= 0 && nval == 3) {
       out[o->col] = o->scale * val[o->component];

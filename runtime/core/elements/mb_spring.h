@@ -1,0 +1,124 @@
+/* mb_spring.h: the spring-damper between two marker points, and the force
+ * laws it uses (linear, power, table).
+ *
+ * Parameters (m->force_prm + padr, MB_SPRING_NPRM reals):
+ *   MB_SPRING_L0       free length (m)
+ *   MB_SPRING_PRELOAD  tension at the free length (N)
+ * Laws (m->force_law + ladr, MB_SPRING_NLAW records):
+ *   MB_SPRING_STIFFNESS  tension of the elongation x = L - L0
+ *   MB_SPRING_DAMPING    tension of the elongation rate Ld
+ * No state.  Tension T = k(x) + c(Ld) + preload pulls the markers together. */
+#ifndef MB_SPRING_H
+#define MB_SPRING_H
+
+#include "../mb_kernels.h"
+
+typedef enum { MB_LAW_NONE = 0, MB_LAW_LINEAR, MB_LAW_POWER, MB_LAW_TABLE } mb_law_kind;
+
+typedef struct {
+  mb_law_kind kind;
+  mb_real coef, exponent;
+  int ntable;
+  const mb_real *table; /* ntable pairs (x, F) */
+} mb_law;
+
+enum { MB_SPRING_L0 = 0, MB_SPRING_PRELOAD = 1, MB_SPRING_NPRM = 2 };
+enum { MB_SPRING_STIFFNESS = 0, MB_SPRING_DAMPING = 1, MB_SPRING_NLAW = 2 };
+
+/* the table segment x falls in (the end segments extend linearly) */
+static inline int mb_law_segment(const mb_law *l, mb_real x) {
+  const mb_real *d = l->table;
+  int n = l->ntable, k = 0;
+  while (k < n - 2 && x > d[2 * (k + 1)]) k++;
+  return k;
+}
+
+/* F(x) of a force law, and its integral from 0 to x (for potential energy) */
+static inline mb_real mb_law_eval(const mb_law *l, mb_real x, mb_real *energy) {
+  mb_real F = 0, E = 0;
+  switch (l->kind) {
+  case MB_LAW_NONE:
+    break;
+  case MB_LAW_LINEAR:
+    F = l->coef * x;
+    E = 0.5 * l->coef * x * x;
+    break;
+  case MB_LAW_POWER: {
+    mb_real ax = fabs(x), pw = pow(ax, l->exponent);
+    F = (x < 0 ? -1 : 1) * l->coef * pw;
+    E = l->coef * pw * ax / (l->exponent + 1);
+    break;
+  }
+  case MB_LAW_TABLE: { /* piecewise linear, extrapolated linearly */
+    const mb_real *d = l->table;
+    int n = l->ntable, k = mb_law_segment(l, x);
+    mb_real s = (d[2 * k + 3] - d[2 * k + 1]) / (d[2 * k + 2] - d[2 * k]);
+    F = d[2 * k + 1] + s * (x - d[2 * k]);
+    /* energy: integrate the same piecewise-linear curve from 0 to x by segments */
+    mb_real a = 0, b = x, sign = 1;
+    if (b < a) { a = x; b = 0; sign = -1; }
+    for (int j = 0; j <= n - 2; j++) {
+      mb_real lo = (j == 0) ? -INFINITY : d[2 * j], hi = (j == n - 2) ? INFINITY : d[2 * j + 2];
+      mb_real u0 = a > lo ? a : lo, u1 = b < hi ? b : hi;
+      if (u1 <= u0) continue;
+      mb_real sj = (d[2 * j + 3] - d[2 * j + 1]) / (d[2 * j + 2] - d[2 * j]);
+      mb_real f0 = d[2 * j + 1] + sj * (u0 - d[2 * j]), f1 = d[2 * j + 1] + sj * (u1 - d[2 * j]);
+      E += sign * 0.5 * (f0 + f1) * (u1 - u0);
+    }
+    break;
+  }
+  }
+  if (energy) *energy = E;
+  return F;
+}
+
+/* dF/dx of a force law (a power law with exponent < 1 has an infinite slope at 0) */
+static inline mb_real mb_law_slope(const mb_law *l, mb_real x) {
+  switch (l->kind) {
+  case MB_LAW_NONE: return 0;
+  case MB_LAW_LINEAR: return l->coef;
+  case MB_LAW_POWER: return l->coef * l->exponent * pow(fabs(x), l->exponent - 1);
+  case MB_LAW_TABLE: {
+    const mb_real *d = l->table;
+    int k = mb_law_segment(l, x);
+    return (d[2 * k + 3] - d[2 * k + 1]) / (d[2 * k + 2] - d[2 * k]);
+  }
+  }
+  return 0;
+}
+
+/* Spring-damper: writes the forces on marker 0 and marker 1 (global) and
+ * returns the potential energy.  tangent (NULL to skip), 18 reals: the
+ * derivatives of F1 with respect to d = P1 - P0 (3x3, row-major, entry
+ * [3 i + j] = dF1_i / dd_j) and then with respect to its rate dd = V1 - V0;
+ * F0 = -F1, so marker 0's derivatives are the negatives. */
+static inline mb_real mb_spring(const mb_marker *m0, const mb_marker *m1, const mb_real *prm,
+                                const mb_law *law, mb_real F0[3], mb_real F1[3],
+                                mb_real *tangent) {
+  mb_real d[3], dd[3], E = 0;
+  for (int j = 0; j < 3; j++) { d[j] = m1->P[j] - m0->P[j]; dd[j] = m1->V[j] - m0->V[j]; }
+  mb_real L = sqrt(mb_dot3(d, d));
+  mb_real n[3] = {d[0] / L, d[1] / L, d[2] / L};
+  mb_real x = L - prm[MB_SPRING_L0], Ld = mb_dot3(n, dd);
+  mb_real T = mb_law_eval(&law[MB_SPRING_STIFFNESS], x, &E) +
+              mb_law_eval(&law[MB_SPRING_DAMPING], Ld, 0) + prm[MB_SPRING_PRELOAD];
+  for (int j = 0; j < 3; j++) { F0[j] = T * n[j]; F1[j] = -T * n[j]; }
+  if (tangent) {
+    /* F1 = -T n, n = d / L, dn/dd = (I - n n^T) / L, dLd/dd = dd^T (I - n n^T) / L:
+       dF1/dd = -(n dT/dd + T (I - n n^T) / L), dF1/ddd = -c'(Ld) n n^T */
+    mb_real ks = mb_law_slope(&law[MB_SPRING_STIFFNESS], x);
+    mb_real cs = mb_law_slope(&law[MB_SPRING_DAMPING], Ld);
+    mb_real tn[3]; /* (I - n n^T) dd / L */
+    for (int j = 0; j < 3; j++) tn[j] = (dd[j] - Ld * n[j]) / L;
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++) {
+        mb_real P = ((i == j) - n[i] * n[j]) / L;
+        mb_real dTdd = ks * n[j] + cs * tn[j];
+        tangent[3 * i + j] = -(n[i] * dTdd + T * P);
+        tangent[9 + 3 * i + j] = -cs * n[i] * n[j];
+      }
+  }
+  return E + prm[MB_SPRING_PRELOAD] * x;
+}
+
+#endif
