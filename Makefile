@@ -16,7 +16,7 @@ RT_SRC  := runtime/core/model_generic.c \
 # the compiler, one folder a stage: front (YAML -> IR), flex (FE models and
 # modal reduction), lower (IR -> coordinates, rows, pattern, assembly),
 # back (ordering, LDL^T plan, C emission), tools (trade)
-CC_DIRS := compiler/front compiler/flex compiler/lower compiler/back compiler/tools
+CC_DIRS := compiler/front compiler/elements compiler/flex compiler/lower compiler/back compiler/tools
 CC_INC  := -Icompiler $(addprefix -I,$(CC_DIRS)) $(RT_INC)
 CC_SRC  := compiler/main.c $(foreach d,$(CC_DIRS),$(wildcard $(d)/*.c))
 B       ?= build

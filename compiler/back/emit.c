@@ -15,7 +15,9 @@
 
 #include "diag.h"
 #include "emit_ldl.h"
+#include "emit_force.h"
 #include "emit_rows.h"
+#include "element.h"
 #include "flex.h"
 #include "lower.h"
 
@@ -106,17 +108,6 @@ static const char *law_kind_name(mb_law_kind kind) {
   return "0";
 }
 
-/* what a force kind's parameters are, for the comment above them in force_prm */
-static const char *force_prm_layout(mb_force_kind kind) {
-  switch (kind) {
-  case MB_FORCE_POINT: return "force vector";
-  case MB_FORCE_TORQUE: return "torque vector";
-  case MB_FORCE_SPRING: return "free length, preload";
-  case MB_FORCE_FIELD: return "d0[3], K[36], C[36], preload[6]";
-  }
-  return "";
-}
-
 /* the force records (kind and addresses) and their pools: force_prm, force_laws */
 static void emit_force_tables(FILE *f, const lmodel *L) {
   const mb_model *m = &L->m;
@@ -140,8 +131,8 @@ static void emit_force_tables(FILE *f, const lmodel *L) {
     for (int k = 0; k < m->nforce; k++) {
       const mb_forcedef *d = &L->force[k];
       if (!d->pnum) continue;
-      fprintf(f, "  /* %d: force '%s': %s */", d->padr, L->ir->forces[L->force_ir[k]].name,
-              force_prm_layout(d->kind));
+      const ir_force *F = &L->ir->forces[L->force_ir[k]];
+      fprintf(f, "  /* %d: force '%s': %s */", d->padr, F->name, force_element(F->kind)->prm_layout);
       int group = d->kind == MB_FORCE_FIELD ? MB_FIELD_K : 0; /* d0 on a line of its own */
       for (int i = 0; i < d->pnum; i++) {
         fputs(i == 0 || (i >= group && (i - group) % 6 == 0) ? "\n  " : " ", f);
@@ -305,7 +296,7 @@ static void emit_tables(FILE *f, const lmodel *L) {
 
 
 /* c = the body columns of (dV, dW) at marker k; returns how many (6 or 6 + nm) */
-static int emit_cols(FILE *f, const lmodel *L, int k, const char *P, const char *dV, const char *dW,
+int emit_cols(FILE *f, const lmodel *L, int k, const char *P, const char *dV, const char *dW,
                      const char *indent) {
   const mb_markerdef *d = &L->marker[k];
   const mb_body *B = &L->body[d->body];
@@ -321,6 +312,9 @@ static int emit_cols(FILE *f, const lmodel *L, int k, const char *P, const char 
 static void add_cols(FILE *f, int vadr, int n) {
   for (int j = 0; j < n; j++) fprintf(f, "    rhs[%d] += c[%d];\n", vadr + j, j);
 }
+
+void emit_add_cols(FILE *f, int vadr, int n) { add_cols(f, vadr, n); }
+void emit_num(FILE *f, double x) { num(f, x); }
 
 /* a flexible body's constant data: invariants, node shapes, mass-block slots */
 static void emit_flex_tables(FILE *f, const lmodel *L, int b) {
@@ -574,65 +568,11 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
   }
   if (m->nforce) fprintf(f, "\n  /* force elements */\n");
   for (int k = 0; k < m->nforce; k++) {
-    const mb_forcedef *d = &L->force[k];
     const ir_force *F = &L->ir->forces[L->force_ir[k]];
-    int b0 = L->marker[d->m0].body, b1 = d->m1 >= 0 ? L->marker[d->m1].body : -1;
     fprintf(f, "  { /* force '%s' (", F->name);
     loc_comment(f, L, F->loc);
     fputs(") */\n", f);
-    switch (d->kind) {
-    case MB_FORCE_POINT:
-    case MB_FORCE_TORQUE: {
-      if (b0 < 0) { fputs("    /* on the ground: no effect */\n  }\n", f); continue; }
-      fputs("    mb_real s = 1, val[3];\n", f);
-      if (d->profile >= 0) fprintf(f, "    mb_profile_eval(&profiles[%d], t, x);\n    s = x[0];\n", d->profile);
-      for (int j = 0; j < 3; j++) {
-        fprintf(f, "    val[%d] = s * ", j);
-        num(f, L->force_prm[d->padr + MB_POINT_VEC + j]);
-        fputs(";\n", f);
-      }
-      if (d->local) fprintf(f, "    mb_mul3(f%d.A, val, val);\n", b0);
-      {
-        char P[32];
-        snprintf(P, sizeof P, "k%d.P", d->m0);
-        int n = emit_cols(f, L, d->m0, P, d->kind == MB_FORCE_POINT ? "val" : "zero3",
-                          d->kind == MB_FORCE_POINT ? "zero3" : "val", "    ");
-        add_cols(f, L->body[b0].vadr, n);
-      }
-      break;
-    }
-    case MB_FORCE_SPRING:
-      fprintf(f, "    mb_real F0[3], F1[3];\n"
-                 "    mb_spring(&k%d, &k%d, force_prm + %d, force_laws + %d, F0, F1, 0);\n",
-              d->m0, d->m1, d->padr, d->ladr);
-      if (b0 >= 0) {
-        char P[32];
-        snprintf(P, sizeof P, "k%d.P", d->m0);
-        add_cols(f, L->body[b0].vadr, emit_cols(f, L, d->m0, P, "F0", "zero3", "    "));
-      }
-      if (b1 >= 0) {
-        char P[32];
-        snprintf(P, sizeof P, "k%d.P", d->m1);
-        add_cols(f, L->body[b1].vadr, emit_cols(f, L, d->m1, P, "F1", "zero3", "    "));
-      }
-      break;
-    case MB_FORCE_FIELD:
-      fprintf(f, "    mb_real F[3], T[3];\n"
-                 "    mb_field(&k%d, &k%d, force_prm + %d, F, T, 0);\n",
-              d->m0, d->m1, d->padr);
-      if (b0 >= 0)
-        fputs("    mb_real mF[3] = {-F[0], -F[1], -F[2]}, mT[3] = {-T[0], -T[1], -T[2]};\n", f);
-      if (b1 >= 0) {
-        char P[32];
-        snprintf(P, sizeof P, "k%d.P", d->m1);
-        add_cols(f, L->body[b1].vadr, emit_cols(f, L, d->m1, P, "F", "T", "    "));
-      }
-      if (b0 >= 0) {
-        fprintf(f, "    mb_rigid_cols(&f%d, k%d.P, mF, mT, c); /* reaction at the same point */\n", b0, d->m1);
-        add_cols(f, L->body[b0].vadr, 6);
-      }
-      break;
-    }
+    force_element(F->kind)->emit_eval(f, L, k);
     fputs("  }\n", f);
   }
   fprintf(f, "\n  /* constraint rows: D in both triangles of K, gamma, phi, phid */\n");

@@ -22,6 +22,8 @@
 
 #include "diag.h"
 #include "names.h"
+#include "reader.h"
+#include "element.h"
 #include "yaml_map.h"
 
 
@@ -96,7 +98,7 @@ static void node_global(const ir_body *b, int k, double out[3]);
 
 /* whether the element is given on FE nodes (true also when the nodes given
  * were wrong: that was reported, and the point is then not required) */
-static bool fe_nodes_given(mapping *m, const int body[2], int node[2]) {
+bool fe_nodes_given(mapping *m, const int body[2], int node[2]) {
   bool given = get_fe_nodes(m, body, node) || map_has(m, "node") || map_has(m, "nodes");
   /* a body from a modal data file: its node positions are read later, so the
      point must be given (it is checked against the node when the file is read) */
@@ -107,7 +109,7 @@ static bool fe_nodes_given(mapping *m, const int body[2], int node[2]) {
 
 /* the point of side s: the node's position when a node is given (a point
  * given as well must coincide with it) */
-static void check_node_point(reader *r, const ir_model *model, ir_loc loc, const int body[2],
+void check_node_point(reader *r, const ir_model *model, ir_loc loc, const int body[2],
                              const int node[2], bool point_given, double *point) {
   for (int s = 0; s < 2; s++) {
     if (node[s] < 0 || !model->bodies[body[s]].flex || !model->bodies[body[s]].flex->nodes) continue;
@@ -346,12 +348,12 @@ static int *to_node_list(reader *r, yaml_node_t *n, const char *label, int nnode
   return out;
 }
 
-static const char *const theory_names[] = {"euler_bernoulli", "timoshenko", NULL};
+const char *const theory_names[] = {"euler_bernoulli", "timoshenko", NULL};
 static const char *const mass_kind_names[] = {"lumped", "consistent", NULL};
 static const char *const coupling_names[] = {"full", "partial", "constant", "rigid", NULL};
 
 /* section and material of a beam (fields of ir_beam other than the nodes) */
-static void parse_beam_properties(reader *r, mapping *body, ir_beam *proto) {
+void parse_beam_properties(reader *r, mapping *body, ir_beam *proto) {
   yaml_node_t *n = map_require(body, "section", true, "a mapping {area, Iy, Iz, J, ...}");
   if (n != NULL) {
     mapping m;
@@ -917,7 +919,7 @@ static const char *const profile_type_names[] = {"constant", "constant_velocity"
                                                  NULL};
 
 /* 'label' says whose profile it is, e.g. "'motion' of driver 'd'". */
-static void parse_profile(reader *r, yaml_node_t *n, const char *label, ir_profile *p) {
+void parse_profile(reader *r, yaml_node_t *n, const char *label, ir_profile *p) {
   memset(p, 0, sizeof *p);
   p->loc = loc_of(n);
   mapping m;
@@ -1066,278 +1068,9 @@ static void parse_driver(reader *r, yaml_node_t *key, yaml_node_t *value) {
 }
 
 /* ---------------------------------------------------------------------------
- * forces
+ * forces: each type's keys and parser are its element descriptor's
+ * (compiler/elements/, one table in registry.c)
  * ------------------------------------------------------------------------- */
-
-static const char *const force_type_names[] = {"force", "torque", "spring_damper", "bushing", "field", "beam", NULL};
-static const char *const frame_names[] = {"global", "body", NULL};
-
-/* A number (linear), {coefficient, exponent} (power) or {table: ...}. */
-static void parse_law(reader *r, yaml_node_t *n, const char *key, const char *owner, ir_law *law) {
-  law->loc = loc_of(n);
-  char label[64];
-  quote_key(label, sizeof label, key);
-  if (n->type == YAML_SCALAR_NODE) {
-    double coef;
-    if (!to_number(r, n, label, &coef))
-      return;
-    if (!(coef >= 0)) {
-      error_at(r, loc_of(n), "%s must be >= 0 (got %g)", label, coef);
-      return;
-    }
-    law->kind = LAW_LINEAR;
-    law->coef = coef;
-    return;
-  }
-  if (n->type != YAML_MAPPING_NODE) {
-    error_at(r, loc_of(n),
-             "%s: expected a number, {coefficient: c, exponent: e} or {table: [[x, F], ...]}, "
-             "got %s",
-             label, show_node(r, n));
-    return;
-  }
-  mapping m;
-  map_open(&m, r, n, loc_of(n), "%s of %s", label, owner);
-  if (map_has(&m, "table")) {
-    static const char *const keys[] = {"table", NULL};
-    map_check_keys(&m, keys);
-    if (to_table(r, map_get(&m, "table"), "'table'", "[x, F]", "x", &law->table, &law->ntable))
-      law->kind = LAW_TABLE;
-  } else {
-    static const char *const keys[] = {"coefficient", "exponent", NULL};
-    map_check_keys(&m, keys);
-    bool ok = get_nonnegative(&m, "coefficient", true, &law->coef);
-    ok = get_positive(&m, "exponent", true, &law->exponent) && ok;
-    if (ok)
-      law->kind = LAW_POWER;
-  }
-  map_close(&m);
-}
-
-/* Six numbers, each >= 0 when 'nonnegative'. */
-static void get_six(mapping *m, const char *key, bool required, bool nonnegative, double out[6]) {
-  double v[6];
-  if (!get_vector(m, key, 6, required, v))
-    return;
-  for (int i = 0; i < 6; i++) {
-    if (nonnegative && !(v[i] >= 0)) {
-      error_at(m->r, m->last_loc, "'%s': every entry must be >= 0 (entry %d is %g)", key, i + 1,
-               v[i]);
-      return;
-    }
-  }
-  memcpy(out, v, sizeof v);
-}
-
-static void parse_point_load(mapping *m, ir_force *f) {
-  reader *r = m->r;
-  static const char *const force_keys[] = {"type",  "body",  "point", "value",
-                                           "frame", "scale", "node", NULL};
-  static const char *const torque_keys[] = {"type", "body", "value", "frame", "scale", "node", NULL};
-  bool is_force = f->kind == FORCE_POINT_FORCE;
-  map_check_keys(m, is_force ? force_keys : torque_keys);
-  bool on_node = false;
-  if (get_ref(m, "body", NAME_BODY, true, &f->body[0], &f->body_loc[0])) {
-    memcpy(f->point[0], r->model->bodies[f->body[0]].position, sizeof f->point[0]);
-    on_node = fe_nodes_given(m, f->body, f->node);
-  }
-  bool given = is_force && get_vector(m, "point", 3, false, f->point[0]);
-  if (on_node) check_node_point(r, r->model, m->loc, f->body, f->node, given, &f->point[0][0]);
-  get_vector(m, "value", 3, true, f->vector);
-  int frame = FRAME_GLOBAL;
-  if (get_choice(m, "frame", "frame", frame_names, false, &frame))
-    f->frame = (ir_frame)frame;
-  yaml_node_t *scale = map_get(m, "scale");
-  if (scale != NULL) {
-    char label[SHOWN_SIZE];
-    snprintf(label, sizeof label, "'scale' of %s '%s'", force_type_names[f->kind], f->name);
-    parse_profile(r, scale, label, &f->scale);
-  }
-}
-
-static void parse_spring_damper(mapping *m, ir_force *f) {
-  reader *r = m->r;
-  static const char *const keys[] = {"type",    "bodies",      "points",  "stiffness",
-                                     "damping", "free_length", "preload", "node", "nodes", NULL};
-  map_check_keys(m, keys);
-  bool on_nodes = get_body_pair(m, f->body, f->body_loc) && fe_nodes_given(m, f->body, f->node);
-  bool all_nodes = f->node[0] >= 0 && f->node[1] >= 0;
-  yaml_node_t *points = map_require(m, "points", !all_nodes, "a list of 2 points [x, y, z]");
-  bool have_points = false, given = points != NULL && to_vector_list(r, points, "'points'", 2, 3, &f->point[0][0]);
-  if (on_nodes) check_node_point(r, r->model, points ? loc_of(points) : m->loc, f->body, f->node, given, &f->point[0][0]);
-  if (given || all_nodes) {
-    have_points = distance3(f->point[0], f->point[1]) > ZERO_LENGTH;
-    if (!have_points)
-      error_at(r, points ? loc_of(points) : m->loc,
-               "spring_damper end points coincide (the line of action would be undefined)");
-  }
-  bool has_law = false;
-  yaml_node_t *stiffness = map_get(m, "stiffness");
-  if (stiffness != NULL) {
-    parse_law(r, stiffness, "stiffness", m->what, &f->stiffness);
-    has_law = true;
-  }
-  yaml_node_t *damping = map_get(m, "damping");
-  if (damping != NULL) {
-    parse_law(r, damping, "damping", m->what, &f->damping);
-    has_law = true;
-  }
-  has_law = map_has(m, "preload") || has_law;
-  get_number(m, "preload", false, &f->preload);
-  if (have_points)
-    f->free_length = distance3(f->point[0], f->point[1]);
-  get_nonnegative(m, "free_length", false, &f->free_length);
-  if (!has_law)
-    error_at(r, m->loc,
-             "spring_damper '%s' has no force law (expected at least one of 'stiffness', "
-             "'damping', 'preload')",
-             f->name);
-}
-
-/* 'axes': rows x, y, z of an orthonormal right-handed frame (global) */
-static void parse_axes(mapping *m, ir_force *f) {
-  reader *r = m->r;
-  yaml_node_t *axes = map_get(m, "axes");
-  double rows[9];
-  if (axes == NULL || !to_vector_list(r, axes, "'axes'", 3, 3, rows))
-    return;
-  for (int i = 0; i < 3; i++) {
-    for (int k = i; k < 3; k++) {
-      double expected = i == k ? 1 : 0;
-      if (fabs(dot3(rows + 3 * i, rows + 3 * k) - expected) > ANGLE_TOLERANCE) {
-        error_at(r, loc_of(axes),
-                 "'axes' must be orthonormal (row %d . row %d = %g, expected %g)", i + 1,
-                 k + 1, dot3(rows + 3 * i, rows + 3 * k), expected);
-        return;
-      }
-    }
-  }
-  double cross_z = rows[0] * rows[4] - rows[1] * rows[3]; /* (x cross y) . z */
-  double cross_y = rows[2] * rows[3] - rows[0] * rows[5];
-  double cross_x = rows[1] * rows[5] - rows[2] * rows[4];
-  if (cross_x * rows[6] + cross_y * rows[7] + cross_z * rows[8] < 0) {
-    error_at(r, loc_of(axes), "'axes' must be right-handed (z = x cross y)");
-    return;
-  }
-  memcpy(f->axes, rows, sizeof rows);
-}
-
-/* a 6x6 matrix as a list of 6 rows of 6 numbers */
-static bool to_matrix6(reader *r, yaml_node_t *n, const char *label, double out[36]) {
-  if (n->type != YAML_SEQUENCE_NODE || seq_length(n) != 6) {
-    error_at(r, loc_of(n), "%s: expected a 6x6 matrix (a list of 6 rows of 6 numbers)", label);
-    return false;
-  }
-  bool ok = true;
-  for (int i = 0; i < 6; i++) {
-    char row_label[SHOWN_SIZE];
-    snprintf(row_label, sizeof row_label, "row %d of %s", i + 1, label);
-    yaml_node_t *row = seq_item(r, n, i);
-    if (row->type != YAML_SEQUENCE_NODE || seq_length(row) != 6) {
-      error_at(r, loc_of(row), "%s: expected 6 numbers", row_label);
-      ok = false;
-      continue;
-    }
-    for (int j = 0; j < 6; j++) {
-      char item_label[SHOWN_SIZE + 32];
-      snprintf(item_label, sizeof item_label, "element %d of %s", j + 1, row_label);
-      ok = to_number(r, seq_item(r, row, j), item_label, &out[6 * i + j]) && ok;
-    }
-  }
-  return ok;
-}
-
-/* 'bodies' and one 'point' for both sides, or the point of the node given
- * ('node' / 'nodes'): a bushing's or a field's */
-static void parse_pair_at_point(mapping *m, ir_force *f) {
-  reader *r = m->r;
-  bool on_nodes = get_body_pair(m, f->body, f->body_loc) && fe_nodes_given(m, f->body, f->node);
-  bool given = get_vector(m, "point", 3, !on_nodes, f->point[0]);
-  if (given)
-    memcpy(f->point[1], f->point[0], sizeof f->point[0]);
-  if (on_nodes) {
-    check_node_point(r, r->model, m->loc, f->body, f->node, given, &f->point[0][0]);
-    if (!given)
-      memcpy(f->point[f->node[0] >= 0 ? 1 : 0], f->point[f->node[0] >= 0 ? 0 : 1], sizeof f->point[0]);
-  }
-}
-
-/* field: a general 6x6 stiffness and damping between two bodies (seed 001 3.2.6) */
-static void parse_field(mapping *m, ir_force *f) {
-  reader *r = m->r;
-  static const char *const keys[] = {"type", "bodies", "point", "stiffness", "damping",
-                                     "preload", "axes", "node", "nodes", NULL};
-  map_check_keys(m, keys);
-  parse_pair_at_point(m, f);
-  yaml_node_t *k = map_require(m, "stiffness", true, "a 6x6 matrix");
-  if (k != NULL && to_matrix6(r, k, "'stiffness'", f->K))
-    for (int i = 0; i < 6; i++)
-      for (int j = 0; j < i; j++)
-        if (fabs(f->K[6 * i + j] - f->K[6 * j + i]) > 1e-9 * (fabs(f->K[6 * i + j]) + fabs(f->K[6 * j + i]) + 1e-300)) {
-          error_at(r, loc_of(k), "field 'stiffness' must be symmetric (row %d, column %d differs from row %d, column %d)", i + 1, j + 1, j + 1, i + 1);
-          i = 6;
-          break;
-        }
-  yaml_node_t *c = map_get(m, "damping");
-  if (c != NULL) to_matrix6(r, c, "'damping'", f->C);
-  get_six(m, "preload", false, false, f->preload6);
-  parse_axes(m, f);
-}
-
-/* beam: a massless Euler-Bernoulli or Timoshenko beam from point 0 (clamped on
- * body 0) to point 1 (seed 001 3.2.5), damping = damping_ratio * stiffness */
-static void parse_beam_force(mapping *m, ir_force *f) {
-  reader *r = m->r;
-  static const char *const keys[] = {"type", "bodies", "points", "node", "nodes", "section",
-                                     "material", "theory", "damping_ratio", NULL};
-  map_check_keys(m, keys);
-  bool on_nodes = get_body_pair(m, f->body, f->body_loc) && fe_nodes_given(m, f->body, f->node);
-  bool all_nodes = f->node[0] >= 0 && f->node[1] >= 0;
-  yaml_node_t *points = map_require(m, "points", !all_nodes, "a list of 2 points [x, y, z]");
-  bool given = points != NULL && to_vector_list(r, points, "'points'", 2, 3, &f->point[0][0]);
-  if (on_nodes)
-    check_node_point(r, r->model, points ? loc_of(points) : m->loc, f->body, f->node, given, &f->point[0][0]);
-  int th = 0;
-  if (get_choice(m, "theory", "beam theory", theory_names, false, &th)) f->beam.theory = (ir_beam_theory)th;
-  f->beam.yaxis[1] = 1;
-  parse_beam_properties(r, m, &f->beam);
-  get_nonnegative(m, "damping_ratio", false, &f->damping_ratio);
-  double x[3];
-  for (int i = 0; i < 3; i++) x[i] = f->point[1][i] - f->point[0][i];
-  double len = norm3(x);
-  if ((given || all_nodes) && !(len > ZERO_LENGTH)) {
-    error_at(r, points ? loc_of(points) : m->loc, "beam end points coincide (a beam needs a length)");
-    return;
-  }
-  if (!(len > ZERO_LENGTH)) return;
-  scale3(x, 1 / len);
-  /* the section's y axis across the beam: given, else global y (global z for a beam along y) */
-  double y[3];
-  memcpy(y, f->beam.yaxis, sizeof y);
-  if (fabs(dot3(x, y)) > 0.9) { y[0] = y[1] = 0; y[2] = 1; }
-  double along = dot3(x, y);
-  for (int i = 0; i < 3; i++) y[i] -= along * x[i];
-  if (!(norm3(y) > 1e-6)) {
-    error_at(r, m->loc, "the beam's section 'yaxis' is parallel to the beam");
-    return;
-  }
-  scale3(y, 1 / norm3(y));
-  double z[3] = {x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]};
-  memcpy(f->axes, x, sizeof x);
-  memcpy(f->axes + 3, y, sizeof y);
-  memcpy(f->axes + 6, z, sizeof z);
-}
-
-static void parse_bushing(mapping *m, ir_force *f) {
-  static const char *const keys[] = {"type",    "bodies",  "point", "stiffness",
-                                     "damping", "preload", "axes",  "node", "nodes", NULL};
-  map_check_keys(m, keys);
-  parse_pair_at_point(m, f);
-  get_six(m, "stiffness", true, true, f->k6);
-  get_six(m, "damping", false, true, f->c6);
-  get_six(m, "preload", false, false, f->preload6);
-  parse_axes(m, f);
-}
 
 static void parse_force(reader *r, yaml_node_t *key, yaml_node_t *value) {
   ir_model *model = r->model;
@@ -1356,27 +1089,12 @@ static void parse_force(reader *r, yaml_node_t *key, yaml_node_t *value) {
   if (!map_open(&m, r, value, f->loc, "force '%s'", f->name))
     return;
   int type;
-  if (get_choice(&m, "type", "force type", force_type_names, true, &type)) {
-    f->kind = (ir_force_kind)type;
-    map_describe(&m, "%s '%s'", force_type_names[type], f->name);
-    switch (f->kind) {
-    case FORCE_POINT_FORCE:
-    case FORCE_POINT_TORQUE:
-      parse_point_load(&m, f);
-      break;
-    case FORCE_SPRING_DAMPER:
-      parse_spring_damper(&m, f);
-      break;
-    case FORCE_BUSHING:
-      parse_bushing(&m, f);
-      break;
-    case FORCE_FIELD:
-      parse_field(&m, f);
-      break;
-    case FORCE_BEAM:
-      parse_beam_force(&m, f);
-      break;
-    }
+  if (get_choice(&m, "type", "force type", force_type_names(), true, &type)) {
+    const element_desc *e = force_elements[type];
+    f->kind = e->ir_kind;
+    map_describe(&m, "%s '%s'", e->type, f->name);
+    map_check_keys(&m, e->keys);
+    e->parse(&m, f);
   }
   map_close(&m);
 }

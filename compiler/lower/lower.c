@@ -9,9 +9,10 @@
 
 #include "diag.h"
 #include "lower.h"
+#include "element.h"
 
 /* The IR's profile and law kinds are copied into the runtime's by value
-   (add_profile, the spring's laws): the two enumerations must agree. */
+   (lower_add_profile, the spring's laws): the two enumerations must agree. */
 _Static_assert((int)PROFILE_CONSTANT == (int)MB_PROFILE_CONSTANT &&
                    (int)PROFILE_CONSTANT_VELOCITY == (int)MB_PROFILE_CONSTANT_VELOCITY &&
                    (int)PROFILE_POLYNOMIAL == (int)MB_PROFILE_POLYNOMIAL &&
@@ -75,15 +76,21 @@ static void natural_spline(const double *d, int n, double *m2) {
   }
 }
 
-/* n zeroed reals of the force parameter pool for force record d */
-static double *force_prm(lmodel *L, mb_forcedef *d, int n) {
+double *lower_force_prm(lmodel *L, mb_forcedef *d, int n) {
   d->padr = L->m.nforce_prm;
   d->pnum = n;
   L->m.nforce_prm += n;
   return L->force_prm + d->padr;
 }
 
-static int add_profile(lmodel *L, const ir_profile *p, int driver, int force) {
+mb_law *lower_force_laws(lmodel *L, mb_forcedef *d, int n) {
+  d->ladr = L->m.nforce_law;
+  d->lnum = n;
+  L->m.nforce_law += n;
+  return L->force_law + d->ladr;
+}
+
+int lower_add_profile(lmodel *L, const ir_profile *p, int driver, int force) {
   int k = L->m.nprofile++;
   mb_profile *P = &L->profile[k];
   memset(P, 0, sizeof *P);
@@ -147,6 +154,12 @@ static int add_marker(lmodel *L, int b, int node, const double P[3], const doubl
     for (int j = 0; j < 3; j++)
       d->C[3 * i + j] = A[i] * Cg[j] + A[3 + i] * Cg[3 + j] + A[6 + i] * Cg[6 + j];
   return k;
+}
+
+int lower_force_marker(lmodel *L, const ir_force *F, int side, const double C[9]) {
+  return add_marker(L, F->body[side] - 1, F->node[side], F->point[side], C,
+                    xstrdup_printf("force '%s', on body '%s'%s", F->name,
+                                   L->ir->bodies[F->body[side]].name, ""));
 }
 
 static const char *joint_kind_name(ir_joint_kind k) {
@@ -421,7 +434,7 @@ lmodel *lower_model(const ir_model *ir) {
   for (int d = 0; d < ir->ndrivers; d++) {
     const ir_driver *D = &ir->drivers[d];
     if (!D->active || !ir->joints[D->joint].active) continue;
-    int p = add_profile(L, &D->motion, d, -1);
+    int p = lower_add_profile(L, &D->motion, d, -1);
     if (p < 0) { free(jm0); free(jm1); lower_free(L); return NULL; }
     int rot = D->dof == DRIVER_ROTATION;
     add_row(L, rot ? MB_PRIM_ROT : MB_PRIM_TRANS, jm0[D->joint], jm1[D->joint], 2, 0,
@@ -431,8 +444,7 @@ lmodel *lower_model(const ir_model *ir) {
     L->row[m->nrow - 1].profile = p;
   }
 
-  /* forces */
-  static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  /* forces: each kind lowered by its element descriptor (compiler/elements/) */
   for (int e = 0; e < ir->nforces; e++) {
     const ir_force *F = &ir->forces[e];
     if (!F->active) continue;
@@ -441,79 +453,9 @@ lmodel *lower_model(const ir_model *ir) {
     L->force_ir[k] = e;
     d->profile = -1;
     d->m1 = -1;
-    switch (F->kind) {
-    case FORCE_POINT_FORCE:
-    case FORCE_POINT_TORQUE: {
-      d->kind = F->kind == FORCE_POINT_FORCE ? MB_FORCE_POINT : MB_FORCE_TORQUE;
-      d->m0 = add_marker(L, F->body[0] - 1, F->node[0], F->point[0], I3,
-                         xstrdup_printf("force '%s', on body '%s'%s", F->name,
-                                        ir->bodies[F->body[0]].name, ""));
-      double *prm = force_prm(L, d, MB_POINT_NPRM);
-      memcpy(prm + MB_POINT_VEC, F->vector, 3 * sizeof *prm);
-      d->local = F->frame == FRAME_BODY;
-      if (F->scale.kind != PROFILE_NONE) d->profile = add_profile(L, &F->scale, -1, e);
-      break;
-    }
-    case FORCE_SPRING_DAMPER:
-    case FORCE_BUSHING:
-    case FORCE_FIELD:
-    case FORCE_BEAM: {
-      /* marker axes: the element's frame (rows of 'axes', global at t = 0) */
-      double Cg[9];
-      for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) Cg[3 * i + j] = F->axes[3 * j + i]; /* columns = axes rows */
-      int spring = F->kind == FORCE_SPRING_DAMPER;
-      d->kind = spring ? MB_FORCE_SPRING : MB_FORCE_FIELD;
-      for (int s = 0; s < 2; s++) {
-        int mk = add_marker(L, F->body[s] - 1, F->node[s], F->point[s], spring ? I3 : Cg,
-                            xstrdup_printf("force '%s', on body '%s'%s", F->name,
-                                           ir->bodies[F->body[s]].name, ""));
-        if (s) d->m1 = mk; else d->m0 = mk;
-      }
-      if (spring) {
-        double *prm = force_prm(L, d, MB_SPRING_NPRM);
-        const ir_law *laws[MB_SPRING_NLAW] = {[MB_SPRING_STIFFNESS] = &F->stiffness,
-                                              [MB_SPRING_DAMPING] = &F->damping};
-        d->ladr = L->m.nforce_law;
-        d->lnum = MB_SPRING_NLAW;
-        L->m.nforce_law += MB_SPRING_NLAW;
-        for (int l = 0; l < MB_SPRING_NLAW; l++) {
-          mb_law *out = &L->force_law[d->ladr + l];
-          out->kind = (mb_law_kind)laws[l]->kind;
-          out->coef = laws[l]->coef;
-          out->exponent = laws[l]->exponent;
-          out->ntable = laws[l]->ntable;
-          out->table = laws[l]->table; /* owned by the IR, which outlives L */
-        }
-        prm[MB_SPRING_L0] = F->free_length;
-        prm[MB_SPRING_PRELOAD] = F->preload;
-        break;
-      }
-      double *prm = force_prm(L, d, MB_FIELD_NPRM);
-      double *K = prm + MB_FIELD_K, *C = prm + MB_FIELD_C, *pre = prm + MB_FIELD_PRE;
-      if (F->kind == FORCE_BUSHING) {
-        for (int i = 0; i < 6; i++) {
-          K[7 * i] = F->k6[i];
-          C[7 * i] = F->c6[i];
-          pre[i] = F->preload6[i];
-        }
-      } else if (F->kind == FORCE_FIELD) {
-        memcpy(K, F->K, 36 * sizeof *K);
-        memcpy(C, F->C, 36 * sizeof *C);
-        memcpy(pre, F->preload6, 6 * sizeof *pre);
-      } else { /* beam: x from point 0 to point 1, clamped at marker 0 */
-        const ir_beam *bm = &F->beam;
-        double len = 0;
-        for (int i = 0; i < 3; i++) len += (F->point[1][i] - F->point[0][i]) * (F->point[1][i] - F->point[0][i]);
-        len = sqrt(len);
-        prm[MB_FIELD_D0] = len;
-        mb_beam_stiffness(len, bm->E, bm->G, bm->A, bm->Iy, bm->Iz, bm->J, bm->shear_y * bm->A,
-                          bm->shear_z * bm->A, K);
-        for (int i = 0; i < 36; i++) C[i] = F->damping_ratio * K[i];
-      }
-      break;
-    }
-    }
+    const element_desc *desc = force_element(F->kind);
+    d->kind = desc->runtime_kind;
+    desc->lower(L, F, e, d);
   }
 
   /* outputs */

@@ -48,6 +48,15 @@ typedef struct {
   int real_float;            /* emit for single precision (mbcc compile --real float) */
 } lmodel;
 
+/* For the lowering hooks of the elements (compiler/elements/): the marker
+ * of a force's side (0 or 1) with axes C (columns, global); the force record
+ * d's n reals of the parameter pool (zeroed) and n laws of the law pool; a
+ * time function (force: the IR force index, for provenance). */
+int lower_force_marker(lmodel *L, const ir_force *F, int side, const double C[9]);
+double *lower_force_prm(lmodel *L, mb_forcedef *d, int n);
+mb_law *lower_force_laws(lmodel *L, mb_forcedef *d, int n);
+int lower_add_profile(lmodel *L, const ir_profile *p, int driver, int force);
+
 /* Build the tables and pattern from the IR (positions as given).  Returns
  * NULL and reports on error. */
 lmodel *lower_model(const ir_model *ir);

@@ -1,0 +1,249 @@
+/* force_field.c: the 6x6 field elements between two markers: the field
+ * (general K and C), the bushing (diagonal) and the massless beam (its K
+ * from the section, C a ratio of it); one runtime kind, MB_FORCE_FIELD
+ * (kernel runtime/core/elements/mb_field.h). */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "element.h"
+#include "emit_force.h"
+#include "reader.h"
+
+/* Six numbers, each >= 0 when 'nonnegative'. */
+static void get_six(mapping *m, const char *key, bool required, bool nonnegative, double out[6]) {
+  double v[6];
+  if (!get_vector(m, key, 6, required, v))
+    return;
+  for (int i = 0; i < 6; i++) {
+    if (nonnegative && !(v[i] >= 0)) {
+      error_at(m->r, m->last_loc, "'%s': every entry must be >= 0 (entry %d is %g)", key, i + 1,
+               v[i]);
+      return;
+    }
+  }
+  memcpy(out, v, sizeof v);
+}
+
+/* 'axes': rows x, y, z of an orthonormal right-handed frame (global) */
+static void parse_axes(mapping *m, ir_force *f) {
+  reader *r = m->r;
+  yaml_node_t *axes = map_get(m, "axes");
+  double rows[9];
+  if (axes == NULL || !to_vector_list(r, axes, "'axes'", 3, 3, rows))
+    return;
+  for (int i = 0; i < 3; i++) {
+    for (int k = i; k < 3; k++) {
+      double expected = i == k ? 1 : 0;
+      if (fabs(dot3(rows + 3 * i, rows + 3 * k) - expected) > ANGLE_TOLERANCE) {
+        error_at(r, loc_of(axes),
+                 "'axes' must be orthonormal (row %d . row %d = %g, expected %g)", i + 1,
+                 k + 1, dot3(rows + 3 * i, rows + 3 * k), expected);
+        return;
+      }
+    }
+  }
+  double cross_z = rows[0] * rows[4] - rows[1] * rows[3]; /* (x cross y) . z */
+  double cross_y = rows[2] * rows[3] - rows[0] * rows[5];
+  double cross_x = rows[1] * rows[5] - rows[2] * rows[4];
+  if (cross_x * rows[6] + cross_y * rows[7] + cross_z * rows[8] < 0) {
+    error_at(r, loc_of(axes), "'axes' must be right-handed (z = x cross y)");
+    return;
+  }
+  memcpy(f->axes, rows, sizeof rows);
+}
+
+/* a 6x6 matrix as a list of 6 rows of 6 numbers */
+static bool to_matrix6(reader *r, yaml_node_t *n, const char *label, double out[36]) {
+  if (n->type != YAML_SEQUENCE_NODE || seq_length(n) != 6) {
+    error_at(r, loc_of(n), "%s: expected a 6x6 matrix (a list of 6 rows of 6 numbers)", label);
+    return false;
+  }
+  bool ok = true;
+  for (int i = 0; i < 6; i++) {
+    char row_label[SHOWN_SIZE];
+    snprintf(row_label, sizeof row_label, "row %d of %s", i + 1, label);
+    yaml_node_t *row = seq_item(r, n, i);
+    if (row->type != YAML_SEQUENCE_NODE || seq_length(row) != 6) {
+      error_at(r, loc_of(row), "%s: expected 6 numbers", row_label);
+      ok = false;
+      continue;
+    }
+    for (int j = 0; j < 6; j++) {
+      char item_label[SHOWN_SIZE + 32];
+      snprintf(item_label, sizeof item_label, "element %d of %s", j + 1, row_label);
+      ok = to_number(r, seq_item(r, row, j), item_label, &out[6 * i + j]) && ok;
+    }
+  }
+  return ok;
+}
+
+/* 'bodies' and one 'point' for both sides, or the point of the node given
+ * ('node' / 'nodes'): a bushing's or a field's */
+static void parse_pair_at_point(mapping *m, ir_force *f) {
+  reader *r = m->r;
+  bool on_nodes = get_body_pair(m, f->body, f->body_loc) && fe_nodes_given(m, f->body, f->node);
+  bool given = get_vector(m, "point", 3, !on_nodes, f->point[0]);
+  if (given)
+    memcpy(f->point[1], f->point[0], sizeof f->point[0]);
+  if (on_nodes) {
+    check_node_point(r, r->model, m->loc, f->body, f->node, given, &f->point[0][0]);
+    if (!given)
+      memcpy(f->point[f->node[0] >= 0 ? 1 : 0], f->point[f->node[0] >= 0 ? 0 : 1], sizeof f->point[0]);
+  }
+}
+
+/* field: a general 6x6 stiffness and damping between two bodies (seed 001 3.2.6) */
+static void parse_field(mapping *m, ir_force *f) {
+  reader *r = m->r;
+  parse_pair_at_point(m, f);
+  yaml_node_t *k = map_require(m, "stiffness", true, "a 6x6 matrix");
+  if (k != NULL && to_matrix6(r, k, "'stiffness'", f->K))
+    for (int i = 0; i < 6; i++)
+      for (int j = 0; j < i; j++)
+        if (fabs(f->K[6 * i + j] - f->K[6 * j + i]) > 1e-9 * (fabs(f->K[6 * i + j]) + fabs(f->K[6 * j + i]) + 1e-300)) {
+          error_at(r, loc_of(k), "field 'stiffness' must be symmetric (row %d, column %d differs from row %d, column %d)", i + 1, j + 1, j + 1, i + 1);
+          i = 6;
+          break;
+        }
+  yaml_node_t *c = map_get(m, "damping");
+  if (c != NULL) to_matrix6(r, c, "'damping'", f->C);
+  get_six(m, "preload", false, false, f->preload6);
+  parse_axes(m, f);
+}
+
+/* beam: a massless Euler-Bernoulli or Timoshenko beam from point 0 (clamped on
+ * body 0) to point 1 (seed 001 3.2.5), damping = damping_ratio * stiffness */
+static void parse_beam_force(mapping *m, ir_force *f) {
+  reader *r = m->r;
+  bool on_nodes = get_body_pair(m, f->body, f->body_loc) && fe_nodes_given(m, f->body, f->node);
+  bool all_nodes = f->node[0] >= 0 && f->node[1] >= 0;
+  yaml_node_t *points = map_require(m, "points", !all_nodes, "a list of 2 points [x, y, z]");
+  bool given = points != NULL && to_vector_list(r, points, "'points'", 2, 3, &f->point[0][0]);
+  if (on_nodes)
+    check_node_point(r, r->model, points ? loc_of(points) : m->loc, f->body, f->node, given, &f->point[0][0]);
+  int th = 0;
+  if (get_choice(m, "theory", "beam theory", theory_names, false, &th)) f->beam.theory = (ir_beam_theory)th;
+  f->beam.yaxis[1] = 1;
+  parse_beam_properties(r, m, &f->beam);
+  get_nonnegative(m, "damping_ratio", false, &f->damping_ratio);
+  double x[3];
+  for (int i = 0; i < 3; i++) x[i] = f->point[1][i] - f->point[0][i];
+  double len = norm3(x);
+  if ((given || all_nodes) && !(len > ZERO_LENGTH)) {
+    error_at(r, points ? loc_of(points) : m->loc, "beam end points coincide (a beam needs a length)");
+    return;
+  }
+  if (!(len > ZERO_LENGTH)) return;
+  scale3(x, 1 / len);
+  /* the section's y axis across the beam: given, else global y (global z for a beam along y) */
+  double y[3];
+  memcpy(y, f->beam.yaxis, sizeof y);
+  if (fabs(dot3(x, y)) > 0.9) { y[0] = y[1] = 0; y[2] = 1; }
+  double along = dot3(x, y);
+  for (int i = 0; i < 3; i++) y[i] -= along * x[i];
+  if (!(norm3(y) > 1e-6)) {
+    error_at(r, m->loc, "the beam's section 'yaxis' is parallel to the beam");
+    return;
+  }
+  scale3(y, 1 / norm3(y));
+  double z[3] = {x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]};
+  memcpy(f->axes, x, sizeof x);
+  memcpy(f->axes + 3, y, sizeof y);
+  memcpy(f->axes + 6, z, sizeof z);
+}
+
+static void parse_bushing(mapping *m, ir_force *f) {
+  parse_pair_at_point(m, f);
+  get_six(m, "stiffness", true, true, f->k6);
+  get_six(m, "damping", false, true, f->c6);
+  get_six(m, "preload", false, false, f->preload6);
+  parse_axes(m, f);
+}
+
+/* both markers with the element's axes (rows of 'axes', global at t = 0);
+   the parameters' K, C and preload are zero */
+static double *lower_field_common(lmodel *L, const ir_force *F, mb_forcedef *d) {
+  double Cg[9];
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) Cg[3 * i + j] = F->axes[3 * j + i]; /* columns = axes rows */
+  d->m0 = lower_force_marker(L, F, 0, Cg);
+  d->m1 = lower_force_marker(L, F, 1, Cg);
+  return lower_force_prm(L, d, MB_FIELD_NPRM);
+}
+
+static void lower_bushing(lmodel *L, const ir_force *F, int index, mb_forcedef *d) {
+  (void)index;
+  double *prm = lower_field_common(L, F, d);
+  for (int i = 0; i < 6; i++) {
+    prm[MB_FIELD_K + 7 * i] = F->k6[i];
+    prm[MB_FIELD_C + 7 * i] = F->c6[i];
+    prm[MB_FIELD_PRE + i] = F->preload6[i];
+  }
+}
+
+static void lower_field(lmodel *L, const ir_force *F, int index, mb_forcedef *d) {
+  (void)index;
+  double *prm = lower_field_common(L, F, d);
+  memcpy(prm + MB_FIELD_K, F->K, 36 * sizeof *prm);
+  memcpy(prm + MB_FIELD_C, F->C, 36 * sizeof *prm);
+  memcpy(prm + MB_FIELD_PRE, F->preload6, 6 * sizeof *prm);
+}
+
+/* beam: x from point 0 to point 1, clamped at marker 0 */
+static void lower_beam(lmodel *L, const ir_force *F, int index, mb_forcedef *d) {
+  (void)index;
+  double *prm = lower_field_common(L, F, d);
+  double *K = prm + MB_FIELD_K;
+  const ir_beam *bm = &F->beam;
+  double len = 0;
+  for (int i = 0; i < 3; i++) len += (F->point[1][i] - F->point[0][i]) * (F->point[1][i] - F->point[0][i]);
+  len = sqrt(len);
+  prm[MB_FIELD_D0] = len;
+  mb_beam_stiffness(len, bm->E, bm->G, bm->A, bm->Iy, bm->Iz, bm->J, bm->shear_y * bm->A,
+                    bm->shear_z * bm->A, K);
+  for (int i = 0; i < 36; i++) prm[MB_FIELD_C + i] = F->damping_ratio * K[i];
+}
+
+/* the wrench on marker 1 at its point; the reaction on body 0 at the same point */
+static void emit_field(FILE *f, const lmodel *L, int k) {
+  const mb_forcedef *d = &L->force[k];
+  int b0 = L->marker[d->m0].body, b1 = L->marker[d->m1].body;
+  fprintf(f, "    mb_real F[3], T[3];\n"
+             "    mb_field(&k%d, &k%d, force_prm + %d, F, T, 0);\n",
+          d->m0, d->m1, d->padr);
+  if (b0 >= 0)
+    fputs("    mb_real mF[3] = {-F[0], -F[1], -F[2]}, mT[3] = {-T[0], -T[1], -T[2]};\n", f);
+  if (b1 >= 0) {
+    char P[32];
+    snprintf(P, sizeof P, "k%d.P", d->m1);
+    emit_add_cols(f, L->body[b1].vadr, emit_cols(f, L, d->m1, P, "F", "T", "    "));
+  }
+  if (b0 >= 0) {
+    fprintf(f, "    mb_rigid_cols(&f%d, k%d.P, mF, mT, c); /* reaction at the same point */\n", b0, d->m1);
+    emit_add_cols(f, L->body[b0].vadr, 6);
+  }
+}
+
+static const char *const field_keys[] = {"type", "bodies", "point", "stiffness", "damping",
+                                         "preload", "axes", "node", "nodes", NULL};
+static const char *const bushing_keys[] = {"type",    "bodies",  "point", "stiffness",
+                                           "damping", "preload", "axes",  "node", "nodes", NULL};
+static const char *const beam_keys[] = {"type", "bodies", "points", "node", "nodes", "section",
+                                        "material", "theory", "damping_ratio", NULL};
+#define FIELD_LAYOUT "d0[3], K[36], C[36], preload[6]"
+
+const element_desc element_bushing = {
+    .family = ELEMENT_FORCE, .type = "bushing", .ir_kind = FORCE_BUSHING,
+    .runtime_kind = MB_FORCE_FIELD, .keys = bushing_keys, .prm_layout = FIELD_LAYOUT,
+    .parse = parse_bushing, .lower = lower_bushing, .emit_eval = emit_field};
+
+const element_desc element_field = {
+    .family = ELEMENT_FORCE, .type = "field", .ir_kind = FORCE_FIELD,
+    .runtime_kind = MB_FORCE_FIELD, .keys = field_keys, .prm_layout = FIELD_LAYOUT,
+    .parse = parse_field, .lower = lower_field, .emit_eval = emit_field};
+
+const element_desc element_beam = {
+    .family = ELEMENT_FORCE, .type = "beam", .ir_kind = FORCE_BEAM,
+    .runtime_kind = MB_FORCE_FIELD, .keys = beam_keys, .prm_layout = FIELD_LAYOUT,
+    .parse = parse_beam_force, .lower = lower_beam, .emit_eval = emit_field};

@@ -1,0 +1,21 @@
+/* reader.h: what the element parsers of compiler/elements/ use from the
+ * document walk (reader.c) besides the typed YAML layer (yaml_map.h). */
+#ifndef MBCC_READER_H
+#define MBCC_READER_H
+
+#include "yaml_map.h"
+
+/* whether the element is given on FE nodes ('node' / 'nodes'; true also when
+ * the nodes given were wrong: that was reported, and the point is then not required) */
+bool fe_nodes_given(mapping *m, const int body[2], int node[2]);
+/* the point of each side on a node: the node's position (a point given as
+ * well must coincide with it) */
+void check_node_point(reader *r, const ir_model *model, ir_loc loc, const int body[2],
+                      const int node[2], bool point_given, double *point);
+/* a time function ('scale', 'motion') */
+void parse_profile(reader *r, yaml_node_t *n, const char *label, ir_profile *p);
+/* a beam's section and material keys, on top of the defaults in *proto */
+void parse_beam_properties(reader *r, mapping *body, ir_beam *proto);
+extern const char *const theory_names[]; /* 'theory' of a beam */
+
+#endif
