@@ -88,6 +88,66 @@ static void flex_moving_entry(char *e, size_t size, int i, int l) {
   else snprintf(e, size, "0 /* constant block */");
 }
 
+static int all_zero(const double *x, int n) {
+  for (int i = 0; i < n; i++)
+    if (x[i] != 0) return 0;
+  return 1;
+}
+
+static const char *body_kind_name(mb_body_kind kind) {
+  switch (kind) {
+  case MB_BODY_RIGID: return "MB_BODY_RIGID";
+  case MB_BODY_VIRTUAL: return "MB_BODY_VIRTUAL";
+  case MB_BODY_FLEXIBLE: return "MB_BODY_FLEXIBLE";
+  }
+  return "0";
+}
+
+static const char *prim_kind_name(mb_prim_kind kind) {
+  switch (kind) {
+  case MB_PRIM_SPH: return "MB_PRIM_SPH";
+  case MB_PRIM_DOT1: return "MB_PRIM_DOT1";
+  case MB_PRIM_DOT2: return "MB_PRIM_DOT2";
+  case MB_PRIM_DIST: return "MB_PRIM_DIST";
+  case MB_PRIM_ROT: return "MB_PRIM_ROT";
+  case MB_PRIM_TRANS: return "MB_PRIM_TRANS";
+  }
+  return "0";
+}
+
+static const char *profile_kind_name(mb_profile_kind kind) {
+  switch (kind) {
+  case MB_PROFILE_CONSTANT: return "MB_PROFILE_CONSTANT";
+  case MB_PROFILE_CONSTANT_VELOCITY: return "MB_PROFILE_CONSTANT_VELOCITY";
+  case MB_PROFILE_POLYNOMIAL: return "MB_PROFILE_POLYNOMIAL";
+  case MB_PROFILE_RAMP: return "MB_PROFILE_RAMP";
+  case MB_PROFILE_SINE: return "MB_PROFILE_SINE";
+  case MB_PROFILE_TABLE: return "MB_PROFILE_TABLE";
+  }
+  return "0";
+}
+
+static const char *output_kind_name(mb_output_kind kind) {
+  switch (kind) {
+  case MB_OUT_POSITION: return "MB_OUT_POSITION";
+  case MB_OUT_ORIENTATION: return "MB_OUT_ORIENTATION";
+  case MB_OUT_ANGLE: return "MB_OUT_ANGLE";
+  case MB_OUT_VELOCITY: return "MB_OUT_VELOCITY";
+  case MB_OUT_ANGULAR_VELOCITY: return "MB_OUT_ANGULAR_VELOCITY";
+  case MB_OUT_ACCELERATION: return "MB_OUT_ACCELERATION";
+  case MB_OUT_ANGULAR_ACCELERATION: return "MB_OUT_ANGULAR_ACCELERATION";
+  case MB_OUT_REACTION: return "MB_OUT_REACTION";
+  case MB_OUT_EFFORT: return "MB_OUT_EFFORT";
+  case MB_OUT_KINETIC_ENERGY: return "MB_OUT_KINETIC_ENERGY";
+  case MB_OUT_POTENTIAL_ENERGY: return "MB_OUT_POTENTIAL_ENERGY";
+  case MB_OUT_TOTAL_ENERGY: return "MB_OUT_TOTAL_ENERGY";
+  case MB_OUT_DEFLECTION: return "MB_OUT_DEFLECTION";
+  case MB_OUT_MODAL: return "MB_OUT_MODAL";
+  case MB_OUT_MOMENTUM: return "MB_OUT_MOMENTUM";
+  }
+  return "0";
+}
+
 static const char *force_kind_name(mb_force_kind kind) {
   switch (kind) {
   case MB_FORCE_POINT: return "MB_FORCE_POINT";
@@ -204,18 +264,14 @@ static void emit_tables(FILE *f, const lmodel *L) {
       } else {
         fprintf(f, "  /* body '%s': massless, inserted for a joint on a flexible node */\n", B->name);
       }
-      fprintf(f, "  {\"%s\", %s, ", B->name, B->kind == MB_BODY_VIRTUAL    ? "MB_BODY_VIRTUAL"
-                                          : B->kind == MB_BODY_FLEXIBLE ? "MB_BODY_FLEXIBLE"
-                                                                        : "MB_BODY_RIGID");
-      num(f, B->mass);
-      fputs(", ", f);
-      vec(f, B->J, 9);
-      fprintf(f, ", %d, %d, ", B->qadr, B->vadr);
+      fprintf(f, "  {.name = \"%s\", .kind = %s", B->name, body_kind_name(B->kind));
+      if (B->mass != 0) { fputs(", .mass = ", f); num(f, B->mass); }
+      if (!all_zero(B->J, 9)) { fputs(", .J = ", f); vec(f, B->J, 9); }
+      fprintf(f, ", .qadr = %d, .vadr = %d, .mslot = ", B->qadr, B->vadr);
       ivec(f, B->mslot, 12);
       if (B->kind == MB_BODY_FLEXIBLE)
-        fprintf(f, ", %d, &flex%d, flex%d_mslot},\n", B->nm, b, b);
-      else
-        fputs(", 0, 0, 0},\n", f);
+        fprintf(f, ", .nm = %d, .flex = &flex%d, .mslotf = flex%d_mslot", B->nm, b, b);
+      fputs("},\n", f);
     }
     fputs("};\n", f);
   }
@@ -223,9 +279,9 @@ static void emit_tables(FILE *f, const lmodel *L) {
     fprintf(f, "static const mb_markerdef markers[%d] = {\n", m->nmarker);
     for (int k = 0; k < m->nmarker; k++) {
       const mb_markerdef *d = &L->marker[k];
-      fprintf(f, "  /* %d: %s */\n  {%d, %d, ", k, L->marker_desc[k], d->body, d->node);
-      vec(f, d->s, 3);
-      fputs(", ", f);
+      fprintf(f, "  /* %d: %s */\n  {.body = %d, .node = %d", k, L->marker_desc[k], d->body, d->node);
+      if (!all_zero(d->s, 3)) { fputs(", .s = ", f); vec(f, d->s, 3); }
+      fputs(", .C = ", f);
       vec(f, d->C, 9);
       fputs("},\n", f);
     }
@@ -235,20 +291,29 @@ static void emit_tables(FILE *f, const lmodel *L) {
     fprintf(f, "static const mb_rowdef rows[%d] = {\n", m->nrow);
     for (int r = 0; r < m->nrow; r++) {
       const mb_rowdef *R = &L->row[r];
-      fprintf(f, "  /* %d: %s */\n  {%d, %d, %d, %d, %d, ", r, L->row_desc[r], R->kind, R->m0, R->m1, R->a, R->b);
-      num(f, R->L);
-      fprintf(f, ", %d, {", R->profile);
+      fprintf(f, "  /* %d: %s */\n  {.kind = %s, .m0 = %d, .m1 = %d, .a = %d, .b = %d", r, L->row_desc[r],
+              prim_kind_name(R->kind), R->m0, R->m1, R->a, R->b);
+      if (R->L != 0) { fputs(", .L = ", f); num(f, R->L); }
+      fprintf(f, ", .profile = %d,\n   .slot = {", R->profile);
       ivec(f, R->slot[0], 6); fputs(", ", f); ivec(f, R->slot[1], 6);
-      fputs("}, {", f);
+      fputs("}, .slotT = {", f);
       ivec(f, R->slotT[0], 6); fputs(", ", f); ivec(f, R->slotT[1], 6);
-      fputs("}, {", f);
-      for (int s = 0; s < 2; s++) {
-        int c[6];
-        for (int j = 0; j < 6; j++) c[j] = R->constant[s][j];
-        if (s) fputs(", ", f);
-        ivec(f, c, 6);
+      fputs("}", f);
+      int any_constant = 0;
+      for (int s = 0; s < 2; s++)
+        for (int j = 0; j < 6; j++) any_constant |= R->constant[s][j];
+      if (any_constant) {
+        fputs(",\n   .constant = {", f);
+        for (int s = 0; s < 2; s++) {
+          int c[6];
+          for (int j = 0; j < 6; j++) c[j] = R->constant[s][j];
+          if (s) fputs(", ", f);
+          ivec(f, c, 6);
+        }
+        fputs("}", f);
       }
-      fprintf(f, "}, {%d, %d}, %d, %d},\n", R->mslot[0], R->mslot[1], R->joint, R->driver);
+      fprintf(f, ", .mslot = {%d, %d}, .joint = %d, .driver = %d},\n", R->mslot[0], R->mslot[1], R->joint,
+              R->driver);
     }
     fputs("};\n", f);
   }
@@ -257,12 +322,12 @@ static void emit_tables(FILE *f, const lmodel *L) {
     fprintf(f, "static const mb_profile profiles[%d] = {\n", m->nprofile);
     for (int k = 0; k < m->nprofile; k++) {
       const mb_profile *p = &L->profile[k];
-      fprintf(f, "  {%d, ", p->kind);
-      vec(f, p->c, 8);
+      fprintf(f, "  {.kind = %s", profile_kind_name(p->kind));
+      if (!all_zero(p->c, 8)) { fputs(", .c = ", f); vec(f, p->c, 8); }
+      if (p->nc) fprintf(f, ", .nc = %d", p->nc);
       if (p->kind == MB_PROFILE_TABLE)
-        fprintf(f, ", %d, %d, profile%d_table, profile%d_spline},\n", p->nc, p->ntable, k, k);
-      else
-        fprintf(f, ", %d, 0, 0, 0},\n", p->nc);
+        fprintf(f, ", .ntable = %d, .table = profile%d_table, .spline = profile%d_spline", p->ntable, k, k);
+      fputs("},\n", f);
     }
     fputs("};\n", f);
   }
@@ -272,13 +337,20 @@ static void emit_tables(FILE *f, const lmodel *L) {
       const mb_outputdef *o = &L->output[k];
       fprintf(f, "  /* output '%s' (", L->ir->outputs[k].name);
       loc_comment(f, L, L->ir->outputs[k].loc);
-      fprintf(f, ") */\n  {%d, %d, ", o->kind, o->body);
-      vec(f, o->s, 3); fputs(", ", f); vec(f, o->axis, 3); fputs(", ", f); vec(f, o->u, 3);
-      fputs(", ", f); vec(f, o->axis_g, 3); fputs(", ", f); vec(f, o->u_g, 3);
-      fprintf(f, ", %d, %d, %d, %d, %d, %d, %d, {%d, %d}, ", o->component, o->joint, o->reaction_marker,
-              o->driver_row, o->driver_marker, o->driver_rotation, o->node, o->chord[0], o->chord[1]);
+      fprintf(f, ") */\n  {.kind = %s, .body = %d", output_kind_name(o->kind), o->body);
+      const char *vnames[5] = {".s", ".axis", ".u", ".axis_g", ".u_g"};
+      const double *vals[5] = {o->s, o->axis, o->u, o->axis_g, o->u_g};
+      for (int v = 0; v < 5; v++)
+        if (!all_zero(vals[v], 3)) {
+          fprintf(f, ", %s = ", vnames[v]);
+          vec(f, vals[v], 3);
+        }
+      fprintf(f, ", .component = %d, .joint = %d, .reaction_marker = %d,\n   .driver_row = %d, .driver_marker = %d",
+              o->component, o->joint, o->reaction_marker, o->driver_row, o->driver_marker);
+      if (o->driver_rotation) fputs(", .driver_rotation = 1", f);
+      fprintf(f, ", .node = %d, .chord = {%d, %d}, .scale = ", o->node, o->chord[0], o->chord[1]);
       num(f, o->scale);
-      fprintf(f, ", %d, %d},\n", o->ncols, o->col);
+      fprintf(f, ", .ncols = %d, .col = %d},\n", o->ncols, o->col);
     }
     fputs("};\n", f);
   }
