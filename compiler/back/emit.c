@@ -148,16 +148,6 @@ static const char *output_kind_name(mb_output_kind kind) {
   return "0";
 }
 
-static const char *force_kind_name(mb_force_kind kind) {
-  switch (kind) {
-  case MB_FORCE_POINT: return "MB_FORCE_POINT";
-  case MB_FORCE_TORQUE: return "MB_FORCE_TORQUE";
-  case MB_FORCE_SPRING: return "MB_FORCE_SPRING";
-  case MB_FORCE_FIELD: return "MB_FORCE_FIELD";
-  }
-  return "0";
-}
-
 static const char *law_kind_name(mb_law_kind kind) {
   switch (kind) {
   case MB_LAW_NONE: return "MB_LAW_NONE";
@@ -177,7 +167,8 @@ static void emit_force_tables(FILE *f, const lmodel *L) {
     const ir_force *F = &L->ir->forces[L->force_ir[k]];
     fprintf(f, "  /* force '%s' (", F->name);
     loc_comment(f, L, F->loc);
-    fprintf(f, ") */\n  {.kind = %s, .m0 = %d, .m1 = %d, .padr = %d, .pnum = %d", force_kind_name(d->kind),
+    fprintf(f, ") */\n  {.kind = %s, .m0 = %d, .m1 = %d, .padr = %d, .pnum = %d",
+            force_element(F->kind)->runtime_kind_name,
             d->m0, d->m1, d->padr, d->pnum);
     if (d->lnum) fprintf(f, ", .ladr = %d, .lnum = %d", d->ladr, d->lnum);
     if (d->snum) fprintf(f, ", .sadr = %d, .snum = %d", d->sadr, d->snum);
@@ -209,9 +200,9 @@ static void emit_force_tables(FILE *f, const lmodel *L) {
       const mb_forcedef *d = &L->force[k];
       for (int l = 0; l < d->lnum; l++) {
         const mb_law *law = &L->force_law[d->ladr + l];
-        fprintf(f, "  /* %d: force '%s', %s */\n  {.kind = %s", d->ladr + l,
-                L->ir->forces[L->force_ir[k]].name, l == MB_SPRING_STIFFNESS ? "stiffness" : "damping",
-                law_kind_name(law->kind));
+        const ir_force *F = &L->ir->forces[L->force_ir[k]];
+        fprintf(f, "  /* %d: force '%s', %s */\n  {.kind = %s", d->ladr + l, F->name,
+                force_element(F->kind)->law_names[l], law_kind_name(law->kind));
         if (law->coef != 0) { fputs(", .coef = ", f); num(f, law->coef); }
         if (law->exponent != 0) { fputs(", .exponent = ", f); num(f, law->exponent); }
         if (law->kind == MB_LAW_TABLE)

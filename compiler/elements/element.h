@@ -17,13 +17,18 @@
 
 typedef enum { ELEMENT_FORCE } element_family;
 
+/* the runtime kind and its enumerator's name, in a descriptor's initializer */
+#define ELEMENT_RUNTIME_KIND(k) .runtime_kind = k, .runtime_kind_name = #k
+
 typedef struct element_desc {
   element_family family;
   const char *type;            /* the YAML 'type' value */
   ir_force_kind ir_kind;       /* the IR record's kind */
   mb_force_kind runtime_kind;  /* the runtime record's kind (runtime/core/mb_model.h) */
+  const char *runtime_kind_name; /* its enumerator, for the emitted tables */
   const char *const *keys;     /* accepted keys, NULL-terminated: any other is an error */
   const char *prm_layout;      /* its force_prm reals, for the emitted table's comment */
+  const char *const *law_names; /* its force laws in order (NULL: none), for the comments */
   /* front: fill f from its mapping (the keys were checked, f->kind is set) */
   void (*parse)(mapping *m, ir_force *f);
   /* lower: markers, record d (kind, markers, pool addresses) and its pools */
@@ -39,10 +44,5 @@ extern const element_desc *const force_elements[];
 const element_desc *force_element(ir_force_kind kind);
 /* the YAML type names of the force elements, NULL-terminated (for "expected one of") */
 const char *const *force_type_names(void);
-
-/* the families, one file each */
-extern const element_desc element_point_force, element_point_torque;  /* force_point.c */
-extern const element_desc element_spring_damper;                      /* force_spring.c */
-extern const element_desc element_bushing, element_field, element_beam; /* force_field.c */
 
 #endif

@@ -235,15 +235,15 @@ static const char *const beam_keys[] = {"type", "bodies", "points", "node", "nod
 
 const element_desc element_bushing = {
     .family = ELEMENT_FORCE, .type = "bushing", .ir_kind = FORCE_BUSHING,
-    .runtime_kind = MB_FORCE_FIELD, .keys = bushing_keys, .prm_layout = FIELD_LAYOUT,
+    ELEMENT_RUNTIME_KIND(MB_FORCE_FIELD), .keys = bushing_keys, .prm_layout = FIELD_LAYOUT,
     .parse = parse_bushing, .lower = lower_bushing, .emit_eval = emit_field};
 
 const element_desc element_field = {
     .family = ELEMENT_FORCE, .type = "field", .ir_kind = FORCE_FIELD,
-    .runtime_kind = MB_FORCE_FIELD, .keys = field_keys, .prm_layout = FIELD_LAYOUT,
+    ELEMENT_RUNTIME_KIND(MB_FORCE_FIELD), .keys = field_keys, .prm_layout = FIELD_LAYOUT,
     .parse = parse_field, .lower = lower_field, .emit_eval = emit_field};
 
 const element_desc element_beam = {
     .family = ELEMENT_FORCE, .type = "beam", .ir_kind = FORCE_BEAM,
-    .runtime_kind = MB_FORCE_FIELD, .keys = beam_keys, .prm_layout = FIELD_LAYOUT,
+    ELEMENT_RUNTIME_KIND(MB_FORCE_FIELD), .keys = beam_keys, .prm_layout = FIELD_LAYOUT,
     .parse = parse_beam_force, .lower = lower_beam, .emit_eval = emit_field};

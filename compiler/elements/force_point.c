@@ -67,10 +67,10 @@ static const char *const torque_keys[] = {"type", "body", "value", "frame", "sca
 
 const element_desc element_point_force = {
     .family = ELEMENT_FORCE, .type = "force", .ir_kind = FORCE_POINT_FORCE,
-    .runtime_kind = MB_FORCE_POINT, .keys = force_keys, .prm_layout = "force vector",
+    ELEMENT_RUNTIME_KIND(MB_FORCE_POINT), .keys = force_keys, .prm_layout = "force vector",
     .parse = parse_point_load, .lower = lower_point_load, .emit_eval = emit_point_load};
 
 const element_desc element_point_torque = {
     .family = ELEMENT_FORCE, .type = "torque", .ir_kind = FORCE_POINT_TORQUE,
-    .runtime_kind = MB_FORCE_TORQUE, .keys = torque_keys, .prm_layout = "torque vector",
+    ELEMENT_RUNTIME_KIND(MB_FORCE_TORQUE), .keys = torque_keys, .prm_layout = "torque vector",
     .parse = parse_point_load, .lower = lower_point_load, .emit_eval = emit_point_load};

@@ -127,7 +127,11 @@ static void emit_spring_damper(FILE *f, const lmodel *L, int k) {
 static const char *const spring_keys[] = {"type",    "bodies",      "points",  "stiffness",
                                           "damping", "free_length", "preload", "node", "nodes", NULL};
 
+static const char *const law_names[] = {[MB_SPRING_STIFFNESS] = "stiffness",
+                                        [MB_SPRING_DAMPING] = "damping", NULL};
+
 const element_desc element_spring_damper = {
     .family = ELEMENT_FORCE, .type = "spring_damper", .ir_kind = FORCE_SPRING_DAMPER,
-    .runtime_kind = MB_FORCE_SPRING, .keys = spring_keys, .prm_layout = "free length, preload",
+    ELEMENT_RUNTIME_KIND(MB_FORCE_SPRING), .keys = spring_keys, .prm_layout = "free length, preload",
+    .law_names = law_names,
     .parse = parse_spring_damper, .lower = lower_spring_damper, .emit_eval = emit_spring_damper};

@@ -2,6 +2,11 @@
  * is one line here (and its file in this folder). */
 #include "element.h"
 
+/* the families, one file each */
+extern const element_desc element_point_force, element_point_torque;    /* force_point.c */
+extern const element_desc element_spring_damper;                        /* force_spring.c */
+extern const element_desc element_bushing, element_field, element_beam; /* force_field.c */
+
 const element_desc *const force_elements[] = {
     &element_point_force, &element_point_torque, &element_spring_damper,
     &element_bushing,     &element_field,        &element_beam,
