@@ -1883,7 +1883,7 @@ static void report_yaml_error(const char *path, const yaml_parser_t *parser, con
   }
 }
 
-ir_model *ir_read(const char *path, const char *scene) {
+static ir_model *read_model(const char *path, const char *scene) {
   int errors_before = diag_errors();
   size_t size = 0;
   char *data = read_file(path, &size);
@@ -1937,6 +1937,21 @@ ir_model *ir_read(const char *path, const char *scene) {
     ir_free(model);
     return NULL;
   }
+  return model;
+}
+
+/* the reader's one recovery point: an allocation that fails anywhere in
+   read_model unwinds here (out_of_memory, yaml_map.h) */
+ir_model *ir_read(const char *path, const char *scene) {
+  jmp_buf oom;
+  if (setjmp(oom)) {
+    reader_catch_oom(NULL);
+    diag_error(path, file_start, "out of memory while reading the model");
+    return NULL;
+  }
+  reader_catch_oom(&oom);
+  ir_model *model = read_model(path, scene);
+  reader_catch_oom(NULL);
   return model;
 }
 

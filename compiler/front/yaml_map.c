@@ -6,6 +6,7 @@
 #include "yaml_map.h"
 
 #include <errno.h>
+#include <setjmp.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -16,11 +17,13 @@
  * memory
  * ------------------------------------------------------------------------- */
 
-void out_of_memory(void) {
-  fputs("mbcc: error: out of memory\n", stderr);
-  abort();
-}
+/* ir_read's recovery point (reader_catch_oom): every allocation of the
+   reader happens while ir_read runs, and one that fails unwinds there */
+static jmp_buf *oom_recovery;
 
+void reader_catch_oom(jmp_buf *recovery) { oom_recovery = recovery; }
+
+_Noreturn void out_of_memory(void) { longjmp(*oom_recovery, 1); }
 void *xcalloc(size_t count, size_t size) {
   void *p = calloc(count ? count : 1, size ? size : 1);
   if (p == NULL)

@@ -5,6 +5,7 @@
 #ifndef MBCC_YAML_MAP_H
 #define MBCC_YAML_MAP_H
 
+#include <setjmp.h>
 #include <stdbool.h>
 #include <stddef.h>
 #include <string.h>
@@ -15,9 +16,13 @@
 #include "names.h"
 #include "vec3.h"
 
-/* memory: the reader's allocations never return NULL; out of memory is
-   reported once, as "mbcc: error: out of memory", and ends the program */
-void out_of_memory(void);
+/* memory: the reader's allocations never return NULL.  Out of memory
+   unwinds (longjmp) to the recovery point that ir_read sets with
+   reader_catch_oom before it reads; ir_read then reports "out of memory" as
+   a located error and returns NULL, as for any other error (what was
+   allocated is then not freed).  No exit or abort in the library. */
+void reader_catch_oom(jmp_buf *recovery);
+_Noreturn void out_of_memory(void);
 void *xcalloc(size_t count, size_t size);
 char *xstrndup(const char *s, size_t length);
 static inline char *xstrdup(const char *s) { return xstrndup(s, strlen(s)); }
