@@ -18,4 +18,11 @@ void parse_profile(reader *r, yaml_node_t *n, const char *label, ir_profile *p);
 void parse_beam_properties(reader *r, mapping *body, ir_beam *proto);
 extern const char *const theory_names[]; /* 'theory' of a beam */
 
+/* what the scenes (scene.c) reuse: a flexible body's modal settings, the
+   outputs list (a scene replaces it), freeing outputs */
+void parse_modal_settings(mapping *m, ir_flex *fx);
+void parse_outputs(reader *r, yaml_node_t *n, name_table *scene_outputs,
+                   ir_output **outputs, int *count);
+void free_outputs(ir_output *outputs, int count);
+
 #endif
