@@ -14,6 +14,7 @@ const element_desc *const force_elements[] = {
 };
 
 enum { NFORCE_ELEMENTS = sizeof force_elements / sizeof *force_elements - 1 };
+_Static_assert(NFORCE_ELEMENTS == FORCE_BEAM + 1, "one descriptor per ir_force_kind");
 
 const element_desc *force_element(ir_force_kind kind) {
   for (int i = 0; force_elements[i]; i++)
