@@ -61,7 +61,7 @@ scene.background = new THREE.Color(0xf4f5f7);
 const camera = new THREE.PerspectiveCamera(40, 1, size * 1e-3, size * 100);
 // looking down the model's z axis (the plane of planar mechanisms), a little from the side
 camera.up.set(0, 1, 0);
-camera.position.copy(centre).add(new THREE.Vector3(0.25 * size, 0.35 * size, 1.6 * size));
+camera.position.copy(centre).add(new THREE.Vector3(0.1 * size, 0.25 * size, 0.85 * size));
 const controls = new OrbitControls(camera, renderer.domElement);
 controls.target.copy(centre);
 controls.update();
@@ -102,7 +102,7 @@ function sphere(mat, rad, at) {
 for (const j of data.ground_points) scene.add(sphere(groundMat, thick * 1.6, new THREE.Vector3(...j)));
 for (const a of data.ground_axes) {
   const p = new THREE.Vector3(...a.point), d = new THREE.Vector3(...a.axis);
-  const half = a.kind === 'prismatic' || a.kind === 'cylindrical' ? size * 0.5 : thick * 4;
+  const half = a.kind === 'prismatic' || a.kind === 'cylindrical' ? size * 0.3 : thick * 4;
   scene.add(cylinder(groundMat, p.clone().addScaledVector(d, -half), p.clone().addScaledVector(d, half),
                      a.kind === 'prismatic' || a.kind === 'cylindrical' ? thick * 0.4 : thick * 0.8));
 }
