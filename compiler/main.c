@@ -304,6 +304,8 @@ static int plot_csv(const char *csv, const char *png, const char *columns) {
       char key[300];
       snprintf(key, sizeof key, ",%s,", names[c]);
       if (!strstr(list, key)) continue;
+    } else if (!strncmp(names[c], "body.", 5)) {
+      continue; /* the pose columns of run --animate are for the animation */
     }
     pick[np++] = c;
   }

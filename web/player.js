@@ -59,12 +59,19 @@ view.appendChild(renderer.domElement);
 const scene = new THREE.Scene();
 scene.background = new THREE.Color(0xf4f5f7);
 const camera = new THREE.PerspectiveCamera(40, 1, size * 1e-3, size * 100);
-// looking down the model's z axis (the plane of planar mechanisms), a little from the side
-camera.up.set(0, 1, 0);
-camera.position.copy(centre).add(new THREE.Vector3(0.1 * size, 0.25 * size, 0.85 * size));
 const controls = new OrbitControls(camera, renderer.domElement);
-controls.target.copy(centre);
-controls.update();
+// looking down the model's z axis (the plane of planar mechanisms), a little
+// from above and the side, from just far enough that the extent of the motion
+// in x and y fills the view
+function frameAll() {
+  const ext = box.getSize(new THREE.Vector3()), half = THREE.MathUtils.degToRad(camera.fov / 2);
+  const d = 1.35 * Math.max(ext.y / 2 / Math.tan(half), ext.x / 2 / (Math.tan(half) * camera.aspect)) + ext.z / 2;
+  const dir = new THREE.Vector3(0.1, 0.25, 1).normalize();
+  camera.up.set(0, 1, 0);
+  camera.position.copy(centre).addScaledVector(dir, Math.max(d, 0.2 * size));
+  controls.target.copy(centre);
+  controls.update();
+}
 scene.add(new THREE.HemisphereLight(0xffffff, 0x8090a0, 2.0));
 const sun = new THREE.DirectionalLight(0xffffff, 1.5);
 sun.position.set(1, 2, 3);
@@ -242,6 +249,7 @@ function tick(now) {
 }
 
 resize();
+frameAll();
 showSpeed();
 setFrame(0);
 renderer.render(scene, camera);
