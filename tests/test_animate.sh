@@ -12,6 +12,7 @@
 #     pinned in web/package.json), and the data embedded: every body, a time
 #     per CSV row, the slider's positions equal to the CSV's;
 #   - `mbcc animate CSV -m MODEL` writes the same page as `run --animate`;
+#     without -m, the bodies of the CSV (and any file name, escaped);
 #   - a shape given in the model reaches the page in body axes;
 #   - errors: a CSV without pose columns, a missing player, a bad option: exit
 #     2, a message that says what to do, and no page (nor a .part) written.
@@ -83,6 +84,18 @@ if "$MBCC" animate sc.csv -o frames.html > fr.log 2>&1; then
   grep -q '"name":"slider","kind":"rigid","r":' frames.html || err "without the model: body 'slider' missing"
 else
   err "mbcc animate without -m failed: $(tail -3 fr.log)"
+fi
+# a CSV name with characters that mean something in HTML and JSON
+cp sc.csv 'we<i>rd"&.csv'
+if "$MBCC" animate 'we<i>rd"&.csv' -o weird.html --quiet > we.log 2>&1; then
+  grep -q '<title>we&lt;i&gt;rd&quot;&amp;.csv - mbcc animation</title>' weird.html || err "title not escaped: $(grep '<title>' weird.html)"
+  out=$(node -e '
+    const h = require("fs").readFileSync("weird.html", "utf8");
+    const d = JSON.parse(h.match(/id="mbcc-data">([\s\S]*?)<\/script>/)[1]);
+    if (d.model !== "we<i>rd\"&.csv") console.log("model " + d.model);' 2>&1)
+  [ -z "$out" ] || err "data with an odd CSV name: $out"
+else
+  err "mbcc animate on an odd CSV name failed: $(tail -3 we.log)"
 fi
 
 # 4. a shape, given global at t = 0, stored in body axes (the body turned 90 deg about z)

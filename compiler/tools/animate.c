@@ -218,6 +218,17 @@ static void sb_add(sbuf *b, const char *fmt, ...) {
   }
 }
 
+/* a JSON string; '<' escaped too, so that no text can close the inline script */
+static void sb_string(sbuf *b, const char *text) {
+  sb_add(b, "\"");
+  for (const unsigned char *c = (const unsigned char *)text; *c; c++) {
+    if (*c == '"' || *c == '\\') sb_add(b, "\\%c", *c);
+    else if (*c < 0x20 || *c == '<' || *c == '>' || *c == '&') sb_add(b, "\\u%04x", *c);
+    else sb_add(b, "%c", *c);
+  }
+  sb_add(b, "\"");
+}
+
 static void sb_vec(sbuf *b, const double *v, int n) {
   sb_add(b, "[");
   for (int i = 0; i < n; i++) sb_add(b, "%s%.9g", i ? "," : "", v[i]);
@@ -349,7 +360,16 @@ static int write_page(const char *html, const char *title, const sbuf *data, int
     return 2;
   }
   for (const char *p = tpl; *p;) {
-    if (!strncmp(p, "@TITLE@", 7)) { fputs(title, f); p += 7; }
+    if (!strncmp(p, "@TITLE@", 7)) { /* HTML text: a CSV's name may hold any character */
+      for (const char *c = title; *c; c++) {
+        if (*c == '<') fputs("&lt;", f);
+        else if (*c == '>') fputs("&gt;", f);
+        else if (*c == '&') fputs("&amp;", f);
+        else if (*c == '"') fputs("&quot;", f);
+        else fputc(*c, f);
+      }
+      p += 7;
+    }
     else if (!strncmp(p, "@DATA@", 6)) { fwrite(data->s, 1, data->n, f); p += 6; }
     else if (!strncmp(p, "@PLAYER@", 8)) { fputs(player, f); p += 8; }
     else fputc(*p++, f);
@@ -388,7 +408,9 @@ int animate_write(const char *csv, const char *model, const char *scene, const c
   }
   sbuf b = {0};
   int rc = 0, tcol = 0;
-  sb_add(&b, "{\"model\":\"%s\",\"deformation_scale\":%.9g,\"time\":", model ? L->name : csv, scale);
+  sb_add(&b, "{\"model\":");
+  sb_string(&b, model ? L->name : csv);
+  sb_add(&b, ",\"deformation_scale\":%.9g,\"time\":", scale);
   sb_columns(&b, &t, &tcol, 1);
   sb_add(&b, ",\"bodies\":[");
   int cols[7 + 64 + 1], nbodies = 0;
@@ -417,7 +439,9 @@ int animate_write(const char *csv, const char *model, const char *scene, const c
       char name[256];
       snprintf(name, sizeof name, "%.*s", (int)(len - 9), n + 5);
       if (pose_columns(&t, name, 0, cols) < 7) continue;
-      sb_add(&b, "%s{\"name\":\"%s\",\"kind\":\"rigid\",\"r\":", nbodies++ ? "," : "", name);
+      sb_add(&b, "%s{\"name\":", nbodies++ ? "," : "");
+      sb_string(&b, name);
+      sb_add(&b, ",\"kind\":\"rigid\",\"r\":");
       sb_columns(&b, &t, cols, 3);
       sb_add(&b, ",\"p\":");
       sb_columns(&b, &t, cols + 3, 4);
