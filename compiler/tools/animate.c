@@ -272,23 +272,34 @@ static void body_from_model(sbuf *b, const lmodel *L, int ib, const csv_table *t
   sb_add(b, ",\"p\":");
   sb_columns(b, t, cols + 3, 4);
   /* the points of its joints and force elements that sit in the body frame
-   * (points on FE nodes are drawn as the nodes), each once */
+   * (points on FE nodes are drawn as the nodes), then those of its outputs
+   * given at a point, each once */
   sb_add(b, ",\"points\":[");
-  int np = 0;
-  for (int k = 0; k < L->m.nmarker; k++) {
-    const mb_markerdef *M = &L->marker[k];
-    if (M->body != ib - 1 || M->node >= 0) continue;
-    int seen = 0;
-    for (int j = 0; j < k && !seen; j++) {
-      const mb_markerdef *P = &L->marker[j];
-      seen = P->body == M->body && P->node < 0 && fabs(P->s[0] - M->s[0]) + fabs(P->s[1] - M->s[1]) +
-                                                         fabs(P->s[2] - M->s[2]) < 1e-12;
+  int np = 0, nmk = L->m.nmarker, nout = L->ir->noutputs;
+  double *seen = malloc(3 * (size_t)(nmk + nout + 1) * sizeof *seen);
+  for (int k = 0; seen && k < nmk + nout; k++) {
+    const double *s;
+    double sk[3];
+    if (k < nmk) {
+      const mb_markerdef *M = &L->marker[k];
+      if (M->body != ib - 1 || M->node >= 0) continue;
+      for (int i = 0; i < 3; i++) sk[i] = M->s[i];
+    } else {
+      const ir_output *o = &L->ir->outputs[k - nmk];
+      if (o->body != ib || !o->has_point || (o->kind == OUT_POSITION && o->node >= 0)) continue;
+      for (int i = 0; i < 3; i++) sk[i] = L->output[k - nmk].s[i];
     }
-    if (seen) continue;
-    double s[3] = {M->s[0], M->s[1], M->s[2]};
+    s = sk;
+    int dup = 0;
+    for (int j = 0; j < np && !dup; j++)
+      dup = fabs(seen[3 * j] - s[0]) + fabs(seen[3 * j + 1] - s[1]) + fabs(seen[3 * j + 2] - s[2]) < 1e-12;
+    if (dup) continue;
+    memcpy(seen + 3 * np, s, 3 * sizeof *s);
     sb_add(b, "%s", np++ ? "," : "");
     sb_vec(b, s, 3);
   }
+  if (!seen) b->bad = 1;
+  free(seen);
   sb_add(b, "]");
   const ir_shape *S = &B->shape;
   if (S->kind != SHAPE_NONE) {
