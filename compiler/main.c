@@ -461,10 +461,7 @@ static int cmd_run(const options *o) {
   }
   if (o->animate) { /* the page beside the CSV: results/<model>.html */
     char html[4096];
-    snprintf(html, sizeof html, "%s", csv);
-    char *dot = strrchr(html, '.'), *slash = strrchr(html, '/');
-    if (dot && (!slash || dot > slash)) *dot = 0;
-    strncat(html, ".html", sizeof html - strlen(html) - 1);
+    animate_page_name(csv, html, sizeof html);
     return animate_write(csv, o->model, o->scene, html, 1, o->quiet);
   }
   return 0;

@@ -500,6 +500,13 @@ int animate_write(const char *csv, const char *model, const char *scene, const c
   return rc;
 }
 
+void animate_page_name(const char *csv, char *html, size_t n) {
+  snprintf(html, n, "%s", csv);
+  char *dot = strrchr(html, '.'), *slash = strrchr(html, '/');
+  if (dot && (!slash || dot > slash)) *dot = 0;
+  strncat(html, ".html", n - strlen(html) - 1);
+}
+
 int cmd_animate(int argc, char **argv) {
   const char *csv = NULL, *model = NULL, *scene = NULL, *out = NULL;
   double scale = 1;
@@ -537,11 +544,6 @@ int cmd_animate(int argc, char **argv) {
   if (scene && !model) { fprintf(stderr, "mbcc: error: '--scene' needs the model (-m M.yaml)\n"); return 2; }
   char html[4096];
   if (out) snprintf(html, sizeof html, "%s", out);
-  else {
-    snprintf(html, sizeof html, "%s", csv);
-    char *dot = strrchr(html, '.'), *slash = strrchr(html, '/');
-    if (dot && (!slash || dot > slash)) *dot = 0;
-    strncat(html, ".html", sizeof html - strlen(html) - 1);
-  }
+  else animate_page_name(csv, html, sizeof html);
   return animate_write(csv, model, scene, html, scale, quiet);
 }

@@ -3,6 +3,8 @@
 #ifndef MBCC_ANIMATE_H
 #define MBCC_ANIMATE_H
 
+#include <stddef.h>
+
 #include "ir.h"
 
 /* Append the outputs the animation reads to the model: every body's position
@@ -18,6 +20,9 @@ int animate_add_pose_outputs(ir_model *ir);
  * is left half-written. */
 int animate_write(const char *csv, const char *model, const char *scene, const char *html,
                   double scale, int quiet);
+
+/* the page beside a CSV: its name with .html for .csv (or appended) */
+void animate_page_name(const char *csv, char *html, size_t n);
 
 /* mbcc animate results.csv [-m M.yaml] [--scene S] [-o out.html] [--scale S] [--quiet] */
 int cmd_animate(int argc, char **argv);
