@@ -22,7 +22,7 @@ CC_SRC  := compiler/main.c $(foreach d,$(CC_DIRS),$(wildcard $(d)/*.c))
 B       ?= build
 DEPFLAGS = -MMD -MP
 
-.PHONY: all test demo clean sanitize docs bench trade extremes
+.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser
 all: $(B)/mbcc $(B)/libmbrt.a $(B)/libmbrt_float.a
 
 # objects keep the source's folders: $(B)/rt/core/x.o, $(B)/cc/front/x.o
@@ -45,7 +45,8 @@ $(B)/libmbrt_float.a: $(patsubst runtime/%.c,$(B)/rt-float/%.o,$(RT_FLOAT_SRC))
 	rm -f $@ && ar rcs $@ $^
 
 # where the built mbcc finds its templates, runtime headers and library
-CC_DEFS := -DMBCC_ROOT='"$(ROOT)"' -DMBCC_RTLIB='"$(ROOT)/$(B)/libmbrt.a"' -DMBCC_GEN_CFLAGS='"$(CFLAGS)"'
+CC_DEFS := -DMBCC_ROOT='"$(ROOT)"' -DMBCC_RTLIB='"$(ROOT)/$(B)/libmbrt.a"' -DMBCC_GEN_CFLAGS='"$(CFLAGS)"' \
+           -DMBCC_PLAYER_JS='"$(ROOT)/$(B)/web/player.js"'
 $(B)/cc/%.o: compiler/%.c
 	@mkdir -p $(@D)
 	$(CC) $(STD) $(WARN) $(CFLAGS) $(DEPFLAGS) $(CC_INC) $(CC_DEFS) -c $< -o $@
@@ -71,6 +72,21 @@ trade: all
 # the stability suite at the extremes (tests/extremes/run.sh): writes docs/stability.md
 extremes: all
 	MBCC=$(B)/mbcc bash tests/extremes/run.sh
+
+# the browser animation's player (mbcc animate): web/player.js with three.js and
+# OrbitControls bundled by esbuild into one script that mbcc inlines into each
+# page; the npm packages are pinned by web/package-lock.json (npm ci)
+WEB := $(B)/web
+web: $(WEB)/player.js
+$(WEB)/node_modules/.installed: web/package.json web/package-lock.json
+	@command -v npm >/dev/null || { echo "make web: npm is missing (bash scripts/install-deps.sh installs it)"; exit 1; }
+	@mkdir -p $(WEB)
+	cp web/package.json web/package-lock.json $(WEB)/
+	cd $(WEB) && npm ci --no-audit --no-fund --loglevel=error
+	touch $@
+$(WEB)/player.js: web/player.js $(WEB)/node_modules/.installed
+	NODE_PATH=$(ROOT)/$(WEB)/node_modules $(WEB)/node_modules/.bin/esbuild web/player.js \
+	  --bundle --minify --format=iife --log-level=warning --outfile=$@
 
 include tests/tests.mk
 include docs/results.mk

@@ -1,4 +1,4 @@
-/* main.c: the mbcc command line: check, compile, run, bench, modes, plot, trade. */
+/* main.c: the mbcc command line: check, compile, run, bench, modes, plot, trade, animate. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <math.h>
@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "animate.h"
 #include "diag.h"
 #include "fe.h"
 #include "flex.h"
@@ -41,11 +42,13 @@ static void usage(void) {
           "                [--integrator rk4|dopri5|genalpha|auto] [-o results.csv] [--plot out.png|none]\n"
           "                [--end T] [--output-step H] [--step H] [--max-step H] [--rtol R] [--atol A]\n"
           "                [--stabilization projection|baumgarte|none] [--rho-inf R] [--max-steps N] [--quiet]\n"
+          "                [--animate]\n"
           "       mbcc bench M.yaml [--scene S] [--csv FILE] [--reps N] [--paths a,b,...]\n"
           "                [--integrator rk4|dopri5] [--end T] [--rtol R] [--atol A] [--ida-rtol R] [--quiet]\n"
           "       mbcc modes M.yaml --body NAME [--scene S] [--shapes shapes.csv]\n"
           "                [--write-modal body.modal.yaml]\n"
           "       mbcc plot results.csv [-o out.png] [--columns a,b,...]\n"
+          "       mbcc animate results.csv [-m M.yaml] [--scene S] [-o out.html] [--scale S] [--quiet]\n"
           "       mbcc trade M.yaml [--scene S] [--outputs a,b,...] [--max-error E] [--csv FILE]\n"
           "                [--plot FILE.png|none] [--reps N] [--end T] [--output-step H]\n"
           "                [--integrators rk4@H,dopri5@R,...]\n"
@@ -59,6 +62,7 @@ typedef struct {
   const char *sim_args[32];
   int nsim;
   int quiet;
+  int animate;      /* run --animate: pose outputs added, and the HTML animation written */
 } options;
 
 static int parse_options(int argc, char **argv, options *o) {
@@ -72,6 +76,7 @@ static int parse_options(int argc, char **argv, options *o) {
       continue;
     }
     if (!strcmp(a, "--quiet")) { o->quiet = 1; o->sim_args[o->nsim++] = a; continue; }
+    if (!strcmp(a, "--animate")) { o->animate = 1; continue; }
     if (!v) { fprintf(stderr, "mbcc: error: option '%s' needs a value\n", a); return 2; }
     i++;
     if (!strcmp(a, "--scene")) o->scene = v;
@@ -112,6 +117,10 @@ static int parse_options(int argc, char **argv, options *o) {
 static lmodel *build(const options *o, ir_model **irp, int verbose) {
   ir_model *ir = ir_read(o->model, o->scene);
   if (!ir) return NULL;
+  if (o->animate && animate_add_pose_outputs(ir)) {
+    ir_free(ir);
+    return NULL;
+  }
   lmodel *L = lower_model(ir);
   if (!L) {
     if (!diag_errors()) diag_error(o->model, (ir_loc){0, 0}, "out of memory while lowering");
@@ -295,6 +304,8 @@ static int plot_csv(const char *csv, const char *png, const char *columns) {
       char key[300];
       snprintf(key, sizeof key, ",%s,", names[c]);
       if (!strstr(list, key)) continue;
+    } else if (!strncmp(names[c], "body.", 5)) {
+      continue; /* the pose columns of run --animate are for the animation */
     }
     pick[np++] = c;
   }
@@ -448,6 +459,11 @@ static int cmd_run(const options *o) {
     if (plot_csv(csv, png, columns)) return 2;
     if (!o->quiet) printf("wrote %s\n", png);
   }
+  if (o->animate) { /* the page beside the CSV: results/<model>.html */
+    char html[4096];
+    animate_page_name(csv, html, sizeof html);
+    return animate_write(csv, o->model, o->scene, html, 1, o->quiet);
+  }
   return 0;
 }
 
@@ -490,6 +506,7 @@ int main(int argc, char **argv) {
   const char *cmd = argv[1];
   options o;
   if (!strcmp(cmd, "trade")) return cmd_trade(argc, argv);
+  if (!strcmp(cmd, "animate")) return cmd_animate(argc, argv);
   if (!strcmp(cmd, "plot")) {
     if (parse_options(argc, argv, &o)) return 2;
     char png[4096];

@@ -36,13 +36,19 @@ present() {
     libsundials-dev)    [ -e /usr/include/ida/ida.h ] && links sundials_ida && links sundials_nvecserial ;;
     gnuplot-nox)        gnuplot -e 'set terminal pngcairo' ;;
     clang)              command -v clang ;;
+    nodejs)             command -v node ;;
+    npm)                command -v npm ;;
+    chromium)           command -v chromium ;;
     *)                  false ;;
   esac >/dev/null 2>&1
 }
 
-# gnuplot-nox has the pngcairo terminal on Debian 12 (checked: 5.4.4)
+# gnuplot-nox has the pngcairo terminal on Debian 12 (checked: 5.4.4).
+# nodejs and npm build the animation player (make web: three.js, esbuild);
+# chromium plays the pages in make test-browser.  A Node.js installed some
+# other way (with its own npm) counts as present.
 packages=(build-essential libyaml-dev libsuitesparse-dev liblapack-dev libblas-dev
-          libcmocka-dev libsundials-dev gnuplot-nox clang)
+          libcmocka-dev libsundials-dev gnuplot-nox clang nodejs npm chromium)
 missing=()
 for p in "${packages[@]}"; do
   present "$p" || missing+=("$p")

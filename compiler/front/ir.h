@@ -95,6 +95,18 @@ typedef struct ir_flex {
   ir_loc loc;
 } ir_flex;
 
+/* what the browser animation draws for a rigid or virtual body (mbcc animate);
+ * the simulation does not use it */
+typedef enum { SHAPE_NONE, SHAPE_BOX, SHAPE_CYLINDER, SHAPE_SPHERE } ir_shape_kind;
+typedef struct {
+  ir_shape_kind kind;
+  double size[3];             /* BOX: edge lengths along the body axes */
+  double radius;              /* CYLINDER, SPHERE */
+  double length;              /* CYLINDER: along 'axis' */
+  double axis[3];             /* CYLINDER: unit axis, body axes (default z) */
+  double offset[3];           /* centre in body axes (default the body frame origin) */
+} ir_shape;
+
 typedef struct {
   char *name;
   ir_loc loc;                 /* of the body's key */
@@ -106,6 +118,7 @@ typedef struct {
   double velocity[3];         /* initial, global (made consistent at assembly) */
   double angular_velocity[3]; /* initial, global */
   struct ir_flex *flex;       /* NULL unless kind == BODY_FLEXIBLE */
+  ir_shape shape;             /* rigid and virtual: optional 'shape:' (animation only) */
 } ir_body;
 
 /* --- joints ------------------------------------------------------------------ */

@@ -144,9 +144,67 @@ static void parse_body_state(mapping *m, ir_body *b) {
   get_vector(m, "angular_velocity", 3, false, b->angular_velocity);
 }
 
+static const char *const shape_type_names[] = {"box", "cylinder", "sphere", NULL};
+
+/* 'shape': what the browser animation draws for the body (mbcc animate); the
+ * simulation does not use it.  Like every vector of the model, 'center' and
+ * 'axis' are global at t = 0; they are stored in body axes. */
+static void parse_shape(mapping *body, ir_body *b) {
+  yaml_node_t *n = map_get(body, "shape");
+  if (n == NULL)
+    return;
+  mapping m;
+  if (!map_open(&m, body->r, n, loc_of(n), "'shape' of body '%s'", b->name)) {
+    map_close(&m);
+    return;
+  }
+  static const char *const keys[] = {"type", "size", "radius", "length", "axis", "center", NULL};
+  int type;
+  ir_shape *S = &b->shape;
+  double A[9], axis[3] = {0, 0, 1}, center[3];
+  quaternion_to_matrix(b->orientation, A);
+  for (int i = 0; i < 3; i++) { /* the defaults: the body's z axis, its origin */
+    axis[i] = A[3 * i + 2];
+    center[i] = b->position[i];
+  }
+  if (get_choice(&m, "type", "shape type", shape_type_names, true, &type)) {
+    S->kind = (ir_shape_kind)(type + 1);
+    if (S->kind != SHAPE_BOX)
+      map_reject(&m, "size", "'size' is for a box; a %s has 'radius'", shape_type_names[type]);
+    if (S->kind != SHAPE_CYLINDER) {
+      map_reject(&m, "length", "'length' is for a cylinder");
+      map_reject(&m, "axis", "'axis' is for a cylinder");
+    }
+    if (S->kind == SHAPE_BOX) {
+      map_reject(&m, "radius", "'radius' is for a cylinder or a sphere; a box has 'size'");
+      if (get_vector(&m, "size", 3, true, S->size))
+        for (int i = 0; i < 3; i++)
+          if (!(S->size[i] > 0))
+            error_at(m.r, m.last_loc, "'size' of a box: every edge must be positive (got %g)",
+                     S->size[i]);
+    } else {
+      get_positive(&m, "radius", true, &S->radius);
+    }
+    if (S->kind == SHAPE_CYLINDER) {
+      get_positive(&m, "length", true, &S->length);
+      get_axis(&m, "axis", false, axis);
+    }
+  }
+  get_vector(&m, "center", 3, false, center);
+  map_check_keys(&m, keys);
+  map_close(&m);
+  for (int i = 0; i < 3; i++) { /* to body axes: A^T axis, A^T (center - position) */
+    S->axis[i] = S->offset[i] = 0;
+    for (int k = 0; k < 3; k++) {
+      S->axis[i] += A[3 * k + i] * axis[k];
+      S->offset[i] += A[3 * k + i] * (center[k] - b->position[k]);
+    }
+  }
+}
+
 static void parse_rigid_body(mapping *m, ir_body *b) {
   static const char *const keys[] = {"type",        "mass",     "inertia",          "position",
-                                     "orientation", "velocity", "angular_velocity", NULL};
+                                     "orientation", "velocity", "angular_velocity", "shape", NULL};
   map_check_keys(m, keys);
   get_positive(m, "mass", true, &b->mass);
   yaml_node_t *inertia = map_require(m, "inertia", true,
@@ -155,15 +213,17 @@ static void parse_rigid_body(mapping *m, ir_body *b) {
   if (inertia != NULL)
     parse_inertia(m->r, inertia, b->inertia);
   parse_body_state(m, b);
+  parse_shape(m, b);
 }
 
 static void parse_virtual_body(mapping *m, ir_body *b) {
   static const char *const keys[] = {"type", "position", "orientation", "velocity",
-                                     "angular_velocity", NULL};
+                                     "angular_velocity", "shape", NULL};
   map_reject(m, "mass", "virtual body '%s' is massless: remove 'mass'", b->name);
   map_reject(m, "inertia", "virtual body '%s' is massless: remove 'inertia'", b->name);
   map_check_keys(m, keys);
   parse_body_state(m, b);
+  parse_shape(m, b);
 }
 
 /* A list of node indices, each < nnodes (nnodes < 0: not checked yet). */
