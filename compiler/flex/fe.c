@@ -101,6 +101,9 @@ static ir_loc node_loc(const ir_flex *fx, int k) {
   return fx->loc;
 }
 
+/* the id a node is known by in messages: its deck id (imported) or its number */
+static long node_name(const ir_flex *fx, int k) { return fx->node_ids ? fx->node_ids[k] : k; }
+
 static void *xcalloc(size_t n, size_t size) { return calloc(n ? n : 1, size); }
 
 /* ------------------------------------------------------------------------- */
@@ -127,8 +130,10 @@ static int beam_frame(const ir_flex *fx, int e, beam_el *el, fe_ctx *c) {
       {"Young's modulus E", b->E}, {"shear modulus G", b->G}, {"density rho", b->rho},
       {"area A", b->A}, {"second moment Iy", b->Iy}, {"second moment Iz", b->Iz},
       {"torsion constant J", b->J}};
+  /* an imported deck may have rods (no bending), no torsion or massless bars:
+     a mechanism or a DOF without mass is then reported by the eigen-analysis */
   for (size_t i = 0; i < sizeof props / sizeof props[0]; i++)
-    if (!finite_pos(props[i].v))
+    if (!finite_pos(props[i].v) && !(fx->fe_path && i != 0 && i != 1 && i != 3 && props[i].v == 0))
       return fail_at(c, b->loc, "beam %d: %s must be positive (got %g)", e, props[i].name, props[i].v);
   if (b->theory == BEAM_TIMOSHENKO && (!finite_pos(b->shear_y) || !finite_pos(b->shear_z)))
     return fail_at(c, b->loc,
@@ -311,6 +316,20 @@ int fe_lumped_nodes(const ir_flex *fx, double *node_mass, double *node_inertia, 
   if (where) *where = no_loc;
   memset(node_mass, 0, sizeof(double) * (size_t)fx->nnodes);
   memset(node_inertia, 0, sizeof(double) * 9 * (size_t)fx->nnodes);
+  if (fx->M_given) {
+    /* an exported mass matrix: each node's mass by row sums of the
+       translational rows (the total mass is kept exactly), its rotary inertia
+       the node's own rotational block */
+    const ir_fe_matrix *Mg = fx->M_given;
+    for (int t = 0; t < Mg->nnz; t++) {
+      int i = Mg->row[t], j = Mg->col[t];
+      if (i < 0 || j < 0 || i >= 6 * fx->nnodes || j >= 6 * fx->nnodes) continue;
+      if (i % 6 < 3 && j % 6 == i % 6) node_mass[i / 6] += Mg->val[t] / 3;
+      if (i % 6 >= 3 && j % 6 >= 3 && i / 6 == j / 6)
+        node_inertia[9 * (i / 6) + 3 * (i % 6 - 3) + (j % 6 - 3)] += Mg->val[t];
+    }
+    return 0;
+  }
   for (int e = 0; e < fx->nbeams; e++) {
     beam_el el;
     if (beam_frame(fx, e, &el, &c)) return -1;
@@ -363,6 +382,20 @@ int fe_assemble_at(const ir_flex *fx, fe_system *out, char *err, size_t nerr, ir
     free(K); free(M); free(nm); free(ni);
     return fail_at(&c, fx->loc, "out of memory assembling %d DOFs", n);
   }
+  if (fx->K_given) { /* an exported K and M: taken as they are */
+    const ir_fe_matrix *G[2] = {fx->K_given, fx->M_given};
+    double *D[2] = {K, M};
+    for (int g = 0; g < 2; g++)
+      for (int t = 0; t < G[g]->nnz; t++) {
+        int i = G[g]->row[t], j = G[g]->col[t];
+        if (i < 0 || j < 0 || i >= n || j >= n) {
+          fail_at(&c, fx->loc, "FE matrix entry (%d, %d) outside the %d DOFs", i, j, n);
+          goto fail;
+        }
+        D[g][(size_t)j * n + i] += G[g]->val[t];
+      }
+    goto symmetric;
+  }
   for (int e = 0; e < fx->nbeams; e++) {
     beam_el el;
     if (beam_frame(fx, e, &el, &c)) goto fail;
@@ -398,6 +431,7 @@ int fe_assemble_at(const ir_flex *fx, fe_system *out, char *err, size_t nerr, ir
       }
     }
   }
+symmetric:
   /* exact symmetry */
   for (int j = 0; j < n; j++)
     for (int i = 0; i < j; i++) {
@@ -695,6 +729,11 @@ static int check_connectivity(const ir_flex *fx, const char *is_ref, fe_ctx *c) 
     deg[a]++; deg[b]++;
     p[uf_find(p, a)] = uf_find(p, b);
   }
+  for (int l = 0; l < fx->nlinks; l++) { /* an RBE2 connects as a beam would */
+    int a = fx->links[l].independent, b = fx->links[l].dependent;
+    deg[a]++; deg[b]++;
+    p[uf_find(p, a)] = uf_find(p, b);
+  }
   for (int i = 0; i < n; i++)
     if (is_ref[i]) held[uf_find(p, i)] = 1;
   int rc = 0;
@@ -702,12 +741,12 @@ static int check_connectivity(const ir_flex *fx, const char *is_ref, fe_ctx *c) 
     if (is_ref[i]) continue;
     if (deg[i] == 0)
       rc = fail_at(c, node_loc(fx, i),
-                   "node %d is not connected to any beam and is not a reference node: its DOFs "
-                   "have no stiffness (a mechanism)", i);
+                   "node %ld is not connected to any beam and is not a reference node: its DOFs "
+                   "have no stiffness (a mechanism)", node_name(fx, i));
     else if (!held[uf_find(p, i)])
       rc = fail_at(c, node_loc(fx, i),
-                   "node %d is not connected through beams to any reference node: that part of the "
-                   "structure is free-floating (a mechanism not held by the reference nodes)", i);
+                   "node %ld is not connected through beams to any reference node: that part of the "
+                   "structure is free-floating (a mechanism not held by the reference nodes)", node_name(fx, i));
   }
   free(p); free(deg); free(held);
   return rc;
@@ -735,11 +774,11 @@ static int check_definite(const ir_flex *fx, const double *Kf, int nf, const int
     int node = dof[bad] / 6;
     if (is_mass)
       return fail_at(c, node_loc(fx, node),
-                     "the mass matrix is singular at node %d DOF %s: a free DOF without mass or "
-                     "rotary inertia", node, dof_names[dof[bad] % 6]);
+                     "the mass matrix is singular at node %ld DOF %s: a free DOF without mass or "
+                     "rotary inertia", node_name(fx, node), dof_names[dof[bad] % 6]);
     return fail_at(c, node_loc(fx, node),
-                   "the stiffness matrix is singular at node %d DOF %s: a mechanism not held by the "
-                   "reference nodes", node, dof_names[dof[bad] % 6]);
+                   "the stiffness matrix is singular at node %ld DOF %s: a mechanism not held by the "
+                   "reference nodes", node_name(fx, node), dof_names[dof[bad] % 6]);
   }
   return 0;
 }
@@ -806,48 +845,216 @@ static int eig_select(const ir_flex *fx, int n, const double *K, const double *M
   return 0;
 }
 
+/* Each FE DOF: free (0), fixed to the body frame (1: reference conditions,
+ * SPCs, DOFs an export lacks), or following another node (2: RBE2). */
+static int dof_states(const ir_flex *fx, char *state, char *is_int, fe_ctx *c) {
+  int nnodes = fx->nnodes;
+  for (int r = 0; r < fx->nreference; r++) {
+    int k = fx->reference[r];
+    if (k < 0 || k >= nnodes)
+      return fail_at(c, fx->loc, "reference node %d out of range (the body has %d nodes)", k, nnodes);
+  }
+  switch (fx->reference_kind) {
+  case REFERENCE_CLAMPED:
+    if (fx->nreference < 1 || !fx->reference)
+      return fail_at(c, fx->loc,
+                     "an FE flexible body needs at least one reference node (nodes fixed to the body "
+                     "frame)");
+    for (int r = 0; r < fx->nreference; r++) memset(state + 6 * fx->reference[r], 1, 6);
+    break;
+  case REFERENCE_CHORD: {
+    /* pinned at A (translations, and the twist about the chord), on the
+       chord's line at B (the two translations across it); body x = chord */
+    if (fx->nreference != 2 || fx->reference[0] == fx->reference[1])
+      return fail_at(c, fx->loc, "a chord frame needs two different nodes [A, B]");
+    int a = fx->reference[0], b = fx->reference[1];
+    const double *pa = fx->nodes + 3 * a, *pb = fx->nodes + 3 * b;
+    double d = hypot(hypot(pb[0] - pa[0], pb[1] - pa[1]), pb[2] - pa[2]);
+    if (!(pa[0] == 0 && pa[1] == 0 && pa[2] == 0) || !(fabs(pb[1]) <= 1e-12 * d && fabs(pb[2]) <= 1e-12 * d && pb[0] > 0))
+      return fail_at(c, fx->loc, "a chord frame needs its origin at node %ld and its x axis towards node %ld",
+                     node_name(fx, a), node_name(fx, b));
+    memset(state + 6 * a, 1, 4);
+    state[6 * b + 1] = state[6 * b + 2] = 1;
+    break;
+  }
+  case REFERENCE_FREE:
+    break;
+  }
+  if (fx->fixed)
+    for (int i = 0; i < 6 * nnodes; i++)
+      if (fx->fixed[i]) state[i] = 1;
+  for (int r = 0; r < fx->ninterface; r++) {
+    int k = fx->interface[r];
+    if (k < 0 || k >= nnodes)
+      return fail_at(c, fx->loc, "interface node %d out of range (the body has %d nodes)", k, nnodes);
+    for (int d = 0; d < 6; d++)
+      if (!state[6 * k + d]) is_int[k] = 1;
+  }
+  for (int l = 0; l < fx->nlinks; l++) {
+    const ir_rigid_link *L = &fx->links[l];
+    for (int d = 0; d < 6; d++) {
+      if (!(L->dofs >> d & 1)) continue;
+      if (state[6 * L->dependent + d] || is_int[L->dependent])
+        return fail_at(c, L->loc, "RBE2: node %ld's DOF %s is already fixed, an interface DOF or "
+                       "dependent on another RBE2", node_name(fx, L->dependent), dof_names[d]);
+      state[6 * L->dependent + d] = 2;
+    }
+  }
+  for (int l = 0; l < fx->nlinks; l++) {
+    const ir_rigid_link *L = &fx->links[l];
+    for (int d = 0; d < 6; d++)
+      if (state[6 * L->independent + d] == 2)
+        return fail_at(c, L->loc, "RBE2: independent node %ld is itself dependent (chained RBE2s)",
+                       node_name(fx, L->independent));
+  }
+  return 0;
+}
+
+/* Row 'dep' DOF d of an RBE2 as a combination of the independent node's
+ * DOFs: u_d = u_i + theta_i x (x_d - x_i), theta_d = theta_i.  coef[6]. */
+static void link_row(const ir_flex *fx, const ir_rigid_link *L, int d, double coef[6]) {
+  const double *xi = fx->nodes + 3 * L->independent, *xd = fx->nodes + 3 * L->dependent;
+  double r[3] = {xd[0] - xi[0], xd[1] - xi[1], xd[2] - xi[2]};
+  memset(coef, 0, 6 * sizeof(double));
+  coef[d] = 1;
+  if (d < 3) { /* (theta x r)_d = sum_k eps_{d k j} theta_k r_j */
+    int d1 = (d + 1) % 3, d2 = (d + 2) % 3;
+    coef[3 + d1] = r[d2];
+    coef[3 + d2] = -r[d1];
+  }
+}
+
+/* fold the RBE2-dependent DOFs of K (n x n) into their independent DOFs:
+ * K <- T^T K T with the dependent rows and columns then zero */
+static void fold_links(const ir_flex *fx, double *K, int n) {
+  for (int l = 0; l < fx->nlinks; l++) {
+    const ir_rigid_link *L = &fx->links[l];
+    for (int d = 0; d < 6; d++) {
+      if (!(L->dofs >> d & 1)) continue;
+      int i = 6 * L->dependent + d;
+      double coef[6];
+      link_row(fx, L, d, coef);
+      for (int a = 0; a < 6; a++) { /* rows */
+        if (coef[a] == 0) continue;
+        int t = 6 * L->independent + a;
+        for (int j = 0; j < n; j++) K[(size_t)j * n + t] += coef[a] * K[(size_t)j * n + i];
+      }
+      for (int a = 0; a < 6; a++) { /* columns */
+        if (coef[a] == 0) continue;
+        int t = 6 * L->independent + a;
+        for (int j = 0; j < n; j++) K[(size_t)t * n + j] += coef[a] * K[(size_t)i * n + j];
+      }
+      for (int j = 0; j < n; j++) K[(size_t)j * n + i] = K[(size_t)i * n + j] = 0;
+    }
+  }
+}
+
+/* the dependent rows of shapes X (n x m, full DOF numbering) from their independent ones */
+static void unfold_links(const ir_flex *fx, double *X, int n, int m) {
+  for (int l = 0; l < fx->nlinks; l++) {
+    const ir_rigid_link *L = &fx->links[l];
+    for (int d = 0; d < 6; d++) {
+      if (!(L->dofs >> d & 1)) continue;
+      double coef[6];
+      link_row(fx, L, d, coef);
+      for (int j = 0; j < m; j++) {
+        double v = 0;
+        for (int a = 0; a < 6; a++) v += coef[a] * X[(size_t)j * n + 6 * L->independent + a];
+        X[(size_t)j * n + 6 * L->dependent + d] = v;
+      }
+    }
+  }
+}
+
+/* Free-free modes in mean axes: the problem (K + sigma M) x = (lambda + sigma) M x
+ * (positive definite); its 6 lowest modes are the rigid-body motions and are
+ * dropped, the rest are M-orthogonal to them (the mean-axis conditions:
+ * sum m u = 0, sum (m x u + J theta) = 0).  The selection applies to the
+ * elastic modes. */
+static int eig_select_free(const ir_flex *fx, int n, const double *K, const double *M,
+                           double *all_hz, int *sel, int *ns, double *hz, double *X, fe_ctx *c) {
+  if (n <= 6) return fail_at(c, fx->loc, "a free-free body needs more than 6 free DOFs");
+  size_t nn = (size_t)n * (size_t)n;
+  double kmax = 0, mmax = 0;
+  for (int i = 0; i < n; i++) {
+    kmax = fmax(kmax, K[(size_t)i * n + i]);
+    mmax = fmax(mmax, M[(size_t)i * n + i]);
+  }
+  /* small beside the stiff end of the spectrum, yet a well-conditioned factor */
+  double sigma = 1e-8 * kmax / mmax;
+  double *Ks = malloc(nn * sizeof(double)), *lam = malloc((size_t)n * sizeof(double));
+  eig_ws ws;
+  memset(&ws, 0, sizeof ws);
+  int rc = -1;
+  if (!Ks || !lam) { fail_at(c, fx->loc, "out of memory"); goto done; }
+  for (size_t i = 0; i < nn; i++) Ks[i] = K[i] + sigma * M[i];
+  int e = eig_reduce(n, Ks, M, &ws, lam);
+  if (e) {
+    fail_at(c, fx->loc, "the eigensolver failed (%s)",
+            e == 1 ? "the mass matrix is not positive definite" : "LAPACK error");
+    goto done;
+  }
+  for (int i = 0; i < n; i++) lam[i] -= sigma;
+  if (!(lam[6] > 1e-6 * sigma)) {
+    fail_at(c, fx->loc, "the free-free body has more than 6 rigid-body modes (a mechanism, or parts "
+            "not connected)");
+    goto done;
+  }
+  for (int i = 6; i < n; i++) all_hz[i - 6] = lam_to_hz(lam[i]);
+  if (select_modes(fx, all_hz, n - 6, sel, ns, "free-free elastic modes", c)) goto done;
+  if (*ns > 0) {
+    int lo = sel[0] + 6, hi = sel[*ns - 1] + 6, m = hi - lo + 1;
+    double *lv = malloc((size_t)m * sizeof(double)), *Xr = malloc((size_t)n * m * sizeof(double));
+    if (!lv || !Xr || eig_vectors(&ws, K, M, lo, hi, lv, Xr)) {
+      free(lv); free(Xr);
+      fail_at(c, fx->loc, "the eigensolver failed (LAPACK error computing mode shapes)");
+      goto done;
+    }
+    for (int j = 0; j < *ns; j++) {
+      int i = sel[j] + 6 - lo;
+      hz[j] = all_hz[sel[j]] = lam_to_hz(lv[i]);
+      memcpy(X + (size_t)j * n, Xr + (size_t)i * n, (size_t)n * sizeof(double));
+    }
+    free(lv); free(Xr);
+  }
+  rc = 0;
+done:
+  free(Ks); free(lam); eig_free(&ws);
+  return rc;
+}
+
 static int modes_from_fe(const ir_flex *fx, fe_modes *out, fe_ctx *c) {
   if (check_flex_common(fx, c)) return -1;
   int nnodes = fx->nnodes, ndof = 6 * nnodes;
-  if (fx->nreference < 1 || !fx->reference)
-    return fail_at(c, fx->loc,
-                   "an FE flexible body needs at least one reference node (nodes fixed to the body "
-                   "frame)");
   char *is_ref = xcalloc((size_t)nnodes, 1), *is_int = xcalloc((size_t)nnodes, 1);
+  char *state = xcalloc((size_t)ndof, 1);
   int *perm = xcalloc((size_t)ndof, sizeof(int));
   int *sel = NULL;
   double *Kf = NULL, *Mf = NULL, *X = NULL, *w = NULL, *T = NULL, *Kr = NULL, *Mr = NULL,
          *tmp = NULL, *Y = NULL, *wi = NULL, *Phi = NULL, *Kii = NULL, *Mii = NULL;
   fe_system sys = {0, NULL, NULL};
   int rc = -1;
-  if (!is_ref || !is_int || !perm) { fail_at(c, fx->loc, "out of memory"); goto done; }
-  for (int r = 0; r < fx->nreference; r++) {
-    int k = fx->reference[r];
-    if (k < 0 || k >= nnodes) {
-      fail_at(c, fx->loc, "reference node %d out of range (the body has %d nodes)", k, nnodes);
-      goto done;
-    }
-    is_ref[k] = 1;
-  }
-  for (int r = 0; r < fx->ninterface; r++) {
-    int k = fx->interface[r];
-    if (k < 0 || k >= nnodes) {
-      fail_at(c, fx->loc, "interface node %d out of range (the body has %d nodes)", k, nnodes);
-      goto done;
-    }
-    is_int[k] = !is_ref[k];
-  }
+  if (!is_ref || !is_int || !perm || !state) { fail_at(c, fx->loc, "out of memory"); goto done; }
+  if (dof_states(fx, state, is_int, c)) goto done;
+  /* held nodes for the connectivity test: any fixed DOF (free-free: the first node) */
+  for (int i = 0; i < ndof; i++)
+    if (state[i] == 1) is_ref[i / 6] = 1;
+  if (fx->reference_kind == REFERENCE_FREE) is_ref[0] = 1;
   if (fe_assemble_at(fx, &sys, c->err, c->nerr, c->where)) goto done;
-  if (check_connectivity(fx, is_ref, c)) goto done;
+  if (!fx->K_given && check_connectivity(fx, is_ref, c)) goto done;
+  fold_links(fx, sys.K, ndof);
+  fold_links(fx, sys.M, ndof);
 
   /* free DOFs, ordered interface (b) first, then internal (i) */
   int nb = 0, ni = 0;
   for (int k = 0; k < nnodes; k++)
     if (is_int[k])
-      for (int d = 0; d < 6; d++) perm[nb++] = 6 * k + d;
+      for (int d = 0; d < 6; d++)
+        if (!state[6 * k + d]) perm[nb++] = 6 * k + d;
   for (int k = 0; k < nnodes; k++)
-    if (!is_ref[k] && !is_int[k])
-      for (int d = 0; d < 6; d++) perm[nb + ni++] = 6 * k + d;
+    if (!is_int[k])
+      for (int d = 0; d < 6; d++)
+        if (!state[6 * k + d]) perm[nb + ni++] = 6 * k + d;
   int nf = nb + ni;
   size_t nnf = (size_t)nf * (size_t)nf;
   Kf = xcalloc(nnf, sizeof(double));
@@ -855,7 +1062,13 @@ static int modes_from_fe(const ir_flex *fx, fe_modes *out, fe_ctx *c) {
   if (!Kf || !Mf) { fail_at(c, fx->loc, "out of memory"); goto done; }
   gather(sys.K, ndof, perm, nf, perm, nf, Kf);
   gather(sys.M, ndof, perm, nf, perm, nf, Mf);
-  if (check_definite(fx, Kf, nf, perm, 0, c) || check_definite(fx, Mf, nf, perm, 1, c)) goto done;
+  if ((fx->reference_kind != REFERENCE_FREE && check_definite(fx, Kf, nf, perm, 0, c)) ||
+      check_definite(fx, Mf, nf, perm, 1, c))
+    goto done;
+  if (fx->reference_kind == REFERENCE_FREE && nb > 0) {
+    fail_at(c, fx->loc, "a free-free body takes no interface nodes (its modes are free-interface)");
+    goto done;
+  }
 
   int nmodes, nall, bad = -1, e;
   if (nb == 0) {
@@ -866,11 +1079,16 @@ static int modes_from_fe(const ir_flex *fx, fe_modes *out, fe_ctx *c) {
     sel = xcalloc((size_t)nf, sizeof(int));
     if (!X || !w || !wi || !sel) { fail_at(c, fx->loc, "out of memory"); goto done; }
     int ns = 0;
-    if (eig_select(fx, nf, Kf, Mf, "constrained normal modes", wi, sel, &ns, w, X, c)) goto done;
+    if (fx->reference_kind == REFERENCE_FREE) {
+      if (eig_select_free(fx, nf, Kf, Mf, wi, sel, &ns, w, X, c)) goto done;
+      nall = nf - 6;
+    } else {
+      if (eig_select(fx, nf, Kf, Mf, "constrained normal modes", wi, sel, &ns, w, X, c)) goto done;
+      nall = nf;
+    }
     nmodes = ns;
-    nall = nf;
     if (alloc_modes(out, nnodes, nmodes, nall)) { fail_at(c, fx->loc, "out of memory"); goto done; }
-    memcpy(out->all_freq_hz, wi, (size_t)nf * sizeof(double));
+    memcpy(out->all_freq_hz, wi, (size_t)nall * sizeof(double));
     for (int j = 0; j < nmodes; j++) {
       double *x = X + (size_t)j * nf;
       fix_sign(x, nf);
@@ -951,12 +1169,13 @@ static int modes_from_fe(const ir_flex *fx, fe_modes *out, fe_ctx *c) {
       for (int i = 0; i < nf; i++) out->shapes[(size_t)j * ndof + perm[i]] = x[i];
     }
   }
+  unfold_links(fx, out->shapes, ndof, out->nmodes);
   memcpy(out->x, fx->nodes, 3 * (size_t)nnodes * sizeof(double));
   if (fe_lumped_nodes(fx, out->node_mass, out->node_inertia, c->err, c->nerr, c->where)) goto done;
   rc = 0;
 done:
   fe_system_free(&sys);
-  free(is_ref); free(is_int); free(perm); free(sel);
+  free(is_ref); free(is_int); free(state); free(perm); free(sel);
   free(Kf); free(Mf); free(X); free(w); free(T); free(Kr); free(Mr); free(tmp); free(Y);
   free(wi); free(Phi); free(Kii); free(Mii);
   return rc;

@@ -174,6 +174,10 @@ int flex_compute_modes(const char *path, const ir_body *B, fe_modes *fm) {
   char err[512];
   ir_loc where = {0, 0};
   if (!fe_compute_modes_at(B->flex, fm, err, sizeof err, &where)) return 0;
+  if (B->flex->fe_path) { /* imported: places in the FE file are the importer's; nodes by id */
+    diag_error(path, B->loc, "flexible body '%s' (FE file %s): %s", B->name, B->flex->fe_path, err);
+    return 2;
+  }
   if (where.line > 0)
     diag_error(path, where, "flexible body '%s': %s", B->name, err);
   else if (strstr(err, ": error: ")) /* a modal data file's own diagnostic */

@@ -64,6 +64,26 @@ typedef struct {
   ir_loc loc;
 } ir_point_mass;
 
+/* RBE2: the 'dofs' (bit d: DOF d of ux uy uz rx ry rz) of node 'dependent'
+ * follow node 'independent' rigidly */
+typedef struct {
+  int independent, dependent;
+  unsigned dofs;
+  ir_loc loc;
+} ir_rigid_link;
+
+/* An FE matrix given as such (Matrix Market import): nnz entries (row, col,
+ * value) in the 6-per-node DOF numbering, body axes; both triangles. */
+typedef struct {
+  int nnz;
+  int *row, *col;
+  double *val;
+} ir_fe_matrix;
+
+/* reference conditions: nodes clamped to the body frame; a pinned-pinned
+ * (chord) frame; free-free modes in mean axes (frame at the centre of mass) */
+typedef enum { REFERENCE_CLAMPED, REFERENCE_CHORD, REFERENCE_FREE } ir_reference_kind;
+
 typedef struct ir_flex {
   /* FE description (nmodal_file == NULL) */
   int nnodes;
@@ -78,6 +98,19 @@ typedef struct ir_flex {
   int nreference;
   int *interface;          /* Craig-Bampton interface nodes (none: constrained normal modes) */
   int ninterface;
+  ir_reference_kind reference_kind; /* CHORD: reference = [A, B]; FREE: none */
+  /* imported FE models (fe_file) */
+  char *fe_path;           /* the FE file it came from (NULL: inline); its errors are reported
+                              by the importer, later ones at the body, naming nodes by id */
+  long *node_ids;          /* nnodes: the deck's GRID ids that name the nodes (NULL: 0, 1, ...) */
+  unsigned char *fixed;    /* 6 * nnodes: DOFs fixed to the body frame besides 'reference' (SPC,
+                              DOFs an FE export does not have), or NULL */
+  ir_rigid_link *links;    /* RBE2 */
+  int nlinks;
+  ir_fe_matrix *K_given, *M_given; /* Matrix Market: the whole K and M (instead of beams) */
+  double *w0, *wd0;        /* initial modal coordinates and rates (n0, nd0 of them), or NULL */
+  int nw0, nwd0;
+  ir_loc w0_loc, wd0_loc;
   /* modal data file instead of FE (documented neutral format) */
   char *modal_file;
   /* mode selection */

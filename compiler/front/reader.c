@@ -11,6 +11,7 @@
  * is yaml_map.c; the namespace of names and references, names.c. */
 #include "ir.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -28,6 +29,8 @@
 #include "sim.h"
 #include "element.h"
 #include "yaml_map.h"
+#include "fe_import.h"
+#include "fe.h"
 
 
 static bool is_null_scalar(const yaml_node_t *n) {
@@ -41,6 +44,12 @@ static int to_fe_node(reader *r, yaml_node_t *n, const ir_body *b) {
   char label[SHOWN_SIZE];
   snprintf(label, sizeof label, "FE node of body '%s'", b->name);
   if (!to_number(r, n, label, &v)) return -1;
+  if (b->flex && b->flex->node_ids) { /* an imported FE model: nodes by their ids */
+    int k = v == floor(v) && fabs(v) < 1e15 ? fe_node_index(b->flex, (long)v) : -1;
+    if (k < 0) error_at(r, loc_of(n), "body '%s' has no node %g (its FE file %s has no such node id)", b->name, v,
+                        b->flex->fe_path);
+    return k;
+  }
   int nn = b->flex && b->flex->nodes ? b->flex->nnodes : -1;
   if (v != floor(v) || v < 0 || (nn >= 0 && v >= nn)) {
     if (nn >= 0)
@@ -367,13 +376,183 @@ void parse_modal_settings(mapping *m, ir_flex *fx) {
   }
 }
 
+/* a file name given in the model, relative to the model file's directory */
+static char *model_relative_path(reader *r, const yaml_node_t *n) {
+  const char *slash = strrchr(r->path, '/');
+  const char *fname = scalar_text(n);
+  size_t dl = (slash && fname[0] != '/') ? (size_t)(slash - r->path + 1) : 0;
+  char *path = xcalloc(dl + scalar_length(n) + 1, 1);
+  memcpy(path, r->path, dl);
+  memcpy(path + dl, fname, scalar_length(n));
+  return path;
+}
+
+/* 'fe_file': a Nastran deck, or Matrix Market matrices with their DOF map
+ * and nodes (compiler/flex/fe_import.h); the node positions, global */
+static double *parse_fe_file(mapping *m, ir_body *b, ir_flex *fx) {
+  reader *r = m->r;
+  static const char *const fe_inline[] = {"line", "nodes", "beams", "section", "material", "theory",
+                                          "point_masses", "modal_file", NULL};
+  for (int i = 0; fe_inline[i]; i++)
+    map_reject(m, fe_inline[i], "flexible body '%s': '%s' does not go with 'fe_file' (the FE file holds "
+               "the model)", b->name, fe_inline[i]);
+  yaml_node_t *n = map_get(m, "fe_file");
+  double *global = NULL;
+  int rc = 0;
+  if (n->type == YAML_SCALAR_NODE) {
+    char *path = model_relative_path(r, n);
+    const char *dot = strrchr(path, '.');
+    char ext[8] = "";
+    for (size_t i = 0; dot && dot[i] && i + 1 < sizeof ext; i++) ext[i] = (char)tolower((unsigned char)dot[i]);
+    if (strcmp(ext, ".bdf") && strcmp(ext, ".dat") && strcmp(ext, ".nas")) {
+      error_at(r, loc_of(n), "'fe_file': a Nastran deck ends in .bdf, .dat or .nas (got '%s'); Matrix "
+               "Market files are given as {stiffness, mass, dofs, nodes}", scalar_text(n));
+      free(path);
+      return NULL;
+    }
+    int mk = 0;
+    if (get_choice(m, "mass", "mass matrix", mass_kind_names, false, &mk)) fx->mass = (ir_mass_kind)mk;
+    rc = fe_import_nastran(path, fx, &global);
+    free(path);
+  } else {
+    mapping fm;
+    if (map_open(&fm, r, n, loc_of(n), "'fe_file' of %s", m->what)) {
+      static const char *const keys[] = {"stiffness", "mass", "dofs", "nodes", NULL};
+      map_check_keys(&fm, keys);
+      char *paths[4] = {NULL, NULL, NULL, NULL};
+      for (int i = 0; i < 4; i++) {
+        yaml_node_t *v = map_require(&fm, keys[i], true, "a file name");
+        if (v && v->type == YAML_SCALAR_NODE) paths[i] = model_relative_path(r, v);
+        else if (v) error_at(r, loc_of(v), "'%s' must be a file name", keys[i]);
+      }
+      map_reject(m, "mass", "flexible body '%s': the mass matrix comes from 'fe_file'", b->name);
+      if (paths[0] && paths[1] && paths[2] && paths[3]) {
+        fe_mtx_files files = {paths[0], paths[1], paths[2], paths[3]};
+        rc = fe_import_mtx(&files, fx, &global);
+      }
+      for (int i = 0; i < 4; i++) free(paths[i]);
+    }
+    map_close(&fm);
+  }
+  if (rc) diag_note(r->path, loc_of(n), "in the FE file of flexible body '%s'", b->name);
+  return global;
+}
+
+/* node numbers of fx (imported: the file's node ids) */
+static int *to_flex_node_list(reader *r, yaml_node_t *n, const char *label, const ir_flex *fx, int nnodes,
+                              int *count) {
+  if (!fx->node_ids) return to_node_list(r, n, label, nnodes, count);
+  int *out = to_node_list(r, n, label, -1, count);
+  for (int i = 0; out && i < *count; i++) {
+    int k = fe_node_index(fx, out[i]);
+    if (k < 0)
+      error_at(r, loc_of(n), "%s: node %d is not a node id of %s", label, out[i], fx->fe_path);
+    out[i] = k < 0 ? 0 : k;
+  }
+  return out;
+}
+
+/* 'reference': a list of clamped nodes, {chord: [A, B]} or free */
+static int *parse_flex_reference(reader *r, yaml_node_t *ref, ir_flex *fx, int nnodes, int *count) {
+  *count = 0;
+  if (ref->type == YAML_SCALAR_NODE && scalar_equals(ref, "free")) {
+    fx->reference_kind = REFERENCE_FREE;
+    return NULL;
+  }
+  if (ref->type == YAML_MAPPING_NODE) {
+    mapping rm;
+    int *out = NULL;
+    if (map_open(&rm, r, ref, loc_of(ref), "'reference'")) {
+      static const char *const keys[] = {"chord", NULL};
+      map_check_keys(&rm, keys);
+      yaml_node_t *ch = map_require(&rm, "chord", true, "two nodes [A, B]");
+      if (ch) {
+        out = to_flex_node_list(r, ch, "'chord'", fx, nnodes, count);
+        if (*count != 2 || seq_length(ch) != 2 || out[0] == out[1])
+          error_at(r, loc_of(ch), "'chord': expected two different nodes [A, B]");
+        fx->reference_kind = REFERENCE_CHORD;
+      }
+    }
+    map_close(&rm);
+    return out;
+  }
+  if (ref->type != YAML_SEQUENCE_NODE) {
+    error_at(r, loc_of(ref), "'reference': expected a list of nodes, {chord: [A, B]} or free (got %s)",
+             show_node(r, ref));
+    return NULL;
+  }
+  return to_flex_node_list(r, ref, "'reference'", fx, nnodes, count);
+}
+
+/* the body frame of a chord (origin at A, x towards B) or free-free (origin
+ * at the centre of mass) reference; global: the node positions */
+static void place_reference_frame(mapping *m, ir_body *b, const double *global, bool has_position,
+                                  bool has_orientation) {
+  reader *r = m->r;
+  ir_flex *fx = b->flex;
+  if (fx->reference_kind == REFERENCE_CHORD && fx->nreference == 2) {
+    if (!has_orientation &&
+        fe_chord_axes(global + 3 * fx->reference[0], global + 3 * fx->reference[1], b->orientation))
+      error_at(r, m->loc, "flexible body '%s': the chord's nodes coincide", b->name);
+    return;
+  }
+  if (fx->reference_kind != REFERENCE_FREE) return;
+  if (has_position) {
+    error_at(r, m->loc, "flexible body '%s': a free-free body's frame is at its centre of mass (leave "
+             "'position' out)", b->name);
+    return;
+  }
+  /* lumped masses (rotation-invariant: the model is still global here) */
+  double *nm = xcalloc((size_t)fx->nnodes, sizeof *nm), *ni = xcalloc(9 * (size_t)fx->nnodes, sizeof *ni);
+  double *keep = fx->nodes, total = 0, c[3] = {0, 0, 0};
+  char err[256];
+  fx->nodes = (double *)global;
+  if (fe_lumped_nodes(fx, nm, ni, err, sizeof err, NULL) == 0)
+    for (int k = 0; k < fx->nnodes; k++) {
+      total += nm[k];
+      for (int i = 0; i < 3; i++) c[i] += nm[k] * global[3 * k + i];
+    }
+  fx->nodes = keep;
+  if (total > 0)
+    for (int i = 0; i < 3; i++) b->position[i] = c[i] / total;
+  free(nm);
+  free(ni);
+}
+
+/* 'initial_modes', 'initial_mode_rates': w and its rate at t = 0 (one value
+ * per selected mode; checked when the modes are known) */
+static void parse_initial_modes(mapping *m, ir_flex *fx) {
+  reader *r = m->r;
+  static const char *const keys[2] = {"initial_modes", "initial_mode_rates"};
+  double **dst[2] = {&fx->w0, &fx->wd0};
+  int *cnt[2] = {&fx->nw0, &fx->nwd0};
+  ir_loc *loc[2] = {&fx->w0_loc, &fx->wd0_loc};
+  for (int k = 0; k < 2; k++) {
+    yaml_node_t *n = map_get(m, keys[k]);
+    if (!n) continue;
+    *loc[k] = loc_of(n);
+    if (n->type != YAML_SEQUENCE_NODE || seq_length(n) < 1) {
+      error_at(r, loc_of(n), "'%s': expected a list of numbers, one per selected mode", keys[k]);
+      continue;
+    }
+    *cnt[k] = seq_length(n);
+    *dst[k] = xcalloc((size_t)*cnt[k], sizeof **dst[k]);
+    for (int i = 0; i < *cnt[k]; i++) {
+      char label[64];
+      snprintf(label, sizeof label, "item %d of '%s'", i + 1, keys[k]);
+      to_number(r, seq_item(r, n, i), label, &(*dst[k])[i]);
+    }
+  }
+}
+
 static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
   reader *r = m->r;
   (void)type_loc;
   static const char *const keys[] = {
       "type",    "position",  "orientation", "velocity", "angular_velocity", "line",
       "nodes",   "beams",     "section",     "material", "theory",           "mass",
-      "point_masses", "reference", "interface", "modes", "damping", "coupling", "modal_file", NULL};
+      "point_masses", "reference", "interface", "modes", "damping", "coupling", "modal_file",
+      "fe_file", "initial_modes", "initial_mode_rates", NULL};
   map_reject(m, "inertia", "flexible body '%s': its inertia comes from its FE model", b->name);
   map_check_keys(m, keys);
   ir_flex *fx = xcalloc(1, sizeof *fx);
@@ -405,6 +584,8 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
       memcpy(fx->modal_file, r->path, dl);
       memcpy(fx->modal_file + dl, fname, scalar_length(modal_file));
     }
+  } else if (map_get(m, "fe_file") != NULL) {
+    global = parse_fe_file(m, b, fx);
   } else if (line != NULL && nodes != NULL) {
     error_at(r, loc_of(nodes), "give either 'line' or 'nodes', not both");
   } else if (line == NULL && nodes == NULL) {
@@ -565,19 +746,29 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
   /* reference conditions and Craig-Bampton interface */
   int nn = modal_file ? -1 : fx->nnodes;
   yaml_node_t *ref = map_get(m, "reference");
+  if (map_get(m, "fe_file") && !global) { /* the import failed (reported): nothing to refer to */
+    map_get(m, "interface");
+    map_get(m, "position");
+    parse_modal_settings(m, fx);
+    parse_initial_modes(m, fx);
+    return;
+  }
   if (ref != NULL) {
-    fx->reference = to_node_list(r, ref, "'reference'", nn, &fx->nreference);
+    fx->reference = parse_flex_reference(r, ref, fx, nn, &fx->nreference);
   } else if (!modal_file) {
     fx->reference = xcalloc(1, sizeof *fx->reference);
-    fx->nreference = 1; /* node 0 */
+    fx->nreference = 1; /* the first node */
   }
   yaml_node_t *itf = map_get(m, "interface");
-  if (itf != NULL) fx->interface = to_node_list(r, itf, "'interface'", nn, &fx->ninterface);
+  if (itf != NULL) fx->interface = to_flex_node_list(r, itf, "'interface'", fx, nn, &fx->ninterface);
 
-  /* body frame: the given position, or the first reference node */
+  /* body frame: the given position, or the first reference node (free-free:
+     the centre of mass; chord: x along it) */
   bool has_position = get_vector(m, "position", 3, false, b->position);
   if (!has_position && global && fx->nreference > 0)
     memcpy(b->position, global + 3 * fx->reference[0], sizeof b->position);
+  if (global && fx->reference_kind != REFERENCE_CLAMPED)
+    place_reference_frame(m, b, global, has_position, orientation != NULL);
   if (global) {
     double A[9];
     quaternion_to_matrix(b->orientation, A);
@@ -595,10 +786,12 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
       for (int i = 0; i < 3; i++)
         fx->beams[e].yaxis[i] = A[i] * y[0] + A[3 + i] * y[1] + A[6 + i] * y[2];
     }
+    if (fx->fe_path) fe_import_to_body(fx, A);
     free(global);
   }
 
   parse_modal_settings(m, fx);
+  parse_initial_modes(m, fx);
 }
 
 /* global position of node k of flexible body b */
@@ -1419,6 +1612,7 @@ static void free_flex(ir_flex *fx) {
   free(fx->modal_file);
   free(fx->list);
   free(fx->ratios);
+  fe_import_free(fx);
   free(fx);
 }
 
