@@ -156,6 +156,24 @@ awk -F, 'NR == 1 { next } { for (i = 1; i <= NF; i++) v[$1, i] = $i; nf = NF }
         for (i = 0; i < 6; i++) { a = v[1, c + i]; if (a < 0) a = -a; if (a > big) big = a } } }
     if (!(big > 0) || worst > 1e-12 * big) { printf "RBE2: dependent nodes off the rigid motion by %.3g (scale %.3g)\n", worst, big; exit 1 } }' "$T/sp.csv" || fail "RBE2 spider"
 
+# --- 6. initial modal state: free vibration in mode 1 -----------------------------------
+M1="$root"/tests/models/fe/cantilever_mode1.yaml
+modes "$M1" beam "$T/c1"
+"$MBCC" run "$M1" -o "$T/c1run.csv" --plot none --quiet > "$T/c1run.log" 2>&1 || { cat "$T/c1run.log"; fail "run $M1"; }
+f1=$(awk '$1 == 1 && NF == 2 { print $2; exit }' "$T/c1.log")
+tip0=$(awk -F, '$1 == 10 { printf "%.17g", 0.01 * $7 }' "$T/c1.csv")   # node 10, mode 1 uz, times w0 = 0.01
+awk -F, -v f1="$f1" -v tip0="$tip0" '
+  NR == 2 { if ((($2 - tip0) < 0 ? tip0 - $2 : $2 - tip0) > 1e-9 * (tip0 < 0 ? -tip0 : tip0)) { printf "initial tip %.10g, expected %.10g\n", $2, tip0; bad = 1 } }
+  NR > 2 && (py < 0) != ($2 < 0) { z[++n] = pt + (0 - py) * ($1 - pt) / ($2 - py) }
+  NR > 1 { pt = $1; py = $2 }
+  END { if (bad) exit 1
+    if (n < 5) { print "too few zero crossings: " n; exit 1 }
+    T = 2 * (z[n] - z[1]) / (n - 1); err = (1 / T - f1) / f1; if (err < 0) err = -err
+    # the lumped 10-element model is 0.5 % below the Euler-Bernoulli cantilever: 7.615 Hz
+    eb = 1.8751040687 ^ 2 / (2 * 3.14159265358979) * sqrt(2e10 * 1e-8 / (2700 * 4e-4))
+    if (err > 1e-4) { printf "free vibration at %.8g Hz, the first mode is %.8g Hz\n", 1 / T, f1; exit 1 }
+    if ((1 / T - eb) / eb > 0.01 || (eb - 1 / T) / eb > 0.01) { printf "free vibration at %.6g Hz, Euler-Bernoulli %.6g Hz\n", 1 / T, eb; exit 1 } }' "$T/c1run.csv" || fail "initial modal state"
+
 # --- 5. bad input ---------------------------------------------------------------------
 bad() { # deck-text expected-message-regex
   printf '%s\n' "$1" > "$T/bad.bdf"

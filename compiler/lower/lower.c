@@ -360,6 +360,20 @@ lmodel *lower_model(const ir_model *ir) {
     memcpy(L->q0 + d->qadr + 3, B->orientation, sizeof(double) * 4);
     memcpy(L->v0 + d->vadr, B->velocity, sizeof(double) * 3);
     mb_mul3t(A, B->angular_velocity, L->v0 + d->vadr + 3);
+    /* initial modal coordinates and rates (assembly then moves the frames only) */
+    const ir_flex *fx = B->kind == BODY_FLEXIBLE ? B->flex : NULL;
+    for (int k = 0; fx && k < 2; k++) {
+      int n = k ? fx->nwd0 : fx->nw0;
+      const double *w = k ? fx->wd0 : fx->w0;
+      if (!w) continue;
+      if (n != d->nm) {
+        diag_error(ir->path, k ? fx->wd0_loc : fx->w0_loc, "flexible body '%s': '%s' has %d values, the body "
+                   "has %d selected modes", B->name, k ? "initial_mode_rates" : "initial_modes", n, d->nm);
+        lower_free(L);
+        return NULL;
+      }
+      memcpy(k ? L->v0 + d->vadr + 6 : L->q0 + d->qadr + 7, w, sizeof(double) * (size_t)n);
+    }
   }
   m->nbody = nb;
 
