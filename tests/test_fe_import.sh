@@ -207,4 +207,14 @@ printf '%%%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 1.0\n1 2 3
 printf 'name: bad\nbodies:\n  b: {type: flexible, fe_file: {stiffness: bad.mtx, mass: bad.mtx, dofs: map.csv, nodes: nodes.csv}}\n' > "$T/badm.yaml"
 "$MBCC" check "$T/badm.yaml" > "$T/bad.log" 2>&1; rc=$?
 [ $rc = 2 ] && grep -q 'bad\.mtx:4:1: error: a symmetric Matrix Market file holds the lower triangle' "$T/bad.log" || { cat "$T/bad.log"; fail "bad Matrix Market (exit $rc)"; }
+# model errors: the count of initial_modes, a chord of one node, a free body's position
+badm() { # yaml-body-line expected-regex
+  printf 'name: bad\nbodies:\n  beam:\n    type: flexible\n    line: {from: [0, 0, 0], to: [1, 0, 0], elements: 4}\n    section: {area: 1.0e-4}\n    material: {E: 2.0e11, density: 7800}\n    modes: 2\n%s\n' "$1" > "$T/badm.yaml"
+  "$MBCC" compile "$T/badm.yaml" -o "$T/badm" > "$T/bad.log" 2>&1; rc=$?
+  [ $rc = 2 ] && grep -Eq "$2" "$T/bad.log" || { cat "$T/bad.log"; fail "bad model (exit $rc): expected /$2/"; }
+}
+badm '    initial_modes: [0.1, 0, 0]' "badm\.yaml:9:20: error: flexible body 'beam': 'initial_modes' has 3 values, the body has 2 selected modes"
+badm '    reference: {chord: [1, 1]}' "badm\.yaml:9:24: error: 'chord': expected two different nodes"
+badm '    reference: free
+    position: [0, 0, 0]' "badm\.yaml:10:15: error: flexible body 'beam': a free-free body's frame is at its centre of mass"
 exit 0

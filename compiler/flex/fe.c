@@ -856,7 +856,7 @@ static int dof_states(const ir_flex *fx, char *state, char *is_int, fe_ctx *c) {
   }
   switch (fx->reference_kind) {
   case REFERENCE_CLAMPED:
-    if (fx->nreference < 1 || !fx->reference)
+    if ((fx->nreference < 1 || !fx->reference) && !fx->fixed)
       return fail_at(c, fx->loc,
                      "an FE flexible body needs at least one reference node (nodes fixed to the body "
                      "frame)");

@@ -498,7 +498,7 @@ static void place_reference_frame(mapping *m, ir_body *b, const double *global, 
   }
   if (fx->reference_kind != REFERENCE_FREE) return;
   if (has_position) {
-    error_at(r, m->loc, "flexible body '%s': a free-free body's frame is at its centre of mass (leave "
+    error_at(r, m->last_loc, "flexible body '%s': a free-free body's frame is at its centre of mass (leave "
              "'position' out)", b->name);
     return;
   }
