@@ -4,7 +4,7 @@ CFLAGS  ?= -O2 -g
 WARN    := -Wall -Wextra -Werror
 STD     := -std=c11
 ROOT    := $(CURDIR)
-LIBS    := -lyaml -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig -llapack -lblas -lm
+LIBS    := -lyaml -lcholmod -larpack -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig -llapack -lblas -lm
 
 # the runtime: core/ is freestanding (no allocation, no I/O: kernels, model
 # tables, the generic walker); hosted/ holds the integrators, solvers, CSV

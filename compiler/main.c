@@ -7,6 +7,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "animate.h"
@@ -194,7 +195,11 @@ static int cmd_modes(const options *o) {
     return 2;
   }
   fe_modes fm;
-  if (flex_compute_modes(o->model, &ir->bodies[ib], &fm)) {
+  struct timespec t0, t1;
+  clock_gettime(CLOCK_MONOTONIC, &t0);
+  int modes_failed = flex_compute_modes(o->model, &ir->bodies[ib], &fm);
+  clock_gettime(CLOCK_MONOTONIC, &t1);
+  if (modes_failed) {
     ir_free(ir);
     return 2;
   }
@@ -202,7 +207,12 @@ static int cmd_modes(const options *o) {
   int cb = fx->ninterface > 0;
   printf("flexible body '%s': %d nodes, %d modes selected%s\n", o->body, fm.nnodes, fm.nmodes,
          cb ? " (Craig-Bampton: interface constraint modes and fixed-interface normal modes, "
-              "orthonormalized)" : " (constrained normal modes)");
+              "orthonormalized)"
+            : fx->reference_kind == REFERENCE_FREE ? " (free-free modes in mean axes)"
+            : fx->reference_kind == REFERENCE_CHORD ? " (pinned-pinned modes of the chord frame)"
+            : " (constrained normal modes)");
+  printf("modal analysis: %.3f s (%s)\n", (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec),
+         fm.sparse ? "sparse: CHOLMOD and ARPACK shift-invert Lanczos" : fx->modal_file ? "modal data file" : "dense LAPACK");
   printf("mode  frequency_hz\n");
   for (int j = 0; j < fm.nmodes; j++) printf("%4d  %12.6g\n", j + 1, fm.freq_hz[j]);
   printf("%s (%d):", cb ? "fixed-interface normal modes computed, Hz" : "all modes computed, Hz", fm.nall);

@@ -29,10 +29,12 @@ present() {
   case $1 in
     build-essential)    command -v cc && command -v make && [ -e /usr/include/stdio.h ] ;;
     libyaml-dev)        [ -e /usr/include/yaml.h ] && links yaml ;;
-    libsuitesparse-dev) [ -e /usr/include/suitesparse/klu.h ] && links klu ;;
+    libsuitesparse-dev) [ -e /usr/include/suitesparse/klu.h ] && links klu &&
+                        [ -e /usr/include/suitesparse/cholmod.h ] && links cholmod ;;
     liblapack-dev)      links lapack ;;
     libblas-dev)        links blas ;;
     libcmocka-dev)      [ -e /usr/include/cmocka.h ] && links cmocka ;;
+    libarpack2-dev)     links arpack ;;
     libsundials-dev)    [ -e /usr/include/ida/ida.h ] && links sundials_ida && links sundials_nvecserial ;;
     gnuplot-nox)        gnuplot -e 'set terminal pngcairo' ;;
     clang)              command -v clang ;;
@@ -48,7 +50,7 @@ present() {
 # chromium plays the pages in make test-browser.  A Node.js installed some
 # other way (with its own npm) counts as present.
 packages=(build-essential libyaml-dev libsuitesparse-dev liblapack-dev libblas-dev
-          libcmocka-dev libsundials-dev gnuplot-nox clang nodejs npm chromium)
+          libcmocka-dev libsundials-dev libarpack2-dev gnuplot-nox clang nodejs npm chromium)
 missing=()
 for p in "${packages[@]}"; do
   present "$p" || missing+=("$p")

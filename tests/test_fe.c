@@ -6,6 +6,7 @@
  * rotation of the model, the modal data file round trip and its diagnostics,
  * and the errors for bad FE data. */
 #include "../compiler/flex/fe.c"
+#include "../compiler/flex/fe_sparse.c"
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -174,6 +174,25 @@ awk -F, -v f1="$f1" -v tip0="$tip0" '
     if (err > 1e-4) { printf "free vibration at %.8g Hz, the first mode is %.8g Hz\n", 1 / T, f1; exit 1 }
     if ((1 / T - eb) / eb > 0.01 || (eb - 1 / T) / eb > 0.01) { printf "free vibration at %.6g Hz, Euler-Bernoulli %.6g Hz\n", 1 / T, eb; exit 1 } }' "$T/c1run.csv" || fail "initial modal state"
 
+# --- 7. the sparse eigensolver (CHOLMOD + ARPACK) against dense LAPACK ---------------------
+# the fine beam with unequal bending stiffnesses (no repeated frequencies), 366 DOFs
+sed 's/^PBEAM.*$/PBEAM,5,8,1.e-4,2.e-9,3.e-9,,4.e-9/' "$T/fine.bdf" > "$T/mid.bdf"
+# the spider with a beam on from a dependent GRID: RBE2 folding in both assemblies
+sed 's/^CBAR,1,1,1,2,0.,1.,0.$/CBAR,1,1,1,2,0.,1.,0.\nGRID,5,,1.5,0.,.3\nCBAR,2,1,4,5,0.,1.,0./' "$T/spider.bdf" > "$T/spider2.bdf"
+for ref in '[1]' '{chord: [1, 61]}' free spider; do
+  for es in dense sparse; do
+    if [ "$ref" = spider ]; then
+      printf 'name: sp\nbodies:\n  beam: {type: flexible, fe_file: spider2.bdf, reference: [1], modes: 8, mass: consistent, eigensolver: %s}\n' $es > "$T/mid_$es.yaml"
+    else
+      printf 'name: mid\nbodies:\n  beam: {type: flexible, fe_file: mid.bdf, reference: %s, modes: 12, eigensolver: %s}\n' "$ref" $es > "$T/mid_$es.yaml"
+    fi
+    modes "$T/mid_$es.yaml" beam "$T/mid_$es"
+  done
+  grep -q 'sparse: CHOLMOD' "$T/mid_sparse.log" || fail "the sparse eigensolver was not used ($ref)"
+  compare "$T/mid_dense.csv" "$T/mid_sparse.csv" "$T/mid_dense.modal" "$T/mid_sparse.modal" 1e-8 "sparse vs dense ($ref)" ||
+    fail "sparse eigensolver ($ref)"
+done
+
 # --- 5. bad input ---------------------------------------------------------------------
 bad() { # deck-text expected-message-regex
   printf '%s\n' "$1" > "$T/bad.bdf"

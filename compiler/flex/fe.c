@@ -70,6 +70,8 @@ static const char *const dof_names[6] = {"ux", "uy", "uz", "rx", "ry", "rz"};
 #define FE_PIVOT_TOL 1e-11
 /* modal data file: tolerance of X^T M X = I */
 #define FE_NORM_TOL 1e-6
+/* above this many free DOFs the sparse eigensolver is used (eigensolver: auto) */
+#define FE_SPARSE_MIN_DOFS 3000
 
 /* ------------------------------------------------------------------------- */
 /* errors                                                                    */
@@ -447,6 +449,94 @@ symmetric:
   return 0;
 fail:
   free(K); free(M); free(nm); free(ni);
+  return -1;
+}
+
+/* triplet list that grows */
+static int trip_add(ir_fe_matrix *t, int *cap, int i, int j, double v) {
+  if (v == 0) return 0;
+  if (t->nnz == *cap) {
+    int nc = *cap ? 2 * *cap : 1024;
+    int *r = realloc(t->row, (size_t)nc * sizeof *r), *c = NULL;
+    if (r) t->row = r;
+    c = realloc(t->col, (size_t)nc * sizeof *c);
+    if (c) t->col = c;
+    double *v2 = realloc(t->val, (size_t)nc * sizeof *v2);
+    if (v2) t->val = v2;
+    if (!r || !c || !v2) return -1;
+    *cap = nc;
+  }
+  t->row[t->nnz] = i;
+  t->col[t->nnz] = j;
+  t->val[t->nnz++] = v;
+  return 0;
+}
+
+int fe_assemble_triplets(const ir_flex *fx, ir_fe_matrix *K, ir_fe_matrix *M, char *err, size_t nerr,
+                         ir_loc *where) {
+  fe_ctx c = {err, nerr, where};
+  if (where) *where = no_loc;
+  memset(K, 0, sizeof *K);
+  memset(M, 0, sizeof *M);
+  if (check_flex_common(fx, &c)) return -1;
+  int capk = 0, capm = 0, n = fx->nnodes, bad = 0;
+  if (fx->K_given) {
+    const ir_fe_matrix *G[2] = {fx->K_given, fx->M_given};
+    ir_fe_matrix *D[2] = {K, M};
+    int *cap[2] = {&capk, &capm};
+    for (int g = 0; g < 2; g++)
+      for (int t = 0; t < G[g]->nnz && !bad; t++)
+        bad = trip_add(D[g], cap[g], G[g]->row[t], G[g]->col[t], G[g]->val[t]);
+  } else {
+    for (int e = 0; e < fx->nbeams && !bad; e++) {
+      beam_el el;
+      if (beam_frame(fx, e, &el, &c)) goto fail;
+      beam_local(&fx->beams[e], &el);
+      for (int a = 0; a < 2; a++)
+        for (int bb = 0; bb < 2; bb++)
+          for (int p = 0; p < 2; p++)
+            for (int q = 0; q < 2; q++) {
+              int li = 6 * a + 3 * p, lj = 6 * bb + 3 * q;
+              int gi = 6 * fx->beams[e].node[a] + 3 * p, gj = 6 * fx->beams[e].node[bb] + 3 * q;
+              double Bk[9] = {0}, Bm[9] = {0};
+              rotate_add(el.R, el.K + lj * 12 + li, 12, Bk, 3, 1.0);
+              if (fx->mass == MASS_CONSISTENT) rotate_add(el.R, el.M + lj * 12 + li, 12, Bm, 3, 1.0);
+              for (int jj = 0; jj < 3; jj++)
+                for (int ii = 0; ii < 3; ii++) {
+                  bad |= trip_add(K, &capk, gi + ii, gj + jj, Bk[3 * jj + ii]);
+                  bad |= trip_add(M, &capm, gi + ii, gj + jj, Bm[3 * jj + ii]);
+                }
+            }
+    }
+    if (check_point_masses(fx, &c)) goto fail;
+    if (fx->mass == MASS_CONSISTENT) {
+      for (int p = 0; p < fx->npoint_masses && !bad; p++) {
+        const ir_point_mass *pm = &fx->point_masses[p];
+        int g = 6 * pm->node;
+        for (int i = 0; i < 3; i++) {
+          bad |= trip_add(M, &capm, g + i, g + i, pm->mass);
+          for (int j = 0; j < 3; j++) bad |= trip_add(M, &capm, g + 3 + i, g + 3 + j, pm->inertia[3 * i + j]);
+        }
+      }
+    } else {
+      double *nm = xcalloc((size_t)n, sizeof(double)), *ni = xcalloc(9 * (size_t)n, sizeof(double));
+      if (!nm || !ni || fe_lumped_nodes(fx, nm, ni, err, nerr, where)) { free(nm); free(ni); goto fail; }
+      for (int k = 0; k < n && !bad; k++)
+        for (int i = 0; i < 3; i++) {
+          bad |= trip_add(M, &capm, 6 * k + i, 6 * k + i, nm[k]);
+          for (int j = 0; j < 3; j++) bad |= trip_add(M, &capm, 6 * k + 3 + i, 6 * k + 3 + j, ni[9 * k + 3 * i + j]);
+        }
+      free(nm);
+      free(ni);
+    }
+  }
+  if (!bad) return 0;
+  fail_at(&c, fx->loc, "out of memory assembling %d DOFs", 6 * n);
+fail:
+  free(K->row); free(K->col); free(K->val);
+  free(M->row); free(M->col); free(M->val);
+  memset(K, 0, sizeof *K);
+  memset(M, 0, sizeof *M);
   return -1;
 }
 
@@ -912,7 +1002,7 @@ static int dof_states(const ir_flex *fx, char *state, char *is_int, fe_ctx *c) {
 
 /* Row 'dep' DOF d of an RBE2 as a combination of the independent node's
  * DOFs: u_d = u_i + theta_i x (x_d - x_i), theta_d = theta_i.  coef[6]. */
-static void link_row(const ir_flex *fx, const ir_rigid_link *L, int d, double coef[6]) {
+void fe_link_row(const ir_flex *fx, const ir_rigid_link *L, int d, double coef[6]) {
   const double *xi = fx->nodes + 3 * L->independent, *xd = fx->nodes + 3 * L->dependent;
   double r[3] = {xd[0] - xi[0], xd[1] - xi[1], xd[2] - xi[2]};
   memset(coef, 0, 6 * sizeof(double));
@@ -933,7 +1023,7 @@ static void fold_links(const ir_flex *fx, double *K, int n) {
       if (!(L->dofs >> d & 1)) continue;
       int i = 6 * L->dependent + d;
       double coef[6];
-      link_row(fx, L, d, coef);
+      fe_link_row(fx, L, d, coef);
       for (int a = 0; a < 6; a++) { /* rows */
         if (coef[a] == 0) continue;
         int t = 6 * L->independent + a;
@@ -956,7 +1046,7 @@ static void unfold_links(const ir_flex *fx, double *X, int n, int m) {
     for (int d = 0; d < 6; d++) {
       if (!(L->dofs >> d & 1)) continue;
       double coef[6];
-      link_row(fx, L, d, coef);
+      fe_link_row(fx, L, d, coef);
       for (int j = 0; j < m; j++) {
         double v = 0;
         for (int a = 0; a < 6; a++) v += coef[a] * X[(size_t)j * n + 6 * L->independent + a];
@@ -1023,6 +1113,87 @@ done:
   return rc;
 }
 
+/* Large bodies: sparse assembly and shift-invert Lanczos (fe_sparse.c) for
+ * the selected count of lowest modes (free-free: 6 more, the rigid-body
+ * modes, then dropped).  No Craig-Bampton. */
+static int modes_sparse(const ir_flex *fx, fe_modes *out, const char *state, int nf, fe_ctx *c) {
+  int nnodes = fx->nnodes, ndof = 6 * nnodes, nev = 0, rigid = fx->reference_kind == REFERENCE_FREE ? 6 : 0;
+  if (fx->ninterface > 0)
+    return fail_at(c, fx->loc, "the sparse eigensolver does not do Craig-Bampton (interface nodes): use "
+                   "eigensolver: dense");
+  if (fx->select == MODES_COUNT) nev = fx->count;
+  else if (fx->select == MODES_LIST)
+    for (int i = 0; i < fx->nlist; i++) nev = fx->list[i] > nev ? fx->list[i] : nev;
+  else
+    return fail_at(c, fx->loc, "a large body (%d free DOFs; the sparse eigensolver) needs its modes "
+                   "as a count or a list ('modes: 20')", nf);
+  if (nev < 1 || nev + rigid >= nf)
+    return fail_at(c, fx->loc, "mode count %d: the sparse eigensolver finds 1 to %d modes", nev, nf - rigid - 1);
+  ir_fe_matrix K, M;
+  int *fidx = xcalloc((size_t)ndof, sizeof(int)), *perm = xcalloc((size_t)nf, sizeof(int)), *sel = NULL;
+  double *lam = xcalloc((size_t)(nev + rigid), sizeof(double));
+  double *X = xcalloc((size_t)nf * (size_t)(nev + rigid), sizeof(double)), *hz = NULL;
+  int rc = -1;
+  if (!fidx || !perm || !lam || !X) {
+    fail_at(c, fx->loc, "out of memory");
+    goto done;
+  }
+  for (int i = 0, k = 0; i < ndof; i++) {
+    fidx[i] = state[i] == 0 ? k : -1;
+    if (state[i] == 0) perm[k++] = i;
+  }
+  if (fe_assemble_triplets(fx, &K, &M, c->err, c->nerr, c->where)) goto done;
+  double sigma = 0;
+  if (rigid) { /* below zero by a small fraction of the stiff end: K - sigma M is definite */
+    double kmax = 0, mmax = 0;
+    for (int t = 0; t < K.nnz; t++)
+      if (K.row[t] == K.col[t]) kmax = fmax(kmax, K.val[t]);
+    for (int t = 0; t < M.nnz; t++)
+      if (M.row[t] == M.col[t]) mmax = fmax(mmax, M.val[t]);
+    sigma = -1e-8 * kmax / mmax;
+  }
+  int e = fe_sparse_eigs(fx, &K, &M, fidx, nf, nev + rigid, sigma, lam, X, c->err, c->nerr);
+  free(K.row); free(K.col); free(K.val); free(M.row); free(M.col); free(M.val);
+  if (e) {
+    if (c->where) *c->where = no_loc;
+    goto done;
+  }
+  for (int j = rigid; j < nev + rigid; j++)
+    if (!(lam[j] > 0)) {
+      fail_at(c, fx->loc, "the sparse eigensolver found a mode at %g rad^2/s^2 (not positive): the stiffness "
+              "matrix is singular to double precision (a mechanism, or elements so short beside the body "
+              "that the spectrum spans more than 1e16)", lam[j]);
+      goto done;
+    }
+  if (rigid && !(lam[6] > 1e-6 * -sigma)) {
+    fail_at(c, fx->loc, "the free-free body has more than 6 rigid-body modes (a mechanism, or parts not "
+            "connected)");
+    goto done;
+  }
+  hz = xcalloc((size_t)nev, sizeof(double));
+  sel = xcalloc((size_t)nev, sizeof(int));
+  if (!hz || !sel) { fail_at(c, fx->loc, "out of memory"); goto done; }
+  for (int j = 0; j < nev; j++) hz[j] = lam_to_hz(lam[j + rigid]);
+  int ns = 0;
+  if (select_modes(fx, hz, nev, sel, &ns, "modes computed", c)) goto done;
+  if (alloc_modes(out, nnodes, ns, nev)) { fail_at(c, fx->loc, "out of memory"); goto done; }
+  out->sparse = 1;
+  memcpy(out->all_freq_hz, hz, (size_t)nev * sizeof(double));
+  for (int j = 0; j < ns; j++) {
+    double *x = X + (size_t)(sel[j] + rigid) * nf;
+    fix_sign(x, nf);
+    out->freq_hz[j] = hz[sel[j]];
+    for (int i = 0; i < nf; i++) out->shapes[(size_t)j * ndof + perm[i]] = x[i];
+  }
+  unfold_links(fx, out->shapes, ndof, ns);
+  memcpy(out->x, fx->nodes, 3 * (size_t)nnodes * sizeof(double));
+  if (fe_lumped_nodes(fx, out->node_mass, out->node_inertia, c->err, c->nerr, c->where)) goto done;
+  rc = 0;
+done:
+  free(fidx); free(perm); free(sel); free(lam); free(X); free(hz);
+  return rc;
+}
+
 static int modes_from_fe(const ir_flex *fx, fe_modes *out, fe_ctx *c) {
   if (check_flex_common(fx, c)) return -1;
   int nnodes = fx->nnodes, ndof = 6 * nnodes;
@@ -1040,8 +1211,18 @@ static int modes_from_fe(const ir_flex *fx, fe_modes *out, fe_ctx *c) {
   for (int i = 0; i < ndof; i++)
     if (state[i] == 1) is_ref[i / 6] = 1;
   if (fx->reference_kind == REFERENCE_FREE) is_ref[0] = 1;
-  if (fe_assemble_at(fx, &sys, c->err, c->nerr, c->where)) goto done;
   if (!fx->K_given && check_connectivity(fx, is_ref, c)) goto done;
+  {
+    int nfree = 0;
+    for (int i = 0; i < ndof; i++) nfree += state[i] == 0;
+    int sparse = fx->eigensolver == 2 ||
+                 (fx->eigensolver == 0 && nfree > FE_SPARSE_MIN_DOFS && fx->ninterface == 0);
+    if (sparse) {
+      rc = modes_sparse(fx, out, state, nfree, c);
+      goto done;
+    }
+  }
+  if (fe_assemble_at(fx, &sys, c->err, c->nerr, c->where)) goto done;
   fold_links(fx, sys.K, ndof);
   fold_links(fx, sys.M, ndof);
 

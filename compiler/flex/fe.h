@@ -19,6 +19,23 @@ typedef struct {
 int fe_assemble(const ir_flex *fx, fe_system *out, char *err, size_t nerr);
 void fe_system_free(fe_system *s);
 
+/* K and M as triplets (i, j, value; duplicates to be summed, both
+ * triangles) in the 6-per-node DOF numbering: the sparse assembly of large
+ * bodies.  Returns 0, or nonzero with err (the arrays then freed). */
+int fe_assemble_triplets(const ir_flex *fx, ir_fe_matrix *K, ir_fe_matrix *M, char *err, size_t nerr,
+                         ir_loc *where);
+
+/* an RBE2's dependent DOF d as a combination of its independent node's 6 DOFs */
+void fe_link_row(const ir_flex *fx, const ir_rigid_link *L, int d, double coef[6]);
+
+/* The lowest nev eigenpairs of (K, M) restricted to the free DOFs (free[i]:
+ * the free index of DOF i, or -1; nf of them), RBE2-dependent DOFs folded
+ * into their independent ones: shift-invert Lanczos (ARPACK) about sigma,
+ * K - sigma M factored by CHOLMOD.  lam ascending (Rayleigh quotients), X
+ * (nf x nev, column-major) M-orthonormal.  Returns 0, or nonzero with err. */
+int fe_sparse_eigs(const ir_flex *fx, const ir_fe_matrix *K, const ir_fe_matrix *M, const int *free_index,
+                   int nf, int nev, double sigma, double *lam, double *X, char *err, size_t nerr);
+
 /* The modal description a flexible body is simulated with. */
 typedef struct {
   int nnodes, nmodes;
@@ -30,6 +47,7 @@ typedef struct {
   double *node_inertia; /* 9 nnodes: lumped rotary inertia of each node, body axes */
   int nall;
   double *all_freq_hz;  /* every frequency computed before selection (for `mbcc modes`) */
+  int sparse;           /* computed by the sparse eigensolver (fe_sparse.c) */
 } fe_modes;
 
 /* Reduce a flexible body to modes: from its FE model (reference nodes fixed;

@@ -99,6 +99,7 @@ typedef struct ir_flex {
   int *interface;          /* Craig-Bampton interface nodes (none: constrained normal modes) */
   int ninterface;
   ir_reference_kind reference_kind; /* CHORD: reference = [A, B]; FREE: none */
+  int eigensolver;         /* 0 auto (sparse above FE_SPARSE_MIN_DOFS free DOFs), 1 dense, 2 sparse */
   /* imported FE models (fe_file) */
   char *fe_path;           /* the FE file it came from (NULL: inline); its errors are reported
                               by the importer, later ones at the body, naming nodes by id */

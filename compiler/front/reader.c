@@ -552,7 +552,7 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
       "type",    "position",  "orientation", "velocity", "angular_velocity", "line",
       "nodes",   "beams",     "section",     "material", "theory",           "mass",
       "point_masses", "reference", "interface", "modes", "damping", "coupling", "modal_file",
-      "fe_file", "initial_modes", "initial_mode_rates", NULL};
+      "fe_file", "initial_modes", "initial_mode_rates", "eigensolver", NULL};
   map_reject(m, "inertia", "flexible body '%s': its inertia comes from its FE model", b->name);
   map_check_keys(m, keys);
   ir_flex *fx = xcalloc(1, sizeof *fx);
@@ -792,6 +792,9 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
 
   parse_modal_settings(m, fx);
   parse_initial_modes(m, fx);
+  static const char *const eigensolver_names[] = {"auto", "dense", "sparse", NULL};
+  int es = 0;
+  if (get_choice(m, "eigensolver", "eigensolver", eigensolver_names, false, &es)) fx->eigensolver = es;
 }
 
 /* global position of node k of flexible body b */
