@@ -193,6 +193,17 @@ for ref in '[1]' '{chord: [1, 61]}' free spider; do
     fail "sparse eigensolver ($ref)"
 done
 
+# --- 8. a free body in mean axes simulated: energy and momentum conserved ----------------
+sed 's/    reference: \[0\]/    reference: free/' "$root"/tests/models/free_flexible.yaml > "$T/ff.yaml"
+"$MBCC" run "$T/ff.yaml" -o "$T/ff.csv" --plot none --quiet > "$T/ff.log" 2>&1 || { cat "$T/ff.log"; fail "run free-free"; }
+awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) col[$i] = i; next }
+  NR == 2 { e0 = $col["energy"]; for (i = col["momentum.px"]; i <= col["momentum.hz"]; i++) p0[i] = $i; next }
+  { d = $col["energy"] - e0; if (d < 0) d = -d; if (d > de) de = d
+    for (i = col["momentum.px"]; i <= col["momentum.hz"]; i++) { x = $i - p0[i]; if (x < 0) x = -x; if (x > dp) dp = x }
+    x = $col["tip.y"]; if (x < 0) x = -x; if (x > tip) tip = x }
+  END { if (de > 1e-8 * e0 || dp > 1e-10 || !(tip > 0)) { printf "free-free run: energy drift %.3g, momentum drift %.3g, tip %.3g\n", de / e0, dp, tip; exit 1 } }' "$T/ff.csv" ||
+  fail "free-free body in mean axes"
+
 # --- 5. bad input ---------------------------------------------------------------------
 bad() { # deck-text expected-message-regex
   printf '%s\n' "$1" > "$T/bad.bdf"
@@ -226,6 +237,9 @@ printf '%%%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 1.0\n1 2 3
 printf 'name: bad\nbodies:\n  b: {type: flexible, fe_file: {stiffness: bad.mtx, mass: bad.mtx, dofs: map.csv, nodes: nodes.csv}}\n' > "$T/badm.yaml"
 "$MBCC" check "$T/badm.yaml" > "$T/bad.log" 2>&1; rc=$?
 [ $rc = 2 ] && grep -q 'bad\.mtx:4:1: error: a symmetric Matrix Market file holds the lower triangle' "$T/bad.log" || { cat "$T/bad.log"; fail "bad Matrix Market (exit $rc)"; }
+printf '%%%%MatrixMarket matrix coordinate real general\n2 2 3\n1 1 1.0\n1 2 3.0\n2 1 2.0\n' > "$T/bad.mtx"
+"$MBCC" check "$T/badm.yaml" > "$T/bad.log" 2>&1; rc=$?
+[ $rc = 2 ] && grep -q 'bad\.mtx: error: the matrix is not symmetric: entries (1, 2) and (2, 1) differ' "$T/bad.log" || { cat "$T/bad.log"; fail "unsymmetric Matrix Market (exit $rc)"; }
 # model errors: the count of initial_modes, a chord of one node, a free body's position
 badm() { # yaml-body-line expected-regex
   printf 'name: bad\nbodies:\n  beam:\n    type: flexible\n    line: {from: [0, 0, 0], to: [1, 0, 0], elements: 4}\n    section: {area: 1.0e-4}\n    material: {E: 2.0e11, density: 7800}\n    modes: 2\n%s\n' "$1" > "$T/badm.yaml"

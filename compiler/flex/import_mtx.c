@@ -216,23 +216,45 @@ done:
   return rc;
 }
 
-/* a general matrix must be symmetric (to 1e-9 of its largest entry) */
+/* a general matrix must be symmetric (to 1e-9 of its largest entry): each
+ * entry above the diagonal less its mirror, summed by sorting (no dense copy) */
+typedef struct {
+  long long key;
+  double v;
+} mtx_term;
+
+static int cmp_term(const void *a, const void *b) {
+  long long x = ((const mtx_term *)a)->key, y = ((const mtx_term *)b)->key;
+  return (x > y) - (x < y);
+}
+
 static int check_symmetric(const char *path, int n, const ir_fe_matrix *m) {
-  double *D = calloc((size_t)n * (size_t)n, sizeof *D);
-  if (!D) { diag_error(path, (ir_loc){0, 0}, "matrix too large (%d rows) for the dense eigensolver", n); return -1; }
+  mtx_term *t = malloc(((size_t)m->nnz + 1) * sizeof *t);
+  if (!t) { diag_error(path, (ir_loc){0, 0}, "out of memory"); return -1; }
+  size_t k = 0;
   double big = 0;
-  for (int t = 0; t < m->nnz; t++) D[(size_t)m->col[t] * n + m->row[t]] += m->val[t];
-  for (size_t i = 0; i < (size_t)n * n; i++) big = fmax(big, fabs(D[i]));
+  for (int e = 0; e < m->nnz; e++) {
+    int i = m->row[e], j = m->col[e];
+    big = fmax(big, fabs(m->val[e]));
+    if (i == j) continue;
+    t[k].key = i < j ? (long long)i * n + j : (long long)j * n + i;
+    t[k++].v = i < j ? m->val[e] : -m->val[e];
+  }
+  qsort(t, k, sizeof *t, cmp_term);
   int rc = 0;
-  for (int j = 0; j < n && !rc; j++)
-    for (int i = 0; i < j; i++)
-      if (fabs(D[(size_t)j * n + i] - D[(size_t)i * n + j]) > 1e-9 * big) {
-        diag_error(path, (ir_loc){0, 0}, "the matrix is not symmetric: entries (%d, %d) and (%d, %d) differ",
-                   i + 1, j + 1, j + 1, i + 1);
-        rc = -1;
-        break;
-      }
-  free(D);
+  for (size_t a = 0; a < k && !rc;) {
+    size_t b = a;
+    double sum = 0;
+    while (b < k && t[b].key == t[a].key) sum += t[b++].v;
+    if (fabs(sum) > 1e-9 * big) {
+      int i = (int)(t[a].key / n), j = (int)(t[a].key % n);
+      diag_error(path, (ir_loc){0, 0}, "the matrix is not symmetric: entries (%d, %d) and (%d, %d) differ",
+                 i + 1, j + 1, j + 1, i + 1);
+      rc = -1;
+    }
+    a = b;
+  }
+  free(t);
   return rc;
 }
 
