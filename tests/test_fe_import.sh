@@ -204,6 +204,18 @@ awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) col[$i] = i; next }
   END { if (de > 1e-8 * e0 || dp > 1e-10 || !(tip > 0)) { printf "free-free run: energy drift %.3g, momentum drift %.3g, tip %.3g\n", de / e0, dp, tip; exit 1 } }' "$T/ff.csv" ||
   fail "free-free body in mean axes"
 
+# --- 9. stress recovery: a cantilever under a tip load settles on beam theory -------------
+CS="$root"/tests/models/fe/cantilever_section.yaml
+"$MBCC" run "$CS" -o "$T/cs.csv" --plot none --quiet > "$T/cs.log" 2>&1 || { cat "$T/cs.log"; fail "run $CS"; }
+awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) col[$i] = i; next } { for (k in col) last[k] = $col[k] }
+  END { P = 2; L = 1; c = 0.01; Iz = 3e-8
+    n = split("root.N 0 root.Vy -2 root.Vz 0 root.T 0 root.My 0 root.Mz -2 mid_Mz -1", w, " ")
+    for (i = 1; i < n; i += 2) { d = last[w[i]] - w[i + 1]; if (d < 0) d = -d
+      if (d > 2e-4 * P * L) { printf "%s = %.8g, beam theory %g\n", w[i], last[w[i]], w[i + 1]; bad = 1 } }
+    s = P * L * c / Iz; d = (last["root_top"] - s) / s; if (d < 0) d = -d
+    if (d > 1e-4) { printf "root top fiber stress %.8g, beam theory %.8g\n", last["root_top"], s; bad = 1 }
+    exit bad }' "$T/cs.csv" || fail "stress recovery"
+
 # --- 5. bad input ---------------------------------------------------------------------
 bad() { # deck-text expected-message-regex
   printf '%s\n' "$1" > "$T/bad.bdf"
@@ -248,6 +260,8 @@ badm() { # yaml-body-line expected-regex
 }
 badm '    initial_modes: [0.1, 0, 0]' "badm\.yaml:9:20: error: flexible body 'beam': 'initial_modes' has 3 values, the body has 2 selected modes"
 badm '    reference: {chord: [1, 1]}' "badm\.yaml:9:24: error: 'chord': expected two different nodes"
+badm 'outputs:
+  - {name: s, type: section, body: beam, element: 4}' "badm\\.yaml:10:51: error: body 'beam' has no beam 4 \\(beams are numbered from 0\\)"
 badm '    reference: free
     position: [0, 0, 0]' "badm\.yaml:10:15: error: flexible body 'beam': a free-free body's frame is at its centre of mass"
 exit 0

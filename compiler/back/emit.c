@@ -144,6 +144,7 @@ static const char *output_kind_name(mb_output_kind kind) {
   case MB_OUT_DEFLECTION: return "MB_OUT_DEFLECTION";
   case MB_OUT_MODAL: return "MB_OUT_MODAL";
   case MB_OUT_MOMENTUM: return "MB_OUT_MOMENTUM";
+  case MB_OUT_SECTION: return "MB_OUT_SECTION";
   }
   return "0";
 }
@@ -342,6 +343,14 @@ static void emit_tables(FILE *f, const lmodel *L) {
       fprintf(f, ", .node = %d, .chord = {%d, %d}, .scale = ", o->node, o->chord[0], o->chord[1]);
       num(f, o->scale);
       fprintf(f, ", .ncols = %d, .col = %d},\n", o->ncols, o->col);
+    }
+    fputs("};\n", f);
+  }
+  if (L->noutput_coef) { /* section outputs: coefficients on the modal coordinates */
+    fprintf(f, "static const mb_real output_coef[%d] = {", L->noutput_coef);
+    for (int i = 0; i < L->noutput_coef; i++) {
+      fputs(i ? (i % 4 ? ", " : ",\n  ") : "\n  ", f);
+      num(f, L->output_coef[i]);
     }
     fputs("};\n", f);
   }
@@ -801,6 +810,7 @@ static void emit_source(FILE *f, const lmodel *L, const char *nm) {
   vec(f, m->gravity, 3);
   fprintf(f, ",\n  .Kp = Kp, .Ki = %s, .q0 = %s, .v0 = %s, .modal_slot = %s,\n", m->nnz ? "Ki" : "0",
           m->nq ? "q0" : "0", m->nv ? "v0" : "0", L->nmodal_slot ? "modal_slot" : "0");
+  if (L->noutput_coef) fputs("  .output_coef = output_coef,\n", f);
   emit_ldl_fields(f, nm, ldl);
   fprintf(f, "  .ncols = %s_NCOLS, .col_name = %s,\n  .eval = %s_eval, .init = %s_init,\n};\n", U,
           m->ncols ? "col_names" : "0", nm, nm);

@@ -1692,3 +1692,40 @@ void fe_modes_free(fe_modes *m) {
   free(m->all_freq_hz);
   memset(m, 0, sizeof *m);
 }
+
+/* ------------------------------------------------------------------------- */
+/* stress recovery                                                            */
+
+int fe_section_rows(const ir_flex *fx, int e, int end, const fe_modes *fm, double *rows, double sec[3],
+                    char *err, size_t nerr) {
+  fe_ctx c = {err, nerr, NULL};
+  if (!fx->beams || e < 0 || e >= fx->nbeams) return fail_at(&c, fx->loc, "no beam %d", e);
+  beam_el el;
+  if (beam_frame(fx, e, &el, &c)) return -1;
+  beam_local(&fx->beams[e], &el);
+  int nm = fm->nmodes, ndof = 6 * fm->nnodes;
+  double *u = xcalloc(12 * (size_t)(nm ? nm : 1), sizeof(double));
+  if (!u) return fail_at(&c, fx->loc, "out of memory");
+  /* the element's local DOFs per mode: R (translations; rotations) of its two nodes */
+  for (int j = 0; j < nm; j++)
+    for (int a = 0; a < 2; a++) {
+      const double *x = fm->shapes + (size_t)j * ndof + 6 * fx->beams[e].node[a];
+      for (int p = 0; p < 2; p++)
+        for (int i = 0; i < 3; i++)
+          u[12 * j + 6 * a + 3 * p + i] =
+              el.R[3 * i] * x[3 * p] + el.R[3 * i + 1] * x[3 * p + 1] + el.R[3 * i + 2] * x[3 * p + 2];
+    }
+  /* nodal forces f = K u; the section resultant on the face whose outward
+     normal is +x: -f at end A, f at end B */
+  for (int r = 0; r < 6; r++)
+    for (int j = 0; j < nm; j++) {
+      double f = 0;
+      for (int k = 0; k < 12; k++) f += el.K[k * 12 + 6 * end + r] * u[12 * j + k];
+      rows[(size_t)r * nm + j] = end ? f : -f;
+    }
+  free(u);
+  sec[0] = fx->beams[e].A;
+  sec[1] = fx->beams[e].Iy;
+  sec[2] = fx->beams[e].Iz;
+  return 0;
+}

@@ -77,6 +77,13 @@ int fe_compute_modes_at(const ir_flex *fx, fe_modes *out, char *err, size_t nerr
 int fe_lumped_nodes(const ir_flex *fx, double *node_mass, double *node_inertia, char *err,
                     size_t nerr, ir_loc *where);
 
+/* Section resultants of beam e at its end (0: A, 1: B) per unit modal
+ * coordinate: rows (6 x nmodes, row-major) N Vy Vz T My Mz in the element's
+ * axes, on the face whose outward normal is the element's +x (tension,
+ * and the moments the part beyond applies); sec: A, Iy, Iz.  0 or -1 with err. */
+int fe_section_rows(const ir_flex *fx, int e, int end, const fe_modes *fm, double *rows, double sec[3],
+                    char *err, size_t nerr);
+
 /* Write m (its selected modes) as a modal data file (docs/modal-file.md);
  * 'description' may be NULL.  Returns 0, or nonzero with err. */
 int fe_modes_write(const fe_modes *m, const char *path, const char *description, char *err,

@@ -627,6 +627,7 @@ int fe_import_nastran(const char *path, ir_flex *fx, double **global) {
   double *x = nas_alloc(3 * (size_t)ngrid, sizeof *x);
   unsigned char *fixed = nas_alloc(6 * (size_t)ngrid, 1);
   ir_beam *beams = nas_alloc((size_t)nel, sizeof *beams);
+  long *eids = nas_alloc((size_t)nel, sizeof *eids);
   ir_point_mass *pms = nas_alloc((size_t)nmass, sizeof *pms);
   int nlinks = 0, capl = 0;
   ir_rigid_link *links = NULL;
@@ -856,6 +857,7 @@ int fe_import_nastran(const char *path, ir_flex *fx, double **global) {
           continue;
         }
       }
+      eids[nel] = eid;
       ir_beam *b = &beams[nel++];
       memset(b, 0, sizeof *b);
       b->node[0] = ga;
@@ -1007,6 +1009,8 @@ int fe_import_nastran(const char *path, ir_flex *fx, double **global) {
   fx->beams = beams;
   fx->nbeams = nel;
   beams = NULL;
+  fx->beam_ids = eids;
+  eids = NULL;
   fx->point_masses = pms;
   fx->npoint_masses = nmass;
   pms = NULL;
@@ -1025,7 +1029,7 @@ int fe_import_nastran(const char *path, ir_flex *fx, double **global) {
   x = NULL;
 done:
   free(cs); free(ps); free(ms); free(ids); free(sorted); free(cp); free(grid_card); free(x);
-  free(fixed); free(beams); free(pms); free(links);
+  free(fixed); free(beams); free(eids); free(pms); free(links);
   for (int i = 0; i < d.ncards; i++) free(d.cards[i].f);
   free(d.cards);
   for (int i = 0; i < d.nfiles; i++) free(d.files[i]);
@@ -1116,6 +1120,7 @@ int fe_chord_axes(const double a[3], const double b[3], double e[4]) {
 void fe_import_free(ir_flex *fx) {
   free(fx->fe_path);
   free(fx->node_ids);
+  free(fx->beam_ids);
   free(fx->fixed);
   free(fx->links);
   ir_fe_matrix *G[2] = {fx->K_given, fx->M_given};

@@ -101,6 +101,7 @@ typedef struct ir_flex {
   ir_reference_kind reference_kind; /* CHORD: reference = [A, B]; FREE: none */
   int eigensolver;         /* 0 auto (sparse above FE_SPARSE_MIN_DOFS free DOFs), 1 dense, 2 sparse */
   /* imported FE models (fe_file) */
+  long *beam_ids;          /* nbeams: the deck's element ids (NULL: 0, 1, ...) */
   char *fe_path;           /* the FE file it came from (NULL: inline); its errors are reported
                               by the importer, later ones at the body, naming nodes by id */
   long *node_ids;          /* nnodes: the deck's GRID ids that name the nodes (NULL: 0, 1, ...) */
@@ -264,7 +265,9 @@ typedef enum {
   OUT_TOTAL_ENERGY,         /* system: 1 */
   OUT_DEFLECTION,           /* flexible body: node deflection X_k w, body axes: 3 or 1 */
   OUT_MODAL,                /* flexible body: modal coordinate 'mode' (1-based in the model) */
-  OUT_MOMENTUM              /* system: linear and angular momentum (about the origin): 6 */
+  OUT_MOMENTUM,             /* system: linear and angular momentum (about the origin): 6 */
+  OUT_SECTION               /* flexible body: a beam's section forces at one end (6 or 1), or the
+                               normal stress at a point of the section (1) */
 } ir_output_kind;
 
 typedef struct {
@@ -282,6 +285,9 @@ typedef struct {
   double axis[3];    /* OUT_ANGLE: unit axis */
   int component;     /* -1: all components; 0, 1, 2: x, y, z only */
   double scale;      /* multiply the output by this (default 1) */
+  int element, end;  /* SECTION: the beam (index into the body's beams) and its end (0: A, 1: B) */
+  bool has_fiber;    /* SECTION: the stress at fiber (y, z) of the section, element axes */
+  double fiber[2];
 } ir_output;
 
 /* --- simulation settings --------------------------------------------------------------- */

@@ -1224,7 +1224,7 @@ static void parse_force(reader *r, yaml_node_t *key, yaml_node_t *value) {
 static const char *const output_type_names[] = {
     "position",     "orientation",          "angle",    "velocity",       "angular_velocity",
     "acceleration", "angular_acceleration", "reaction", "effort",         "kinetic_energy",
-    "potential_energy", "total_energy",     "deflection", "modal", "momentum", NULL};
+    "potential_energy", "total_energy",     "deflection", "modal", "momentum", "section", NULL};
 static const char *const component_names[] = {"x", "y", "z", NULL};
 
 static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_outputs,
@@ -1256,10 +1256,10 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
   map_describe(&m, "%s output '%s'", output_type_names[type], o->name ? o->name : "?");
 
   ir_output_kind k = o->kind;
-  bool of_body = k <= OUT_ANGULAR_ACCELERATION || k == OUT_DEFLECTION || k == OUT_MODAL;
+  bool of_body = k <= OUT_ANGULAR_ACCELERATION || k == OUT_DEFLECTION || k == OUT_MODAL || k == OUT_SECTION;
   bool has_point = k == OUT_POSITION || k == OUT_VELOCITY || k == OUT_ACCELERATION;
   bool has_component = of_body && k != OUT_ORIENTATION && k != OUT_ANGLE && k != OUT_MODAL;
-  const char *keys[10];
+  const char *keys[12];
   int nkeys = 0;
   keys[nkeys++] = "name";
   keys[nkeys++] = "type";
@@ -1283,6 +1283,11 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
   }
   if (k == OUT_MODAL)
     keys[nkeys++] = "mode";
+  if (k == OUT_SECTION) {
+    keys[nkeys++] = "element";
+    keys[nkeys++] = "end";
+    keys[nkeys++] = "fiber";
+  }
   keys[nkeys++] = "scale";
   keys[nkeys] = NULL;
   map_check_keys(&m, keys);
@@ -1303,13 +1308,15 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
   }
   if (k == OUT_ANGLE)
     get_axis(&m, "axis", true, o->axis);
+  static const char *const section_names[] = {"N", "Vy", "Vz", "T", "My", "Mz", NULL};
   if (has_component)
-    get_choice(&m, "component", "component", component_names, false, &o->component);
+    get_choice(&m, "component", "component", k == OUT_SECTION ? section_names : component_names, false,
+               &o->component);
   if (k == OUT_REACTION)
     get_ref(&m, "joint", NAME_JOINT, true, &o->joint, NULL);
   if (k == OUT_EFFORT)
     get_ref(&m, "driver", NAME_DRIVER, true, &o->driver, NULL);
-  if ((k == OUT_DEFLECTION || k == OUT_MODAL) && o->body >= 0 &&
+  if ((k == OUT_DEFLECTION || k == OUT_MODAL || k == OUT_SECTION) && o->body >= 0 &&
       r->model->bodies[o->body].kind != BODY_FLEXIBLE) {
     error_at(r, m.loc, "%s output '%s' needs a flexible body ('%s' is not)", output_type_names[k],
              o->name ? o->name : "?", r->model->bodies[o->body].name);
@@ -1323,6 +1330,25 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
         error_at(r, loc_of(ch), "'chord': expected [K0, K1], two node numbers");
       else
         for (int i = 0; i < 2; i++) o->chord[i] = to_fe_node(r, seq_item(r, ch, i), b);
+    }
+  } else if (k == OUT_SECTION && o->body >= 0) {
+    const ir_flex *fx = r->model->bodies[o->body].flex;
+    double e = -1;
+    if (get_number(&m, "element", true, &e)) {
+      o->element = -1;
+      if (fx && fx->nodes && e == floor(e))
+        for (int i = 0; i < fx->nbeams; i++)
+          if ((fx->beam_ids ? fx->beam_ids[i] : i) == (long)e) o->element = i;
+      if (o->element < 0)
+        error_at(r, m.last_loc, "body '%s' has no beam %g (%s)", r->model->bodies[o->body].name, e,
+                 fx && fx->beam_ids ? "elements by their ids in the FE file" : "beams are numbered from 0");
+    }
+    static const char *const end_names[] = {"A", "B", NULL};
+    get_choice(&m, "end", "element end", end_names, false, &o->end);
+    yaml_node_t *fb = map_get(&m, "fiber");
+    if (fb != NULL) {
+      o->has_fiber = to_vector(r, fb, "'fiber'", 2, o->fiber);
+      if (map_has(&m, "component")) error_at(r, loc_of(fb), "give either 'fiber' (a stress) or 'component'");
     }
   } else if (k == OUT_MODAL) {
     double mode;

@@ -242,6 +242,7 @@ static int output_columns(const ir_output *o) {
     return o->component >= 0 ? 1 : 3;
   case OUT_ORIENTATION: return 4;
   case OUT_REACTION: case OUT_MOMENTUM: return 6;
+  case OUT_SECTION: return o->component >= 0 || o->has_fiber ? 1 : 6;
   default: return 1;
   }
 }
@@ -254,7 +255,44 @@ static const mb_output_kind out_kind_map[] = {
     [OUT_EFFORT] = MB_OUT_EFFORT, [OUT_KINETIC_ENERGY] = MB_OUT_KINETIC_ENERGY,
     [OUT_POTENTIAL_ENERGY] = MB_OUT_POTENTIAL_ENERGY, [OUT_TOTAL_ENERGY] = MB_OUT_TOTAL_ENERGY,
     [OUT_DEFLECTION] = MB_OUT_DEFLECTION, [OUT_MODAL] = MB_OUT_MODAL,
-    [OUT_MOMENTUM] = MB_OUT_MOMENTUM};
+    [OUT_MOMENTUM] = MB_OUT_MOMENTUM, [OUT_SECTION] = MB_OUT_SECTION};
+
+/* a SECTION output's rows of coefficients on w, appended to L->output_coef */
+static int section_coefficients(lmodel *L, const ir_output *o, mb_outputdef *d) {
+  const ir_body *B = &L->ir->bodies[o->body];
+  const fe_modes *fm = &L->modes[d->body];
+  int nm = L->body[d->body].nm;
+  double rows[6 * MB_MAX_MODES + 1], sec[3];
+  char err[256];
+  if (!B->flex->nodes || !B->flex->beams) {
+    diag_error(L->ir->path, o->loc, "output '%s': body '%s' has no beam elements (a modal data file)", o->name,
+               B->name);
+    return -1;
+  }
+  if (fe_section_rows(B->flex, o->element, o->end, fm, rows, sec, err, sizeof err)) {
+    diag_error(L->ir->path, o->loc, "output '%s': %s", o->name, err);
+    return -1;
+  }
+  double *c = realloc(L->output_coef, sizeof(double) * (size_t)(L->noutput_coef + 6 * nm + 1));
+  if (!c) return -1;
+  L->output_coef = c;
+  d->node = L->noutput_coef;
+  double *dst = c + L->noutput_coef;
+  if (o->has_fiber) { /* sigma = N / A - Mz y / Iz + My z / Iy */
+    for (int j = 0; j < nm; j++)
+      dst[j] = rows[j] / sec[0] - (sec[2] > 0 ? rows[5 * nm + j] * o->fiber[0] / sec[2] : 0) +
+               (sec[1] > 0 ? rows[4 * nm + j] * o->fiber[1] / sec[1] : 0);
+    L->noutput_coef += nm;
+  } else if (o->component >= 0) {
+    memcpy(dst, rows + (size_t)o->component * nm, sizeof(double) * (size_t)nm);
+    L->noutput_coef += nm;
+  } else {
+    memcpy(dst, rows, sizeof(double) * 6 * (size_t)nm);
+    L->noutput_coef += 6 * nm;
+  }
+  d->component = -1; /* the rows are the columns */
+  return 0;
+}
 
 lmodel *lower_model(const ir_model *ir) {
   lmodel *L = calloc(1, sizeof *L);
@@ -510,8 +548,15 @@ lmodel *lower_model(const ir_model *ir) {
       d->chord[1] = o->chord[1];
     }
     if (o->kind == OUT_MODAL) d->node = o->mode;
+    if (o->kind == OUT_SECTION && d->body >= 0 && L->body[d->body].kind == MB_BODY_FLEXIBLE &&
+        section_coefficients(L, o, d)) {
+      free(jm0);
+      free(jm1);
+      lower_free(L);
+      return NULL;
+    }
     if (o->kind == OUT_POSITION || o->kind == OUT_VELOCITY) d->node = o->node;
-    if ((o->kind == OUT_DEFLECTION || o->kind == OUT_MODAL) &&
+    if ((o->kind == OUT_DEFLECTION || o->kind == OUT_MODAL || o->kind == OUT_SECTION) &&
         (d->body < 0 || L->body[d->body].kind != MB_BODY_FLEXIBLE ||
          (o->kind == OUT_MODAL && o->mode >= L->body[d->body].nm))) {
       diag_error(ir->path, o->loc, "output '%s' needs a flexible body%s", o->name,
@@ -531,12 +576,13 @@ lmodel *lower_model(const ir_model *ir) {
     }
     static const char *xyz[3] = {"x", "y", "z"}, *e4[4] = {"e0", "e1", "e2", "e3"},
                       *rc[6] = {"fx", "fy", "fz", "tx", "ty", "tz"},
-                      *pm[6] = {"px", "py", "pz", "hx", "hy", "hz"};
+                      *pm[6] = {"px", "py", "pz", "hx", "hy", "hz"},
+                      *sf[6] = {"N", "Vy", "Vz", "T", "My", "Mz"};
     for (int j = 0; j < d->ncols; j++) {
       const char *suffix = NULL;
       if (d->ncols == 3) suffix = xyz[j];
       else if (d->ncols == 4) suffix = e4[j];
-      else if (d->ncols == 6) suffix = o->kind == OUT_MOMENTUM ? pm[j] : rc[j];
+      else if (d->ncols == 6) suffix = o->kind == OUT_MOMENTUM ? pm[j] : o->kind == OUT_SECTION ? sf[j] : rc[j];
       L->col_name[col + j] = suffix ? xstrdup_printf("%s.%s%s", o->name, suffix, "")
                                     : strdup(o->name);
     }
@@ -556,6 +602,7 @@ lmodel *lower_model(const ir_model *ir) {
   m->force_law = L->force_law;
   m->profile = L->profile;
   m->output = L->output;
+  m->output_coef = L->output_coef;
   m->q0 = L->q0;
   m->v0 = L->v0;
   m->col_name = (const char *const *)L->col_name;
@@ -834,6 +881,7 @@ void lower_free(lmodel *L) {
   for (int r = 0; r < L->m.nrow; r++) free(L->row_desc[r]);
   for (int k = 0; k < L->m.nprofile; k++) { free(L->spline[k]); free(L->table[k]); }
   for (int c = 0; c < L->m.ncols; c++) free(L->col_name[c]);
+  free(L->output_coef);
   free(L->body); free(L->marker); free(L->marker_desc); free(L->row); free(L->row_desc);
   free(L->row_loc); free(L->force); free(L->force_ir); free(L->force_prm); free(L->force_law);
   free(L->profile);

@@ -20,6 +20,8 @@ typedef struct {
   mb_law *force_law;         /* m.nforce_law laws (mb_forcedef.ladr) */
   mb_profile *profile;
   mb_outputdef *output;
+  double *output_coef;       /* SECTION outputs' coefficient rows (m.output_coef) */
+  int noutput_coef;
   int *Kp, *Ki;
   double *q0, *v0;
   char **col_name;

@@ -78,7 +78,7 @@ typedef enum {
   MB_OUT_POSITION = 1, MB_OUT_ORIENTATION, MB_OUT_ANGLE, MB_OUT_VELOCITY, MB_OUT_ANGULAR_VELOCITY,
   MB_OUT_ACCELERATION, MB_OUT_ANGULAR_ACCELERATION, MB_OUT_REACTION, MB_OUT_EFFORT,
   MB_OUT_KINETIC_ENERGY, MB_OUT_POTENTIAL_ENERGY, MB_OUT_TOTAL_ENERGY, MB_OUT_DEFLECTION,
-  MB_OUT_MODAL, MB_OUT_MOMENTUM
+  MB_OUT_MODAL, MB_OUT_MOMENTUM, MB_OUT_SECTION
 } mb_output_kind;
 
 typedef struct {
@@ -96,7 +96,9 @@ typedef struct {
   int driver_marker; /* EFFORT: marker 0 of the driven joint (its z axis) */
   int driver_rotation; /* EFFORT: 1 rotation, 0 translation */
   int node;          /* DEFLECTION: the node (deflection X_k w, body axes); POSITION, VELOCITY:
-                        a node of a flexible body, or -1; MODAL: the mode */
+                        a node of a flexible body, or -1; MODAL: the mode; SECTION: the first
+                        of its ncols x nm coefficients (row-major) in the model's output_coef:
+                        the output is output_coef rows times w */
   int chord[2];      /* DEFLECTION: minus the chord between these nodes' deflections, or -1 */
   mb_real scale;
   int ncols, col;    /* columns in the output vector and the first of them */
@@ -126,6 +128,7 @@ typedef struct mb_model {
   int nforce_state;            /* reals of force-element state (none yet: 0) */
   const mb_profile *profile;
   const mb_outputdef *output;
+  const mb_real *output_coef;  /* SECTION outputs: linear in the modal coordinates (or 0) */
   const char *const *joint_name;
   mb_real gravity[3];
   const int *Kp, *Ki;          /* CSC pattern of K (both triangles), n+1 and nnz */

@@ -527,6 +527,15 @@ void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_r
       }
       nval = 6;
       break;
+    case MB_OUT_SECTION: {
+      /* beam section forces or a stress: rows of coefficients times w */
+      const mb_body *B = &m->body[o->body];
+      const mb_real *w = q + B->qadr + 7, *c = m->output_coef + o->node;
+      nval = o->ncols;
+      for (int i = 0; i < nval; i++)
+        for (int j = 0; j < B->nm; j++) val[i] += c[i * B->nm + j] * w[j];
+      break;
+    }
     case MB_OUT_KINETIC_ENERGY: val[0] = kin; nval = 1; break;
     case MB_OUT_POTENTIAL_ENERGY: val[0] = pot; nval = 1; break;
     case MB_OUT_TOTAL_ENERGY: val[0] = kin + pot; nval = 1; break;
