@@ -23,7 +23,7 @@ typedef struct {
 } nas_field;
 
 typedef struct {
-  char name[16];
+  char name[24];
   const char *file; /* path of the file the card is in */
   ir_loc loc;
   nas_field *f; /* f[1..nf-1]: data fields by logical position (8 per line) */

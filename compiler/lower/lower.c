@@ -398,7 +398,12 @@ lmodel *lower_model(const ir_model *ir) {
     memcpy(L->q0 + d->qadr + 3, B->orientation, sizeof(double) * 4);
     memcpy(L->v0 + d->vadr, B->velocity, sizeof(double) * 3);
     mb_mul3t(A, B->angular_velocity, L->v0 + d->vadr + 3);
-    /* initial modal coordinates and rates (assembly then moves the frames only) */
+  }
+  m->nbody = nb;
+  /* initial modal coordinates and rates (assembly then moves the frames only) */
+  for (int b = 0; b < nb; b++) {
+    const ir_body *B = &ir->bodies[b + 1];
+    const mb_body *d = &L->body[b];
     const ir_flex *fx = B->kind == BODY_FLEXIBLE ? B->flex : NULL;
     for (int k = 0; fx && k < 2; k++) {
       int n = k ? fx->nwd0 : fx->nw0;
@@ -413,7 +418,6 @@ lmodel *lower_model(const ir_model *ir) {
       memcpy(k ? L->v0 + d->vadr + 6 : L->q0 + d->qadr + 7, w, sizeof(double) * (size_t)n);
     }
   }
-  m->nbody = nb;
 
   /* joints: two markers each (frames z = axis), then their rows; a side on a
      flexible node lowered through a virtual body gets the body and the 6-row
