@@ -43,14 +43,14 @@ typedef struct {
  * d/dt exp(theta~) = (Jl thetad)~ exp(theta~) */
 static inline void mb_so3_jl(const mb_real th[3], const mb_real thd[3], mb_real Jl[9],
                              mb_real Jld[9]) {
-  mb_real p2 = mb_dot3(th, th), p = sqrt(p2), a, b, a1, b1;
-  if (p < 1e-2) { /* series: no cancellation near zero */
-    a = 0.5 - p2 / 24 + p2 * p2 / 720;
-    b = 1.0 / 6 - p2 / 120 + p2 * p2 / 5040;
-    a1 = -1.0 / 12 + p2 / 180;
-    b1 = -1.0 / 60 + p2 / 1260;
+  mb_real p2 = mb_dot3(th, th), p = MB_SQRT(p2), a, b, a1, b1;
+  if (p < MB_R(1e-2)) { /* series: no cancellation near zero */
+    a = MB_R(0.5) - p2 / 24 + p2 * p2 / 720;
+    b = MB_R(1.0) / 6 - p2 / 120 + p2 * p2 / 5040;
+    a1 = -MB_R(1.0) / 12 + p2 / 180;
+    b1 = -MB_R(1.0) / 60 + p2 / 1260;
   } else {
-    mb_real s = sin(p), c = cos(p);
+    mb_real s = MB_SIN(p), c = MB_COS(p);
     a = (1 - c) / p2;
     b = (p - s) / (p2 * p);
     a1 = (p * s - 2 + 2 * c) / (p2 * p2);
@@ -71,9 +71,9 @@ static inline void mb_so3_jl(const mb_real th[3], const mb_real thd[3], mb_real 
 
 /* exp(theta~) by Rodrigues' formula */
 static inline void mb_so3_exp(const mb_real th[3], mb_real E[9]) {
-  mb_real p2 = mb_dot3(th, th), p = sqrt(p2), s1, c1;
-  if (p < 1e-4) { s1 = 1 - p2 / 6; c1 = 0.5 - p2 / 24; }
-  else { s1 = sin(p) / p; c1 = (1 - cos(p)) / p2; }
+  mb_real p2 = mb_dot3(th, th), p = MB_SQRT(p2), s1, c1;
+  if (p < MB_R(1e-4)) { s1 = 1 - p2 / 6; c1 = MB_R(0.5) - p2 / 24; }
+  else { s1 = MB_SIN(p) / p; c1 = (1 - MB_COS(p)) / p2; }
   mb_real T[9] = {0, -th[2], th[1], th[2], 0, -th[0], -th[1], th[0], 0}, T2[9];
   mb_matmul3(T, T, T2);
   for (int i = 0; i < 9; i++) E[i] = (i % 4 == 0) + s1 * T[i] + c1 * T2[i];
@@ -205,7 +205,7 @@ static inline void mb_flex_contract(const mb_flex *fx, const mb_real *w, const m
       for (int i = 0; i < 3; i++)
         for (int l = 0; l < 3; l++) {
           mb_real t = 2 * tr * (i == l) - E[3 * i + l] - E[3 * l + i];
-          if (quad) t += tf * (i == l) - 0.5 * (Fw[3 * i + l] + Fw[3 * l + i]);
+          if (quad) t += tf * (i == l) - MB_R(0.5) * (Fw[3 * i + l] + Fw[3 * l + i]);
           c->J[3 * i + l] += w[j] * t;
         }
     }
@@ -318,7 +318,7 @@ static inline mb_real mb_flex_kinetic(const mb_flex *fx, const mb_frame *f, cons
   for (int i = 0; i < 3; i++) { v[i] = f->rd[i]; v[3 + i] = f->wl[i]; }
   for (int j = 0; j < fx->nm; j++) v[6 + j] = wd[j];
   for (int i = 0; i < n; i++)
-    for (int l = 0; l < n; l++) T += 0.5 * v[i] * Mb[n * i + l] * v[l];
+    for (int l = 0; l < n; l++) T += MB_R(0.5) * v[i] * Mb[n * i + l] * v[l];
   return T;
 }
 

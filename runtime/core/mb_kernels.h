@@ -14,8 +14,7 @@
 #ifndef MB_KERNELS_H
 #define MB_KERNELS_H
 
-#include <math.h>
-#include "mb_types.h"
+#include "mb_math.h"
 
 /* --- small vector algebra --------------------------------------------------- */
 static inline mb_real mb_dot3(const mb_real a[3], const mb_real b[3]) {
@@ -54,7 +53,7 @@ static inline void mb_col3(const mb_real R[9], int k, mb_real a[3]) {
 /* Rotation matrix of Euler parameters p (normalized here, so that a state
  * whose p drifted off the unit sphere still gives a rotation). */
 static inline void mb_euler_to_A(const mb_real p_in[4], mb_real A[9]) {
-  mb_real n = sqrt(p_in[0] * p_in[0] + p_in[1] * p_in[1] + p_in[2] * p_in[2] + p_in[3] * p_in[3]);
+  mb_real n = MB_SQRT(p_in[0] * p_in[0] + p_in[1] * p_in[1] + p_in[2] * p_in[2] + p_in[3] * p_in[3]);
   mb_real e0 = p_in[0] / n, e1 = p_in[1] / n, e2 = p_in[2] / n, e3 = p_in[3] / n;
   A[0] = 2 * (e0 * e0 + e1 * e1) - 1; A[1] = 2 * (e1 * e2 - e0 * e3); A[2] = 2 * (e1 * e3 + e0 * e2);
   A[3] = 2 * (e1 * e2 + e0 * e3); A[4] = 2 * (e0 * e0 + e2 * e2) - 1; A[5] = 2 * (e2 * e3 - e0 * e1);
@@ -63,16 +62,16 @@ static inline void mb_euler_to_A(const mb_real p_in[4], mb_real A[9]) {
 
 /* pd = 1/2 L(p)^T w' : Euler-parameter rates from the body angular velocity */
 static inline void mb_euler_rates(const mb_real p[4], const mb_real wl[3], mb_real pd[4]) {
-  pd[0] = 0.5 * (-p[1] * wl[0] - p[2] * wl[1] - p[3] * wl[2]);
-  pd[1] = 0.5 * (p[0] * wl[0] - p[3] * wl[1] + p[2] * wl[2]);
-  pd[2] = 0.5 * (p[3] * wl[0] + p[0] * wl[1] - p[1] * wl[2]);
-  pd[3] = 0.5 * (-p[2] * wl[0] + p[1] * wl[1] + p[0] * wl[2]);
+  pd[0] = MB_R(0.5) * (-p[1] * wl[0] - p[2] * wl[1] - p[3] * wl[2]);
+  pd[1] = MB_R(0.5) * (p[0] * wl[0] - p[3] * wl[1] + p[2] * wl[2]);
+  pd[2] = MB_R(0.5) * (p[3] * wl[0] + p[0] * wl[1] - p[1] * wl[2]);
+  pd[3] = MB_R(0.5) * (-p[2] * wl[0] + p[1] * wl[1] + p[0] * wl[2]);
 }
 
 /* p <- p (x) exp(dtheta'/2): rotate by a body-axes rotation vector, exactly */
 static inline void mb_euler_rotate(mb_real p[4], const mb_real dth[3]) {
-  mb_real a = sqrt(dth[0] * dth[0] + dth[1] * dth[1] + dth[2] * dth[2]);
-  mb_real c = cos(0.5 * a), s = (a > 1e-12) ? sin(0.5 * a) / a : 0.5;
+  mb_real a = MB_SQRT(dth[0] * dth[0] + dth[1] * dth[1] + dth[2] * dth[2]);
+  mb_real c = MB_COS(MB_R(0.5) * a), s = (a > MB_R(1e-12)) ? MB_SIN(MB_R(0.5) * a) / a : MB_R(0.5);
   mb_real q0 = c, q1 = s * dth[0], q2 = s * dth[1], q3 = s * dth[2];
   mb_real e0 = p[0], e1 = p[1], e2 = p[2], e3 = p[3];
   p[0] = e0 * q0 - e1 * q1 - e2 * q2 - e3 * q3;
@@ -111,7 +110,7 @@ static inline void mb_rigid_gyro(const mb_real J[9], const mb_real wl[3], mb_rea
 static inline mb_real mb_rigid_kinetic(mb_real m, const mb_real J[9], const mb_frame *f) {
   mb_real h[3];
   mb_mul3(J, f->wl, h);
-  return 0.5 * m * mb_dot3(f->rd, f->rd) + 0.5 * mb_dot3(f->wl, h);
+  return MB_R(0.5) * m * mb_dot3(f->rd, f->rd) + MB_R(0.5) * mb_dot3(f->wl, h);
 }
 
 /* --- markers ----------------------------------------------------------------- */
@@ -204,10 +203,10 @@ static inline void mb_profile_eval(const mb_profile *p, mb_real t, mb_real x[3])
     break;
   }
   case MB_PROFILE_SINE: {
-    mb_real om = 2 * MB_PI * p->c[1], ph = om * t + p->c[2];
-    x[0] = p->c[3] + p->c[0] * sin(ph);
-    x[1] = p->c[0] * om * cos(ph);
-    x[2] = -p->c[0] * om * om * sin(ph);
+    mb_real om = 2 * MB_R(MB_PI) * p->c[1], ph = om * t + p->c[2];
+    x[0] = p->c[3] + p->c[0] * MB_SIN(ph);
+    x[1] = p->c[0] * om * MB_COS(ph);
+    x[2] = -p->c[0] * om * om * MB_SIN(ph);
     break;
   }
   case MB_PROFILE_TABLE: {
@@ -327,7 +326,7 @@ static inline void mb_prim_rot(const mb_marker *m0, const mb_marker *m1, const m
   mb_col3(m0->R, 0, f);
   mb_col3(m0->R, 1, g);
   mb_col3(m1->R, 0, a);
-  mb_real s = sin(th[0]), co = cos(th[0]);
+  mb_real s = MB_SIN(th[0]), co = MB_COS(th[0]);
   for (int k = 0; k < 3; k++) { e[k] = -s * f[k] + co * g[k]; c[k] = co * f[k] + s * g[k]; }
   r->phi = mb_dot3(a, e);
   mb_cross3(e, a, r->dW[0]);

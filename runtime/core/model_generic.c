@@ -317,7 +317,7 @@ void mb_model_qincrement(const mb_model *m, mb_real *q, const mb_real *dv) {
 void mb_model_normalize(const mb_model *m, mb_real *q) {
   for (int b = 0; b < m->nbody; b++) {
     mb_real *p = q + m->body[b].qadr + 3;
-    mb_real n = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3]);
+    mb_real n = MB_SQRT(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3]);
     for (int j = 0; j < 4; j++) p[j] /= n;
   }
 }
@@ -340,7 +340,7 @@ void mb_model_energy(const mb_model *m, mb_real t, const mb_real *q, const mb_re
       for (int i = 0; i < 3; i++) S[i] += fx->S0[i];
       mb_mul3(F[b].A, S, AS);
       U -= mb_dot3(m->gravity, AS) + fx->mass * mb_dot3(m->gravity, F[b].r);
-      for (int j = 0; j < fx->nm; j++) U += 0.5 * fx->stiffness[j] * w[j] * w[j];
+      for (int j = 0; j < fx->nm; j++) U += MB_R(0.5) * fx->stiffness[j] * w[j] * w[j];
       continue;
     }
     T += mb_rigid_kinetic(B->mass, B->J, &F[b]);
@@ -369,10 +369,10 @@ static mb_real body_angle(const mb_outputdef *o, const mb_frame *f, const mb_rea
   mb_real u[3], c[3];
   mb_mul3(f->A, o->u, u);
   mb_cross3(o->u_g, u, c);
-  mb_real a = atan2(mb_dot3(o->axis_g, c), mb_dot3(o->u_g, u));
+  mb_real a = MB_ATAN2(mb_dot3(o->axis_g, c), mb_dot3(o->u_g, u));
   if (prev) {
-    while (a - *prev > MB_PI) a -= 2 * MB_PI;
-    while (a - *prev < -MB_PI) a += 2 * MB_PI;
+    while (a - *prev > MB_R(MB_PI)) a -= 2 * MB_R(MB_PI);
+    while (a - *prev < -MB_R(MB_PI)) a += 2 * MB_R(MB_PI);
   }
   return a;
 }
@@ -416,7 +416,7 @@ void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_r
       break;
     case MB_OUT_ORIENTATION: {
       const mb_real *p = q + m->body[o->body].qadr + 3;
-      mb_real n = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3]);
+      mb_real n = MB_SQRT(p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + p[3] * p[3]);
       for (int j = 0; j < 4; j++) val[j] = p[j] / n;
       nval = 4;
       break;

@@ -48,9 +48,9 @@ static inline mb_real mb_field(const mb_marker *m0, const mb_marker *m1, const m
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++)
       Rr[3 * i + j] = m0->R[i] * m1->R[j] + m0->R[3 + i] * m1->R[3 + j] + m0->R[6 + i] * m1->R[6 + j];
-  mb_real v[3] = {0.5 * (Rr[7] - Rr[5]), 0.5 * (Rr[2] - Rr[6]), 0.5 * (Rr[3] - Rr[1])};
-  mb_real sn = sqrt(mb_dot3(v, v)), cs = 0.5 * (Rr[0] + Rr[4] + Rr[8] - 1);
-  mb_real ang = atan2(sn, cs), fac = (sn > 1e-12) ? ang / sn : 1;
+  mb_real v[3] = {MB_R(0.5) * (Rr[7] - Rr[5]), MB_R(0.5) * (Rr[2] - Rr[6]), MB_R(0.5) * (Rr[3] - Rr[1])};
+  mb_real sn = MB_SQRT(mb_dot3(v, v)), cs = MB_R(0.5) * (Rr[0] + Rr[4] + Rr[8] - 1);
+  mb_real ang = MB_ATAN2(sn, cs), fac = (sn > MB_R(1e-12)) ? ang / sn : 1;
   for (int j = 0; j < 3; j++) u[3 + j] = fac * v[j];
   mb_mul3t(m0->R, wd, ud + 3);
   mb_real E = 0;
@@ -58,7 +58,7 @@ static inline mb_real mb_field(const mb_marker *m0, const mb_marker *m1, const m
     f[i] = pre[i];
     for (int j = 0; j < 6; j++) {
       f[i] -= K[6 * i + j] * u[j] + C[6 * i + j] * ud[j];
-      E += 0.5 * u[i] * K[6 * i + j] * u[j];
+      E += MB_R(0.5) * u[i] * K[6 * i + j] * u[j];
     }
     E -= pre[i] * u[i];
   }
@@ -70,16 +70,16 @@ static inline mb_real mb_field(const mb_marker *m0, const mb_marker *m1, const m
        log(exp(a~) exp(th~)) = th + Jl^-1(th) a + O(a^2), with
        Jl^-1(th) = I - th~/2 + (1/|th|^2 - (1 + cos|th|) / (2 |th| sin|th|)) th~ th~ */
     const mb_real *th = u + 3;
-    mb_real t2 = mb_dot3(th, th), b = 1.0 / 12, Rt[9], Jinv[9], G[9], Hw[9];
-    if (t2 > 1e-8) {
-      mb_real t = sqrt(t2);
-      b = 1 / t2 - (1 + cos(t)) / (2 * t * sin(t));
+    mb_real t2 = mb_dot3(th, th), b = MB_R(1.0) / 12, Rt[9], Jinv[9], G[9], Hw[9];
+    if (t2 > MB_R(1e-8)) {
+      mb_real t = MB_SQRT(t2);
+      b = 1 / t2 - (1 + MB_COS(t)) / (2 * t * MB_SIN(t));
     }
     mb_real S[9] = {0, -th[2], th[1], th[2], 0, -th[0], -th[1], th[0], 0};
     for (int i = 0; i < 3; i++)
       for (int j = 0; j < 3; j++) {
         Rt[3 * i + j] = m0->R[3 * j + i];
-        Jinv[3 * i + j] = (i == j) - 0.5 * S[3 * i + j] + b * (th[i] * th[j] - (i == j) * t2);
+        Jinv[3 * i + j] = (i == j) - MB_R(0.5) * S[3 * i + j] + b * (th[i] * th[j] - (i == j) * t2);
       }
     mb_real W0x[9] = {0, -m0->W[2], m0->W[1], m0->W[2], 0, -m0->W[0], -m0->W[1], m0->W[0], 0};
     mb_matmul3(Jinv, Rt, G);

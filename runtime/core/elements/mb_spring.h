@@ -41,10 +41,10 @@ static inline mb_real mb_law_eval(const mb_law *l, mb_real x, mb_real *energy) {
     break;
   case MB_LAW_LINEAR:
     F = l->coef * x;
-    E = 0.5 * l->coef * x * x;
+    E = MB_R(0.5) * l->coef * x * x;
     break;
   case MB_LAW_POWER: {
-    mb_real ax = fabs(x), pw = pow(ax, l->exponent);
+    mb_real ax = MB_FABS(x), pw = MB_POW(ax, l->exponent);
     F = (x < 0 ? -1 : 1) * l->coef * pw;
     E = l->coef * pw * ax / (l->exponent + 1);
     break;
@@ -58,12 +58,12 @@ static inline mb_real mb_law_eval(const mb_law *l, mb_real x, mb_real *energy) {
     mb_real a = 0, b = x, sign = 1;
     if (b < a) { a = x; b = 0; sign = -1; }
     for (int j = 0; j <= n - 2; j++) {
-      mb_real lo = (j == 0) ? -INFINITY : d[2 * j], hi = (j == n - 2) ? INFINITY : d[2 * j + 2];
+      mb_real lo = (j == 0) ? -(mb_real)INFINITY : d[2 * j], hi = (j == n - 2) ? (mb_real)INFINITY : d[2 * j + 2];
       mb_real u0 = a > lo ? a : lo, u1 = b < hi ? b : hi;
       if (u1 <= u0) continue;
       mb_real sj = (d[2 * j + 3] - d[2 * j + 1]) / (d[2 * j + 2] - d[2 * j]);
       mb_real f0 = d[2 * j + 1] + sj * (u0 - d[2 * j]), f1 = d[2 * j + 1] + sj * (u1 - d[2 * j]);
-      E += sign * 0.5 * (f0 + f1) * (u1 - u0);
+      E += sign * MB_R(0.5) * (f0 + f1) * (u1 - u0);
     }
     break;
   }
@@ -77,7 +77,7 @@ static inline mb_real mb_law_slope(const mb_law *l, mb_real x) {
   switch (l->kind) {
   case MB_LAW_NONE: return 0;
   case MB_LAW_LINEAR: return l->coef;
-  case MB_LAW_POWER: return l->coef * l->exponent * pow(fabs(x), l->exponent - 1);
+  case MB_LAW_POWER: return l->coef * l->exponent * MB_POW(MB_FABS(x), l->exponent - 1);
   case MB_LAW_TABLE: {
     const mb_real *d = l->table;
     int k = mb_law_segment(l, x);
@@ -97,7 +97,7 @@ static inline mb_real mb_spring(const mb_marker *m0, const mb_marker *m1, const 
                                 mb_real *tangent) {
   mb_real d[3], dd[3], E = 0;
   for (int j = 0; j < 3; j++) { d[j] = m1->P[j] - m0->P[j]; dd[j] = m1->V[j] - m0->V[j]; }
-  mb_real L = sqrt(mb_dot3(d, d));
+  mb_real L = MB_SQRT(mb_dot3(d, d));
   mb_real n[3] = {d[0] / L, d[1] / L, d[2] / L};
   mb_real x = L - prm[MB_SPRING_L0], Ld = mb_dot3(n, dd);
   mb_real T = mb_law_eval(&law[MB_SPRING_STIFFNESS], x, &E) +
