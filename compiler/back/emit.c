@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "diag.h"
+#include "emit_float.h"
 #include "emit_ldl.h"
 #include "emit_force.h"
 #include "emit_rows.h"
@@ -921,6 +922,15 @@ int emit_model(const lmodel *L, const char *dir) {
       write_file(tmp, cname, L, emit_source, NULL, 0)) {
     diag_error(NULL, (ir_loc){0, 0}, "cannot write generated code in '%s'", tmp);
     return 2;
+  }
+  if (L->real_float) { /* float literals and float math in the model (not the hosted main.c) */
+    char hpath[4400], cpath[4400];
+    snprintf(hpath, sizeof hpath, "%s/%s", tmp, hname);
+    snprintf(cpath, sizeof cpath, "%s/%s", tmp, cname);
+    if (emit_float_dialect(hpath) || emit_float_dialect(cpath)) {
+      diag_error(NULL, (ir_loc){0, 0}, "cannot rewrite the generated code in '%s' for single precision", tmp);
+      return 2;
+    }
   }
   /* replace the old directory's files */
   mkdir(dir, 0777);
