@@ -38,6 +38,7 @@ static void usage(void) {
   fprintf(stderr,
           "usage: mbcc check M.yaml [--scene S]\n"
           "       mbcc compile M.yaml [--scene S] [-o DIR] [--real float|double]\n"
+          "                [--target embedded [--integrator rk4|genalpha] [--step H]]\n"
           "       mbcc run M.yaml [--scene S] [--path generated|generic] [--solver ldl|klu|dense]\n"
           "                [--real float|double]\n"
           "                [--integrator rk4|dopri5|genalpha|auto] [-o results.csv] [--plot out.png|none]\n"
@@ -60,6 +61,7 @@ static void usage(void) {
 typedef struct {
   const char *model, *scene, *outdir, *csv, *plot, *path, *body, *shapes, *modal_out;
   int real_float;   /* --real float: single-precision generated code and runtime */
+  int embedded;     /* --target embedded: a package for a microcontroller (emit_embedded.c) */
   const char *sim_args[32];
   int nsim;
   int quiet;
@@ -87,6 +89,11 @@ static int parse_options(int argc, char **argv, options *o) {
     else if (!strcmp(a, "-o")) { o->outdir = v; o->csv = v; }
     else if (!strcmp(a, "--plot")) o->plot = v;
     else if (!strcmp(a, "--path")) o->path = v;
+    else if (!strcmp(a, "--target")) {
+      if (!strcmp(v, "embedded")) o->embedded = 1;
+      else if (!strcmp(v, "host")) o->embedded = 0;
+      else { fprintf(stderr, "mbcc: error: '--target' must be host or embedded, got '%s'\n", v); return 2; }
+    }
     else if (!strcmp(a, "--real")) {
       if (!strcmp(v, "float")) o->real_float = 1;
       else if (!strcmp(v, "double")) o->real_float = 0;
@@ -262,11 +269,50 @@ static void default_dir(const lmodel *L, const ir_model *ir, char *dir, size_t n
   snprintf(dir, n, "generated/%s", L->m.name);
 }
 
+static void settings_from_ir(const ir_sim *s, mb_settings *set);
+
+/* the embedded package's fixed-step integrator and step: the model's, or
+ * --integrator / --step; an adaptive choice (dopri5, auto) becomes RK4 unless
+ * the modes are stiff (mb_integrator_auto), then generalized-alpha */
+static int embedded_package(const options *o, const lmodel *L, const char *dir) {
+  mb_settings set;
+  settings_from_ir(&L->ir->sim, &set);
+  for (int i = 0; i + 1 < o->nsim; i += 2) {
+    const char *a = o->sim_args[i], *v = o->sim_args[i + 1];
+    char *end;
+    if (!strcmp(a, "--integrator")) {
+      if (!strcmp(v, "rk4")) set.integrator = MB_RK4;
+      else if (!strcmp(v, "genalpha")) set.integrator = MB_GENALPHA;
+      else { fprintf(stderr, "mbcc: error: --target embedded integrates with rk4 or genalpha, not '%s'\n", v); return 2; }
+    } else if (!strcmp(a, "--step")) {
+      set.step = strtod(v, &end);
+      if (*end || !(set.step > 0)) { fprintf(stderr, "mbcc: error: '--step' must be a positive number, got '%s'\n", v); return 2; }
+    }
+  }
+  if (set.integrator == MB_AUTO || set.integrator == MB_DOPRI5) {
+    set.integrator = mb_integrator_auto(&L->m, &set, NULL, 0) == MB_GENALPHA ? MB_GENALPHA : MB_RK4;
+    if (set.step > set.output_step) set.step = set.output_step;
+  }
+  int st = emit_embedded(L, dir, set.integrator, set.step);
+  if (!st) printf("wrote the embedded package %s/ (%s, step %g s)\n", dir, mb_integrator_name(set.integrator), set.step);
+  return st;
+}
+
 static int cmd_compile(const options *o, char *dir_out, size_t n, lmodel **Lp, ir_model **irp) {
   ir_model *ir;
   lmodel *L = build(o, &ir, 0);
   if (!L) return 2;
   L->real_float = o->real_float;
+  if (o->embedded) {
+    char pdir[4096];
+    if (o->outdir) snprintf(pdir, sizeof pdir, "%s", o->outdir);
+    else snprintf(pdir, sizeof pdir, "generated/%s-embedded", L->m.name);
+    mkdir("generated", 0777);
+    int st = embedded_package(o, L, pdir);
+    lower_free(L);
+    ir_free(ir);
+    return st;
+  }
   char dir[4096];
   if (o->outdir && !dir_out) snprintf(dir, sizeof dir, "%s", o->outdir);
   else default_dir(L, ir, dir, sizeof dir);

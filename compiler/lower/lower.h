@@ -82,5 +82,10 @@ int emit_model(const lmodel *L, const char *dir);
 /* Fill templates/<name> (model name, simulation settings, solver) into the
  * file 'out' (emit.c).  Returns 0 or reports and returns 2. */
 int emit_template(const lmodel *L, const char *name, const char *out);
+/* where the templates and runtime sources are: $MBCC_ROOT, else the build's checkout */
+const char *emit_root_dir(void);
+/* mbcc compile --target embedded: the package of compiler/back/emit_embedded.c;
+ * integrator MB_RK4 or MB_GENALPHA, step the suggested fixed step */
+int emit_embedded(const lmodel *L, const char *dir, int integrator, double step);
 
 #endif
