@@ -1,0 +1,95 @@
+#!/usr/bin/env bash
+# test_embedded.sh: the embedded target (mbcc compile --target embedded).
+# Always (host compiler only):
+#   - runtime/core's step code and a float generated model compile freestanding
+#     under -Wdouble-promotion -Wconversion -Werror -DMB_REAL_FLOAT;
+#   - the package's RK4 (runtime/core/mb_step.c) against the hosted RK4 of
+#     mbcc run (runtime/hosted/integrate.c, an independent implementation) on
+#     the rigid and the flexible slider-crank, same step: within 1e-9 of each
+#     output's size (the CSV has 12 digits);
+#   - the package's generalized-alpha (fixed 3 Newton iterations) converges to
+#     that RK4 solution at second order: halving the step divides the error by
+#     more than 3;
+#   - bad options exit 2 and write nothing.
+# With arm-none-eabi-gcc, newlib and qemu-system-arm (scripts/install-deps.sh):
+#   - each package (rigid and flexible, double and float) cross-compiles for a
+#     Cortex-M4F with -Werror, the float ones link no __aeabi_d* (nm), and the
+#     flexible float one reports its flash and RAM;
+#   - verify.elf runs on qemu's mps2-an386 and matches the host run of the same
+#     package: double within 1e-9 of each output's size, float within 1e-4
+#     (measured: 0 for the rigid, 2e-6 for the flexible slider-crank; libm's
+#     sinf/cosf differ between newlib and glibc by an ulp).
+# Environment: MBCC (set by tests/run_tests.sh; default build/mbcc).
+set -u
+cd "$(dirname "$0")/.."
+# shellcheck source=tests/shell_setup.sh
+. tests/shell_setup.sh
+
+cc -std=c11 -O2 -Wall -Wextra -Werror "$root/tests/embedded/compare.c" -lm -o compare || { echo "FAIL: compare.c"; exit 1; }
+
+# max error relative to each column's size (first field of compare's answer)
+rel_error() { ./compare "$1" "$2" | awk '{ print $1 }'; }
+below() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a != "" && a + 0 <= b + 0) }'; }
+
+# --- freestanding float build of the core with a generated model ---
+"$MBCC" compile "$root/models/slider_crank_flexible.yaml" --real float -o gen_float > /dev/null || err "compile --real float"
+for src in "$root/runtime/core/mb_step.c" "$root/runtime/core/model_generic.c" gen_float/slider_crank_flexible.c; do
+  cc -std=c11 -ffreestanding -fno-math-errno -Wall -Wextra -Wdouble-promotion -Wconversion -Werror -DMB_REAL_FLOAT \
+     -I"$root/runtime/core" -Igen_float -c "$src" -o /dev/null || err "freestanding float build of $(basename "$src")"
+done
+
+# --- the core's RK4 against the hosted RK4; generalized-alpha's order ---
+package() { # package DIR MODEL [mbcc options...]
+  local dir=$1 model=$2; shift 2
+  "$MBCC" compile "$root/models/$model.yaml" --target embedded "$@" -o "$dir" > /dev/null || { err "package $dir"; return 1; }
+}
+host_log() { # host_log DIR STEPS EVERY: the verification run on the host
+  (cd "$1" && make -s host-verify HOSTOPT=-O0 VERIFY="-DVERIFY_STEPS=$2 -DVERIFY_EVERY=$3" > /dev/null && ./host-verify > host.log) ||
+    err "host-verify in $1"
+}
+for model in slider_crank slider_crank_flexible; do
+  package rk4_$model $model --integrator rk4 --step 1e-5 || continue
+  host_log rk4_$model 200 20
+  "$MBCC" run "$root/models/$model.yaml" --integrator rk4 --step 1e-5 --end 0.002 --output-step 2e-4 \
+    -o hosted_$model.csv --plot none --quiet || err "mbcc run $model"
+  e=$(rel_error rk4_$model/host.log hosted_$model.csv)
+  below "$e" 1e-9 || err "$model: the core's RK4 differs from the hosted RK4 by $e (> 1e-9)"
+done
+package ga1 slider_crank_flexible --integrator genalpha --step 1e-5 && host_log ga1 200 20
+package ga2 slider_crank_flexible --integrator genalpha --step 5e-6 && host_log ga2 400 40
+e1=$(rel_error ga1/host.log hosted_slider_crank_flexible.csv)
+e2=$(rel_error ga2/host.log hosted_slider_crank_flexible.csv)
+below "$e1" 1e-3 || err "generalized-alpha, step 1e-5: error $e1 against RK4 (> 1e-3)"
+awk -v a="$e1" -v b="$e2" 'BEGIN { exit !(b > 0 && a / b > 3) }' ||
+  err "generalized-alpha is not second order: error $e1 at 1e-5, $e2 at 5e-6"
+
+# --- bad options: exit 2, nothing written ---
+"$MBCC" compile "$root/models/slider_crank.yaml" --target mcu -o bad1 > out 2>&1; st=$?
+[ $st = 2 ] && [ ! -e bad1 ] || err "--target mcu: exit $st (want 2, nothing written)"
+"$MBCC" compile "$root/models/slider_crank.yaml" --target embedded --integrator dopri5 -o bad2 > out 2>&1; st=$?
+[ $st = 2 ] && [ ! -e bad2 ] || err "--target embedded --integrator dopri5: exit $st (want 2, nothing written)"
+
+# --- on the emulated Cortex-M4F ---
+if ! command -v arm-none-eabi-gcc > /dev/null || ! command -v qemu-system-arm > /dev/null; then
+  echo "test_embedded: no arm-none-eabi-gcc or qemu-system-arm: the ARM part is skipped (scripts/install-deps.sh)"
+  exit $fail
+fi
+for model in slider_crank slider_crank_flexible; do
+  for real in double float; do
+    d=arm_${model}_$real
+    package $d $model --real $real || continue
+    (cd $d && make -s lib$model.a verify.elf example.elf > build.log 2>&1) || { err "$d: cross build"; cat $d/build.log; continue; }
+    ! grep -q warning $d/build.log || err "$d: warnings in the cross build"
+    if [ $real = float ]; then
+      (cd $d && make -s check-double > /dev/null) || err "$d: __aeabi_d* linked in the float build"
+    fi
+    [ "$model-$real" = slider_crank_flexible-float ] && echo "$model float on Cortex-M4F: $(cd $d && make -s size | tr '\n' ' ')"
+    host_log $d 200 20
+    (cd $d && timeout 60 make -s run-qemu > arm.log 2>&1) || { err "$d: qemu run failed"; tail -3 $d/arm.log; continue; }
+    e=$(rel_error $d/arm.log $d/host.log)
+    bound=$([ $real = double ] && echo 1e-9 || echo 1e-4)
+    below "$e" $bound || err "$d: qemu and host differ by $e (> $bound)"
+    echo "$model $real: qemu against host $e"
+  done
+done
+exit $fail
