@@ -22,7 +22,7 @@ CC_SRC  := compiler/main.c $(foreach d,$(CC_DIRS),$(wildcard $(d)/*.c))
 B       ?= build
 DEPFLAGS = -MMD -MP
 
-.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser
+.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser embedded
 all: $(B)/mbcc $(B)/libmbrt.a $(B)/libmbrt_float.a
 
 # objects keep the source's folders: $(B)/rt/core/x.o, $(B)/cc/front/x.o
@@ -87,6 +87,9 @@ $(WEB)/node_modules/.installed: web/package.json web/package-lock.json
 $(WEB)/player.js: web/player.js $(WEB)/node_modules/.installed
 	NODE_PATH=$(ROOT)/$(WEB)/node_modules $(WEB)/node_modules/.bin/esbuild web/player.js \
 	  --bundle --minify --format=iife --log-level=warning --outfile=$@
+# the embedded target on qemu's Cortex-M4F (scripts/embedded.sh): writes docs/embedded.md
+embedded: all
+	MBCC=$(B)/mbcc bash scripts/embedded.sh
 
 include tests/tests.mk
 include docs/results.mk

@@ -21,7 +21,7 @@
 static const char *const core_files[] = {"mb_types.h", "mb_math.h",   "mb_kernels.h", "mb_flex.h",
                                          "mb_model.h", "model_generic.c", "mb_step.h",  "mb_step.c"};
 /* templates/embedded/<name>, written as <name> with @MODEL@ / @UMODEL@ filled */
-static const char *const template_files[] = {"Makefile", "README.md", "example_main.c", "verify_main.c",
+static const char *const template_files[] = {"Makefile", "README.md", "example_main.c", "verify_main.c", "timing_main.c",
                                              "board/startup.c", "board/mps2_an386.ld"};
 
 static void upper(char *dst, const char *src, size_t n) {
@@ -167,11 +167,27 @@ static int join(char *out, size_t n, const char *a, const char *b) {
   return k < 0 || (size_t)k >= n;
 }
 
-int emit_embedded(const lmodel *L, const char *dir, int integrator, double step) {
+/* remove what a failed write_package left in tmp (only names it writes) */
+static void remove_partial(const char *tmp, const char *nm) {
+  char path[4400], fn[300];
+  static const char *const suffixes[] = {".c", ".h", "_api.c", "_api.h"};
+  for (size_t i = 0; i < 4; i++) {
+    snprintf(fn, sizeof fn, "%s%s", nm, suffixes[i]);
+    if (!join(path, sizeof path, tmp, fn)) remove(path);
+  }
+  for (size_t i = 0; i < sizeof core_files / sizeof core_files[0]; i++)
+    if (!join(path, sizeof path, tmp, core_files[i])) remove(path);
+  for (size_t i = 0; i < sizeof template_files / sizeof template_files[0]; i++)
+    if (!join(path, sizeof path, tmp, template_files[i])) remove(path);
+  if (!join(path, sizeof path, tmp, "main.c")) remove(path);
+  if (!join(path, sizeof path, tmp, "board")) rmdir(path);
+  rmdir(tmp);
+}
+
+static int write_package(const lmodel *L, const char *dir, const char *tmp, int integrator, double step) {
   const char *nm = L->m.name;
-  char U[256], tmp[4096], path[4400], src[4400];
+  char U[256], path[4400], src[4400];
   upper(U, nm, sizeof U);
-  snprintf(tmp, sizeof tmp, "%s.pkg", dir);
   /* the model itself (writes <m>.c, <m>.h and a hosted main.c, which goes) */
   if (emit_model(L, tmp)) return 2;
   if (join(path, sizeof path, tmp, "main.c")) return 2;
@@ -239,4 +255,12 @@ int emit_embedded(const lmodel *L, const char *dir, int integrator, double step)
   rmdir(path);
   rmdir(tmp);
   return 0;
+}
+
+int emit_embedded(const lmodel *L, const char *dir, int integrator, double step) {
+  char tmp[4096];
+  snprintf(tmp, sizeof tmp, "%s.pkg", dir);
+  int st = write_package(L, dir, tmp, integrator, step);
+  if (st) remove_partial(tmp, L->m.name);
+  return st;
 }
