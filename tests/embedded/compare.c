@@ -1,12 +1,13 @@
 /* compare.c: compares two output logs of an embedded package, row by row:
- *   compare A B [MAXCOLS]
+ *   compare A B [FLOOR]
  * A log is either verify_main's (each value the hex of its float or double
  * bits, time first) or a CSV of mbcc run (header skipped).  Prints the largest
  * error of a column relative to that column's largest magnitude in B (so a
  * column that crosses zero is judged against its size, not against zero) and
- * the column; a column of round-off only (largest magnitude below 1e-9 of the
- * table's largest, e.g. an out-of-plane force of 1e-36 N) is judged against
- * that 1e-9.  Exit 1 if the row counts differ or a value is not finite. */
+ * the column; a column of round-off only (largest magnitude below FLOOR, default
+ * 1e-9, of the table's largest: an out-of-plane force of 1e-36 N, the total
+ * energy of a conservative model, 0) is judged against that FLOOR; a float
+ * against double comparison takes 1e-3, the system's scale.  Exit 1 if the row counts differ or a value is not finite. */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -48,7 +49,7 @@ int main(int argc, char **argv) {
   static table A, B;
   if (argc < 3 || read_table(argv[1], &A) || read_table(argv[2], &B)) return 2;
   int cols = A.cols < B.cols ? A.cols : B.cols;
-  if (argc > 3 && atoi(argv[3]) < cols) cols = atoi(argv[3]);
+  double floor_rel = argc > 3 ? atof(argv[3]) : 1e-9;
   if (A.rows != B.rows || A.rows == 0) {
     printf("rows differ: %d and %d\n", A.rows, B.rows);
     return 1;
@@ -58,7 +59,7 @@ int main(int argc, char **argv) {
   for (int c = 0; c < cols; c++)
     for (int r = 0; r < B.rows; r++) table_max = fmax(table_max, fabs(B.v[r][c]));
   for (int c = 0; c < cols; c++) {
-    double scale = 1e-9 * table_max, err = 0;
+    double scale = floor_rel * table_max, err = 0;
     for (int r = 0; r < B.rows; r++) scale = fmax(scale, fabs(B.v[r][c]));
     for (int r = 0; r < A.rows; r++) {
       if (!isfinite(A.v[r][c]) || !isfinite(B.v[r][c])) { printf("non-finite value, row %d column %d\n", r, c); return 1; }
