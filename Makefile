@@ -10,7 +10,7 @@ LIBS    := -lyaml -lcholmod -larpack -lklu -lamd -lcolamd -lbtf -lsuitesparsecon
 # tables, the generic walker); hosted/ holds the integrators, solvers, CSV
 # driver and benchmarks that run on an operating system
 RT_INC  := -Iruntime/core -Iruntime/hosted
-RT_SRC  := runtime/core/model_generic.c \
+RT_SRC  := runtime/core/model_generic.c runtime/core/mb_step.c \
            $(addprefix runtime/hosted/,solver_select.c genalpha.c solver_klu.c solver_dense.c \
              solver_generic.c solver_ldl.c integrate.c driver.c ida.c bench.c)
 # the compiler, one folder a stage: front (YAML -> IR), flex (FE models and
@@ -35,7 +35,7 @@ $(B)/libmbrt.a: $(patsubst runtime/%.c,$(B)/rt/%.o,$(RT_SRC))
 
 # the single-precision runtime (mbcc compile --real float): the emitted LDL^T
 # only, since KLU, LAPACK and SUNDIALS work in double
-RT_FLOAT_SRC := runtime/core/model_generic.c \
+RT_FLOAT_SRC := runtime/core/model_generic.c runtime/core/mb_step.c \
                 $(addprefix runtime/hosted/,solver_select.c solver_ldl.c integrate.c genalpha.c driver.c)
 $(B)/rt-float/%.o: runtime/%.c
 	@mkdir -p $(@D)
