@@ -18,8 +18,11 @@
 #include "lower.h"
 
 /* the core sources a package needs, from runtime/core */
-static const char *const core_files[] = {"mb_types.h", "mb_math.h",   "mb_kernels.h", "mb_flex.h",
-                                         "mb_model.h", "model_generic.c", "mb_step.h",  "mb_step.c"};
+static const char *const core_files[] = {
+    "mb_types.h", "mb_math.h", "mb_kernels.h", "mb_flex.h", "mb_model.h", "model_generic.c", "mb_step.h",
+    "mb_step.c", "elements/mb_field.h", "elements/mb_force_point.h", "elements/mb_spring.h"};
+/* the package's folders (core_files and template_files name files in them) */
+static const char *const subdirs[] = {"board", "elements"};
 /* templates/embedded/<name>, written as <name> with @MODEL@ / @UMODEL@ filled */
 static const char *const template_files[] = {"Makefile", "README.md", "example_main.c", "verify_main.c", "timing_main.c",
                                              "board/startup.c", "board/mps2_an386.ld"};
@@ -180,7 +183,8 @@ static void remove_partial(const char *tmp, const char *nm) {
   for (size_t i = 0; i < sizeof template_files / sizeof template_files[0]; i++)
     if (!join(path, sizeof path, tmp, template_files[i])) remove(path);
   if (!join(path, sizeof path, tmp, "main.c")) remove(path);
-  if (!join(path, sizeof path, tmp, "board")) rmdir(path);
+  for (size_t i = 0; i < sizeof subdirs / sizeof subdirs[0]; i++)
+    if (!join(path, sizeof path, tmp, subdirs[i])) rmdir(path);
   rmdir(tmp);
 }
 
@@ -200,10 +204,12 @@ static int write_package(const lmodel *L, const char *dir, const char *tmp, int 
       return 2;
     }
   }
-  if (join(path, sizeof path, tmp, "board")) return 2;
-  if (mkdir(path, 0777) && errno != EEXIST) {
-    diag_error(NULL, (ir_loc){0, 0}, "cannot create directory '%s': %s", path, strerror(errno));
-    return 2;
+  for (size_t i = 0; i < sizeof subdirs / sizeof subdirs[0]; i++) {
+    if (join(path, sizeof path, tmp, subdirs[i])) return 2;
+    if (mkdir(path, 0777) && errno != EEXIST) {
+      diag_error(NULL, (ir_loc){0, 0}, "cannot create directory '%s': %s", path, strerror(errno));
+      return 2;
+    }
   }
   const char *root = emit_root_dir();
   for (size_t i = 0; i < sizeof core_files / sizeof core_files[0]; i++) {
@@ -231,9 +237,11 @@ static int write_package(const lmodel *L, const char *dir, const char *tmp, int 
     diag_error(NULL, (ir_loc){0, 0}, "cannot create directory '%s': %s", dir, strerror(errno));
     return 2;
   }
-  char dboard[4400];
-  if (join(dboard, sizeof dboard, dir, "board")) return 2;
-  mkdir(dboard, 0777);
+  for (size_t i = 0; i < sizeof subdirs / sizeof subdirs[0]; i++) {
+    char sub[4400];
+    if (join(sub, sizeof sub, dir, subdirs[i])) return 2;
+    mkdir(sub, 0777);
+  }
   const char *model_files[4];
   char f0[300], f1[300], f2[300], f3[300];
   snprintf(f0, sizeof f0, "%s.c", nm);
@@ -251,8 +259,8 @@ static int write_package(const lmodel *L, const char *dir, const char *tmp, int 
       return 2;
     }
   }
-  if (join(path, sizeof path, tmp, "board")) return 2;
-  rmdir(path);
+  for (size_t i = 0; i < sizeof subdirs / sizeof subdirs[0]; i++)
+    if (!join(path, sizeof path, tmp, subdirs[i])) rmdir(path);
   rmdir(tmp);
   return 0;
 }
