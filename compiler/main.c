@@ -111,6 +111,12 @@ static int parse_options(int argc, char **argv, options *o) {
     fprintf(stderr, "mbcc: error: unknown path '%s' (expected generated or generic)\n", o->path);
     return 2;
   }
+  for (int i = 0; i + 1 < o->nsim; i++)
+    if (!strcmp(o->path, "generic") && !strcmp(o->sim_args[i], "--solver") && !strcmp(o->sim_args[i + 1], "ldl")) {
+      fprintf(stderr, "mbcc: error: '--solver ldl' is the LDL^T emitted with the generated code; "
+              "the generic path has klu or dense\n");
+      return 2;
+    }
   return 0;
 }
 
@@ -420,6 +426,8 @@ static int cmd_run(const options *o) {
       if (strcmp(o->sim_args[i], "--columns")) args[na++] = (char *)o->sim_args[i];
       else i++;
     args[na] = NULL;
+    /* the generic path has no emitted LDL^T: a model that asks for ldl (the
+       default) runs there with KLU */
     rc = mb_main(na, args, &Lg->m, &set, s->solver == SOLVER_DENSE ? "dense" : "klu");
     lower_free(Lg);
   } else {

@@ -871,7 +871,7 @@ int emit_template(const lmodel *L, const char *name, const char *out) {
       if (!strncmp(p, "@MODEL@", 7)) { fputs(L->m.name, f); p += 7; }
       else if (!strncmp(p, "@SOLVER@", 8)) {
         /* single precision has only the emitted LDL^T (KLU, LAPACK are double) */
-        fputs(L->real_float ? "ldl" : L->ir->sim.solver == SOLVER_DENSE ? "dense" : "klu", f);
+        fputs(L->real_float || L->ir->sim.solver == SOLVER_LDL ? "ldl" : L->ir->sim.solver == SOLVER_DENSE ? "dense" : "klu", f);
         p += 8;
       } else fputc(*p++, f);
     }

@@ -17,7 +17,7 @@ static const char *const sim_keys[SIM_FIELDS] = {
     "solver",   "stabilization", "joints_on_flexible"};
 
 static const char *const integrator_names[] = {"rk4", "dopri5", "genalpha", "auto", NULL};
-static const char *const solver_names[] = {"klu", "dense", NULL};
+static const char *const solver_names[] = {"klu", "dense", "ldl", NULL};
 static const char *const stabilization_names[] = {"projection", "baumgarte", "none", NULL};
 static const char *const jof_names[] = {"direct", "virtual", NULL};
 

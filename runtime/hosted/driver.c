@@ -181,7 +181,14 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
   if (set.max_step > set.output_step) set.max_step = set.output_step;
 
   mb_solver *ls = mb_solver_new(solver, m);
-  if (!ls) { fprintf(stderr, "%s: error: unknown solver '%s' (expected ldl, klu or dense)\n", argv[0], solver); return 2; }
+  if (!ls) {
+    if (!strcmp(solver, "ldl"))
+      fprintf(stderr, "%s: error: solver 'ldl' is the LDL^T emitted with generated code, which this "
+              "model has not (expected %s)\n", argv[0], mb_solver_choices(m));
+    else
+      fprintf(stderr, "%s: error: unknown solver '%s' (expected %s)\n", argv[0], solver, mb_solver_choices(m));
+    return 2;
+  }
   /* write to a temporary file, renamed on success: nothing half-written */
   char tmp[4096];
   snprintf(tmp, sizeof tmp, "%s.part", csv_path);
