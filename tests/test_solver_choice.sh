@@ -4,6 +4,7 @@
 #   - `simulation: {solver: S}` is accepted for every solver the command line
 #     knows (ldl, klu, dense), and the generated simulator uses it (its
 #     closing statistics name it); the three give the same pendulum to 1e-9;
+#   - with no solver named, the generated path uses the emitted LDL^T;
 #   - messages do not contradict themselves: the generic path (no emitted
 #     LDL^T) refuses `--solver ldl` without listing ldl as a choice, and an
 #     unknown solver in the model file lists all three.
@@ -31,6 +32,10 @@ for s in klu dense; do
     ldl.csv "$s.csv")
   [ -z "$out" ] || err "ldl and $s disagree: $out"
 done
+
+# the default: the emitted LDL^T
+"$MBCC" run "$root/models/pendulum.yaml" --end 0.2 -o d.csv --plot none > d.log 2>&1 || err "default run failed: $(tail -3 d.log)"
+grep -q "solver ldl," d.log || err "the default solver is not ldl: $(grep -m1 '^integrator' d.log)"
 
 # the generic path has no emitted LDL^T: said once, without contradiction
 "$MBCC" run "$root/models/pendulum.yaml" --path generic --solver ldl -o g.csv --plot none > g.log 2>&1

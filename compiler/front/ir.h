@@ -306,7 +306,7 @@ typedef struct {
   double rtol, atol;    /* DOPRI5; defaults 1e-6, 1e-8 */
   double min_step, max_step; /* DOPRI5; defaults 1e-12, output_step */
   ir_integrator integrator;  /* default dopri5 */
-  ir_solver solver;          /* default klu */
+  ir_solver solver;          /* default ldl: the emitted LDL^T (the generic path: klu) */
   ir_stab stabilization;     /* default projection */
   double baumgarte_alpha, baumgarte_beta; /* defaults 10, 10 */
   double rho_inf;            /* generalized-alpha; default 0.8 */

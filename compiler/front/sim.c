@@ -31,7 +31,7 @@ void sim_defaults(sim_settings *s) {
   s->value[SIM_BETA] = 10;
   s->value[SIM_RHO_INF] = 0.8;
   s->value[SIM_INTEGRATOR] = INTEGRATOR_DOPRI5;
-  s->value[SIM_SOLVER] = SOLVER_KLU;
+  s->value[SIM_SOLVER] = SOLVER_LDL;
   s->value[SIM_STABILIZATION] = STAB_PROJECTION;
   s->value[SIM_JOINTS_ON_FLEXIBLE] = JOF_DIRECT;
 }
