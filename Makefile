@@ -18,11 +18,11 @@ RT_SRC  := runtime/core/model_generic.c \
 # back (ordering, LDL^T plan, C emission), tools (trade)
 CC_DIRS := compiler/front compiler/elements compiler/flex compiler/lower compiler/back compiler/tools
 CC_INC  := -Icompiler $(addprefix -I,$(CC_DIRS)) $(RT_INC)
-CC_SRC  := compiler/main.c $(foreach d,$(CC_DIRS),$(wildcard $(d)/*.c))
+CC_SRC  := compiler/main.c compiler/help.c $(foreach d,$(CC_DIRS),$(wildcard $(d)/*.c))
 B       ?= build
 DEPFLAGS = -MMD -MP
 
-.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser
+.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser man
 all: $(B)/mbcc $(B)/libmbrt.a $(B)/libmbrt_float.a
 
 # objects keep the source's folders: $(B)/rt/core/x.o, $(B)/cc/front/x.o
@@ -87,6 +87,9 @@ $(WEB)/node_modules/.installed: web/package.json web/package-lock.json
 $(WEB)/player.js: web/player.js $(WEB)/node_modules/.installed
 	NODE_PATH=$(ROOT)/$(WEB)/node_modules $(WEB)/node_modules/.bin/esbuild web/player.js \
 	  --bundle --minify --format=iife --log-level=warning --outfile=$@
+# the man page, from the same text as mbcc help (compiler/help.c)
+man: $(B)/mbcc
+	$(B)/mbcc help --man > docs/mbcc.1
 
 include tests/tests.mk
 include docs/results.mk

@@ -14,10 +14,12 @@
 #include "diag.h"
 #include "fe.h"
 #include "flex.h"
+#include "help.h"
 #include "lower.h"
 #include "mb_driver.h"
 #include "order.h"
 #include "trade.h"
+#include "version.h"
 
 #ifndef MBCC_ROOT
 #define MBCC_ROOT "."
@@ -34,28 +36,7 @@ static const char *root_dir(void) {
   return r && *r ? r : MBCC_ROOT;
 }
 
-static void usage(void) {
-  fprintf(stderr,
-          "usage: mbcc check M.yaml [--scene S]\n"
-          "       mbcc compile M.yaml [--scene S] [-o DIR] [--real float|double]\n"
-          "       mbcc run M.yaml [--scene S] [--path generated|generic] [--solver ldl|klu|dense]\n"
-          "                [--real float|double]\n"
-          "                [--integrator rk4|dopri5|genalpha|auto] [-o results.csv] [--plot out.png|none]\n"
-          "                [--end T] [--output-step H] [--step H] [--max-step H] [--rtol R] [--atol A]\n"
-          "                [--stabilization projection|baumgarte|none] [--rho-inf R] [--max-steps N] [--quiet]\n"
-          "                [--animate]\n"
-          "       mbcc bench M.yaml [--scene S] [--csv FILE] [--reps N] [--paths a,b,...]\n"
-          "                [--integrator rk4|dopri5] [--end T] [--rtol R] [--atol A] [--ida-rtol R] [--quiet]\n"
-          "       mbcc modes M.yaml --body NAME [--scene S] [--shapes shapes.csv]\n"
-          "                [--write-modal body.modal.yaml]\n"
-          "       mbcc plot results.csv [-o out.png] [--columns a,b,...]\n"
-          "       mbcc animate results.csv [-m M.yaml] [--scene S] [-o out.html] [--scale S] [--quiet]\n"
-          "       mbcc trade M.yaml [--scene S] [--outputs a,b,...] [--max-error E] [--csv FILE]\n"
-          "                [--plot FILE.png|none] [--reps N] [--end T] [--output-step H]\n"
-          "                [--integrators rk4@H,dopri5@R,...]\n"
-          "                [--modes all,N,FHz,...] [--couplings ...] [--joints ...] [--solvers ...]\n"
-          "                [--reals double,float] [--ref-rtol R] [--workdir DIR] [--quiet]\n");
-}
+static void usage(void) { help_usage(stderr); }
 
 typedef struct {
   const char *model, *scene, *outdir, *csv, *plot, *path, *body, *shapes, *modal_out;
@@ -517,11 +498,30 @@ static int cmd_bench(const options *o) {
 }
 
 int main(int argc, char **argv) {
-  if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
+  if (argc < 2) {
     usage();
-    return argc < 2 ? 2 : 0;
+    return 2;
+  }
+  if (!strcmp(argv[1], "--version")) {
+    printf("mbcc %s\n", MBCC_VERSION);
+    return 0;
+  }
+  if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
+    if (argc > 2 && !strcmp(argv[2], "--man")) { help_man(stdout); return 0; }
+    if (argc > 2 && (!strcmp(argv[2], "--help") || !strcmp(argv[2], "-h"))) return help_print(stdout, "help");
+    if (argc > 2 && help_print(stdout, argv[2])) {
+      fprintf(stderr, "mbcc: error: no command '%s' (mbcc help lists them)\n", argv[2]);
+      return 2;
+    }
+    return argc > 2 ? 0 : help_print(stdout, NULL);
   }
   const char *cmd = argv[1];
+  /* mbcc CMD --help: that command's help, whatever else is on the line */
+  for (int i = 2; i < argc; i++)
+    if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+      if (help_print(stdout, cmd)) break; /* an unknown command: reported below */
+      return 0;
+    }
   options o;
   if (!strcmp(cmd, "trade")) return cmd_trade(argc, argv);
   if (!strcmp(cmd, "animate")) return cmd_animate(argc, argv);
