@@ -22,7 +22,7 @@ CC_SRC  := compiler/main.c compiler/help.c $(foreach d,$(CC_DIRS),$(wildcard $(d
 B       ?= build
 DEPFLAGS = -MMD -MP
 
-.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser man
+.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser man release-check
 all: $(B)/mbcc $(B)/libmbrt.a $(B)/libmbrt_float.a
 
 # objects keep the source's folders: $(B)/rt/core/x.o, $(B)/cc/front/x.o
@@ -87,6 +87,10 @@ $(WEB)/node_modules/.installed: web/package.json web/package-lock.json
 $(WEB)/player.js: web/player.js $(WEB)/node_modules/.installed
 	NODE_PATH=$(ROOT)/$(WEB)/node_modules $(WEB)/node_modules/.bin/esbuild web/player.js \
 	  --bundle --minify --format=iife --log-level=warning --outfile=$@
+# before a release: the measured documents are current (scripts/docs-fresh.sh)
+release-check:
+	bash scripts/docs-fresh.sh
+
 # the man page, from the same text as mbcc help (compiler/help.c)
 man: $(B)/mbcc
 	$(B)/mbcc help --man > docs/mbcc.1
