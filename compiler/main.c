@@ -40,6 +40,7 @@ static void usage(void) { help_usage(stderr); }
 
 typedef struct {
   const char *model, *scene, *outdir, *csv, *plot, *path, *body, *shapes, *modal_out;
+  const char *results_dir; /* --results DIR: where run's CSV, units and plot go */
   int real_float;   /* --real float: single-precision generated code and runtime */
   const char *sim_args[32];
   int nsim;
@@ -67,6 +68,7 @@ static int parse_options(int argc, char **argv, options *o) {
     else if (!strcmp(a, "--write-modal")) o->modal_out = v;
     else if (!strcmp(a, "-o")) { o->outdir = v; o->csv = v; }
     else if (!strcmp(a, "--plot")) o->plot = v;
+    else if (!strcmp(a, "--results")) o->results_dir = v;
     else if (!strcmp(a, "--path")) o->path = v;
     else if (!strcmp(a, "--real")) {
       if (!strcmp(v, "float")) o->real_float = 1;
@@ -77,7 +79,7 @@ static int parse_options(int argc, char **argv, options *o) {
              !strcmp(a, "--output-step") || !strcmp(a, "--step") || !strcmp(a, "--max-step") || !strcmp(a, "--rtol") ||
              !strcmp(a, "--atol") || !strcmp(a, "--stabilization") || !strcmp(a, "--columns") ||
              !strcmp(a, "--csv") || !strcmp(a, "--reps") || !strcmp(a, "--paths") || !strcmp(a, "--rho-inf") ||
-             !strcmp(a, "--max-steps") || !strcmp(a, "--ida-rtol")) {
+             !strcmp(a, "--max-steps") || !strcmp(a, "--ida-rtol") || !strcmp(a, "--precision")) {
       if (o->nsim + 2 > 30) { fprintf(stderr, "mbcc: error: too many options\n"); return 2; }
       o->sim_args[o->nsim++] = a;
       o->sim_args[o->nsim++] = v;
@@ -376,6 +378,14 @@ int compile_generated(const char *dir, const char *name, const char *main_src, c
   return 0;
 }
 
+/* run's CSV without -o: NAME.csv in --results DIR, else in results/ (made
+   here: only the last directory) */
+static void default_csv(const options *o, const char *name, char *csv, size_t n) {
+  const char *dir = o->results_dir ? o->results_dir : "results";
+  mkdir(dir, 0777);
+  snprintf(csv, n, "%s/%s.csv", dir, name);
+}
+
 static int cmd_run(const options *o) {
   char dir[4096];
   lmodel *L = NULL;
@@ -391,10 +401,7 @@ static int cmd_run(const options *o) {
     o2.outdir = NULL;
     lmodel *Lg = build(&o2, &ir, 0);
     if (!Lg) return 2;
-    if (!o->csv) {
-      mkdir("results", 0777);
-      snprintf(csv, sizeof csv, "results/%s.csv", Lg->m.name);
-    }
+    if (!o->csv) default_csv(o, Lg->m.name, csv, sizeof csv);
     const ir_sim *s = &ir->sim;
     mb_settings set;
     settings_from_ir(s, &set);
@@ -416,10 +423,7 @@ static int cmd_run(const options *o) {
     o2.outdir = NULL;
     rc = cmd_compile(&o2, dir, sizeof dir, &L, &ir);
     if (rc) return rc;
-    if (!o->csv) {
-      mkdir("results", 0777);
-      snprintf(csv, sizeof csv, "results/%s.csv", L->m.name);
-    }
+    if (!o->csv) default_csv(o, L->m.name, csv, sizeof csv);
     /* compile the generated code against the runtime library */
     char exe[8400], src_main[8400];
     snprintf(exe, sizeof exe, "%s/%s_sim", dir, L->m.name);
