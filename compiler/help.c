@@ -81,7 +81,7 @@ static const help_command commands[] = {
       {"--scene S", "apply scene S of the model file"},
       {"--shapes FILE.csv", "write the mode shapes at every node"},
       {"--write-modal FILE", "write the modes as a modal file (docs/modal-file.md)"}}},
-    {"plot", "mbcc plot A.csv [B.csv ...] [-o OUT.png] [--columns a,b+c,...]",
+    {"plot", "mbcc plot A.csv [B.csv ...] [-o OUT.png] [--columns a,b+c,...] [--gnuplot FILE]",
      "plot results with gnuplot, one panel per column against time",
      "Every column (or those of --columns) gets a panel; a panel shows the column of every CSV file "
      "given (overlay of runs), and a+b draws columns a and b in one panel. Eight panels make a page: "
@@ -90,7 +90,9 @@ static const help_command commands[] = {
      "units come from FILE.csv.units when it exists. An unknown column is an error that lists the "
      "known ones.",
      {{"-o OUT.png", "the plot (default: the first CSV with .png)"},
-      {"--columns a,b+c,...", "the columns, in order; + joins columns in one panel"}}},
+      {"--columns a,b+c,...", "the columns, in order; + joins columns in one panel (default: all but the pose columns body.*)"},
+      {"--gnuplot FILE", "keep the gnuplot script in FILE (to restyle the plot)"},
+      {"--quiet", "print nothing but errors"}}},
     {"animate", "mbcc animate results.csv [-m M.yaml] [--scene S] [-o out.html] [--scale S] [--quiet]",
      "a self-contained HTML page that plays a result's motion in the browser",
      "The CSV must hold the pose columns (body.NAME.r, .p, .w<j>) that mbcc run --animate adds. "

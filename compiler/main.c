@@ -18,6 +18,7 @@
 #include "lower.h"
 #include "mb_driver.h"
 #include "order.h"
+#include "plot.h"
 #include "trade.h"
 #include "version.h"
 
@@ -284,49 +285,6 @@ int run_command(char *const argv[]) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
 }
 
-static int plot_csv(const char *csv, const char *png, const char *columns) {
-  /* a gnuplot script: one panel per column (at most 8), against time */
-  FILE *in = fopen(csv, "r");
-  if (!in) { fprintf(stderr, "mbcc: error: cannot read '%s'\n", csv); return 2; }
-  char header[8192];
-  if (!fgets(header, sizeof header, in)) { fclose(in); fprintf(stderr, "%s:1:1: error: empty CSV file\n", csv); return 2; }
-  fclose(in);
-  header[strcspn(header, "\r\n")] = 0;
-  char *names[64];
-  int nn = 0;
-  for (char *tok = strtok(header, ","); tok && nn < 64; tok = strtok(NULL, ",")) names[nn++] = tok;
-  int pick[8], np = 0;
-  for (int c = 1; c < nn && np < 8; c++) {
-    if (columns) {
-      char list[1024];
-      snprintf(list, sizeof list, ",%s,", columns);
-      char key[300];
-      snprintf(key, sizeof key, ",%s,", names[c]);
-      if (!strstr(list, key)) continue;
-    } else if (!strncmp(names[c], "body.", 5)) {
-      continue; /* the pose columns of run --animate are for the animation */
-    }
-    pick[np++] = c;
-  }
-  if (np == 0) { fprintf(stderr, "mbcc: error: no columns to plot in '%s'\n", csv); return 2; }
-  char script[4096];
-  snprintf(script, sizeof script, "%s.gp", png);
-  FILE *g = fopen(script, "w");
-  if (!g) { fprintf(stderr, "mbcc: error: cannot write '%s'\n", script); return 2; }
-  int rows = (np + 1) / 2, cols = np > 1 ? 2 : 1;
-  fprintf(g, "set terminal pngcairo size %d,%d noenhanced font ',9'\nset output '%s'\n", 520 * cols, 300 * rows, png);
-  fprintf(g, "set datafile separator ','\nset key off\nset grid\nset multiplot layout %d,%d\n", rows, cols);
-  for (int k = 0; k < np; k++)
-    fprintf(g, "set title '%s'\nset xlabel 't [s]'\nplot '%s' every ::1 using 1:%d with lines lw 1.5\n", names[pick[k]], csv, pick[k] + 1);
-  fprintf(g, "unset multiplot\n");
-  fclose(g);
-  char *argv[] = {"gnuplot", script, NULL};
-  int st = run_command(argv);
-  remove(script);
-  if (st) { fprintf(stderr, "mbcc: error: gnuplot failed (status %d)\n", st); return 2; }
-  return 0;
-}
-
 /* the runtime settings of the model's simulation block */
 static void settings_from_ir(const ir_sim *s, mb_settings *set) {
   mb_settings_default(set);
@@ -459,8 +417,8 @@ static int cmd_run(const options *o) {
     const char *columns = NULL;
     for (int i = 0; i + 1 < o->nsim; i++)
       if (!strcmp(o->sim_args[i], "--columns")) columns = o->sim_args[i + 1];
-    if (plot_csv(csv, png, columns)) return 2;
-    if (!o->quiet) printf("wrote %s\n", png);
+    const char *files[] = {csv};
+    if (plot_files(1, files, png, columns, o->quiet)) return 2;
   }
   if (o->animate) { /* the page beside the CSV: results/<model>.html */
     char html[4096];
@@ -501,6 +459,39 @@ static int cmd_bench(const options *o) {
   return run_command(args);
 }
 
+/* mbcc plot A.csv [B.csv ...] [-o OUT.png] [--columns a,b+c] [--gnuplot FILE] [--quiet] */
+static int cmd_plot(int argc, char **argv) {
+  const char *files[64], *png_opt = NULL, *columns = NULL;
+  int nfiles = 0, quiet = 0;
+  for (int i = 2; i < argc; i++) {
+    const char *a = argv[i];
+    if (!strcmp(a, "--quiet")) { quiet = 1; continue; }
+    if (a[0] != '-') {
+      if (nfiles == 64) { fprintf(stderr, "mbcc: error: more than 64 CSV files\n"); return 2; }
+      files[nfiles++] = a;
+      continue;
+    }
+    if (i + 1 >= argc) { fprintf(stderr, "mbcc: error: option '%s' needs a value\n", a); return 2; }
+    if (!strcmp(a, "-o")) png_opt = argv[++i];
+    else if (!strcmp(a, "--columns")) columns = argv[++i];
+    else if (!strcmp(a, "--gnuplot")) plot_keep_script = argv[++i];
+    else {
+      fprintf(stderr, "mbcc: error: unknown option '%s' (mbcc plot --help)\n", a);
+      return 2;
+    }
+  }
+  if (!nfiles) { usage(); return 2; }
+  char png[4096];
+  if (png_opt) snprintf(png, sizeof png, "%s", png_opt);
+  else {
+    snprintf(png, sizeof png, "%s", files[0]);
+    char *dot = strrchr(png, '.');
+    if (dot && !strchr(dot, '/')) strcpy(dot, ".png");
+    else strncat(png, ".png", sizeof png - strlen(png) - 1);
+  }
+  return plot_files(nfiles, files, png, columns, quiet);
+}
+
 int main(int argc, char **argv) {
   if (argc < 2) {
     usage();
@@ -529,23 +520,7 @@ int main(int argc, char **argv) {
   options o;
   if (!strcmp(cmd, "trade")) return cmd_trade(argc, argv);
   if (!strcmp(cmd, "animate")) return cmd_animate(argc, argv);
-  if (!strcmp(cmd, "plot")) {
-    if (parse_options(argc, argv, &o)) return 2;
-    char png[4096];
-    if (o.outdir) snprintf(png, sizeof png, "%s", o.outdir);
-    else {
-      snprintf(png, sizeof png, "%s", o.model);
-      char *dot = strrchr(png, '.');
-      if (dot) strcpy(dot, ".png");
-      else strncat(png, ".png", sizeof png - strlen(png) - 1);
-    }
-    const char *columns = NULL;
-    for (int i = 0; i + 1 < o.nsim; i++)
-      if (!strcmp(o.sim_args[i], "--columns")) columns = o.sim_args[i + 1];
-    int st = plot_csv(o.model, png, columns);
-    if (!st) printf("wrote %s\n", png);
-    return st;
-  }
+  if (!strcmp(cmd, "plot")) return cmd_plot(argc, argv);
   if (strcmp(cmd, "check") && strcmp(cmd, "compile") && strcmp(cmd, "run") && strcmp(cmd, "modes") &&
       strcmp(cmd, "bench")) {
     fprintf(stderr, "mbcc: error: unknown command '%s'\n", cmd);
