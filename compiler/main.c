@@ -18,24 +18,14 @@
 #include "lower.h"
 #include "mb_driver.h"
 #include "order.h"
+#include "paths.h"
 #include "plot.h"
 #include "trade.h"
 #include "version.h"
 
-#ifndef MBCC_ROOT
-#define MBCC_ROOT "."
-#endif
-#ifndef MBCC_RTLIB
-#define MBCC_RTLIB MBCC_ROOT "/build/libmbrt.a"
-#endif
 #ifndef MBCC_GEN_CFLAGS
 #define MBCC_GEN_CFLAGS "-O2"
 #endif
-
-static const char *root_dir(void) {
-  const char *r = getenv("MBCC_ROOT");
-  return r && *r ? r : MBCC_ROOT;
-}
 
 static void usage(void) { help_usage(stderr); }
 
@@ -302,10 +292,9 @@ int compile_generated(const char *dir, const char *name, const char *main_src, c
                       char *const extra[], int quiet, int real_float) {
   char src_c[8400], inc[8400], inc_hosted[8400], lib[8400];
   snprintf(src_c, sizeof src_c, "%s/%s.c", dir, name);
-  snprintf(inc, sizeof inc, "-I%s/runtime/core", root_dir());
-  snprintf(inc_hosted, sizeof inc_hosted, "-I%s/runtime/hosted", root_dir());
-  const char *rtlib = getenv("MBCC_RTLIB");
-  snprintf(lib, sizeof lib, "%s", rtlib && *rtlib ? rtlib : MBCC_RTLIB);
+  snprintf(inc, sizeof inc, "-I%s", mbcc_include_dir(0));
+  snprintf(inc_hosted, sizeof inc_hosted, "-I%s", mbcc_include_dir(1)[0] ? mbcc_include_dir(1) : mbcc_include_dir(0));
+  snprintf(lib, sizeof lib, "%s", mbcc_runtime_lib());
   if (real_float) {
     /* the single-precision runtime sits beside the double one: libmbrt_float.a */
     char *dot = strstr(lib, ".a");

@@ -41,6 +41,7 @@ present() {
     nodejs)             command -v node ;;
     npm)                command -v npm ;;
     chromium)           command -v chromium ;;
+    pkgconf)            command -v pkg-config ;;
     *)                  false ;;
   esac >/dev/null 2>&1
 }
@@ -48,9 +49,10 @@ present() {
 # gnuplot-nox has the pngcairo terminal on Debian 12 (checked: 5.4.4).
 # nodejs and npm build the animation player (make web: three.js, esbuild);
 # chromium plays the pages in make test-browser.  A Node.js installed some
-# other way (with its own npm) counts as present.
+# other way (with its own npm) counts as present.  pkgconf (pkg-config) for
+# tests/test_install.sh.
 packages=(build-essential libyaml-dev libsuitesparse-dev liblapack-dev libblas-dev
-          libcmocka-dev libsundials-dev libarpack2-dev gnuplot-nox clang nodejs npm chromium)
+          libcmocka-dev libsundials-dev libarpack2-dev gnuplot-nox clang nodejs npm chromium pkgconf)
 missing=()
 for p in "${packages[@]}"; do
   present "$p" || missing+=("$p")

@@ -13,6 +13,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "paths.h"
 #include "diag.h"
 #include "emit_ldl.h"
 #include "emit_force.h"
@@ -836,19 +837,10 @@ static void settings_block(FILE *f, const ir_sim *s) {
           : s->stabilization == STAB_BAUMGARTE ? "MB_STAB_BAUMGARTE" : "MB_STAB_NONE");
 }
 
-static const char *root_dir(void) {
-  const char *r = getenv("MBCC_ROOT");
-#ifdef MBCC_ROOT
-  return r && *r ? r : MBCC_ROOT;
-#else
-  return r && *r ? r : ".";
-#endif
-}
-
 /* Fill templates/<name> (@MODEL@, @SETTINGS@, @SOLVER@) into out; 0 or 2 */
 int emit_template(const lmodel *L, const char *name, const char *out) {
   char path[4200];
-  snprintf(path, sizeof path, "%s/templates/%s", root_dir(), name);
+  snprintf(path, sizeof path, "%s/%s", mbcc_templates_dir(), name);
   FILE *in = fopen(path, "r");
   if (!in) {
     diag_error(NULL, (ir_loc){0, 0}, "cannot read the template '%s' (set MBCC_ROOT?)", path);
