@@ -11,7 +11,8 @@
 #     against an emitted pendulum, simulates it with the installed runtime:
 #     the bob stays on its unit circle (1e-9) and the energy is conserved
 #     (1e-7 J), which the program checks from q and v itself.
-# Environment: MBCC (unused: this test installs its own), B (build dir).
+# Environment: B (the build directory to install from), CFLAGS (those it was
+# built with); MBCC is unused: this test installs its own.
 set -u
 cd "$(dirname "$0")/.."
 # shellcheck source=tests/shell_setup.sh
@@ -87,8 +88,9 @@ int main(void) {
 EOS
 flags=$(PKG_CONFIG_PATH="$P/lib/pkgconfig" pkg-config --cflags --libs mbcc) || err "pkg-config --cflags --libs mbcc failed"
 case $flags in *"-I$P/include/mbcc"*"-lmbrt"*) ;; *) err "pkg-config gives: $flags" ;; esac
+# the C flags the runtime was built with (make sanitize: the sanitizers)
 # shellcheck disable=SC2086  # flags are words
-if cc -std=c99 -O2 -Ielsewhere/gen -o user user.c elsewhere/gen/pendulum.c $flags > cc.log 2>&1; then
+if cc -std=c99 ${CFLAGS:--O2} -Ielsewhere/gen -o user user.c elsewhere/gen/pendulum.c $flags > cc.log 2>&1; then
   ./user > user.out 2>&1 || err "the user's program failed its own checks: $(cat user.out)"
   echo "user program: $(cat user.out)"
 else
