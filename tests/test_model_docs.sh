@@ -2,8 +2,8 @@
 # test_model_docs.sh: docs/model-format.md documents the whole model format
 # (exit 0 = pass).
 #   - every key and every choice the reader knows (the string lists named
-#     *keys[] and *_names[] in compiler/front/reader.c) appears in the page
-#     in backquotes;
+#     *keys[] and *_names[] in compiler/front/*.c and the force elements'
+#     compiler/elements/*.c) appears in the page in backquotes;
 #   - every complete model in the page (a ```yaml block that starts with
 #     `name:`) passes `mbcc check`;
 #   - the beam-and-field example runs, and its physics holds: the tip of the
@@ -18,9 +18,10 @@ cd "$(dirname "$0")/.."
 doc="$root/docs/model-format.md"
 
 # 1. keys and choices: the reader's string lists, one literal a line
-words=$(awk '/(keys|_names)\[\] *= *\{/ { on = 1 } on { print } on && /\}/ { on = 0 }' "$root/compiler/front/reader.c" |
+words=$(awk '/(keys|_names)\[\] *= *\{/ { on = 1 } on { print } on && /\}/ { on = 0 }' \
+    "$root"/compiler/front/*.c "$root"/compiler/elements/*.c |
   grep -o '"[^"]*"' | tr -d '"' | sort -u)
-[ -n "$words" ] || err "found no key lists in compiler/front/reader.c"
+[ -n "$words" ] || err "found no key lists in compiler/front/ and compiler/elements/"
 for w in $words; do
   grep -qF "\`$w\`" "$doc" || grep -qF "\`$w:" "$doc" || grep -qF "{$w:" "$doc" ||
     err "docs/model-format.md does not document '$w'"
