@@ -114,7 +114,7 @@ install: all
 	if [ -f $(WEB)/player.js ]; then install -m 644 $(WEB)/player.js $(DESTDIR)$(PREFIX)/share/mbcc/; fi
 	install -m 644 docs/mbcc.1 $(DESTDIR)$(PREFIX)/share/man/man1/
 	install -m 644 README.md docs/*.md $(DESTDIR)$(PREFIX)/share/doc/mbcc/
-	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' -e 's|@LIBS@|$(filter-out -lyaml,$(LIBS))|' mbcc.pc.in \
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' -e 's|@LIBS@|$(filter-out -lyaml -lcholmod -larpack,$(LIBS))|' mbcc.pc.in \
 	  > $(DESTDIR)$(PREFIX)/lib/pkgconfig/mbcc.pc
 
 include tests/tests.mk
