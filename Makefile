@@ -18,11 +18,11 @@ RT_SRC  := runtime/core/model_generic.c runtime/core/mb_step.c \
 # back (ordering, LDL^T plan, C emission), tools (trade)
 CC_DIRS := compiler/front compiler/elements compiler/flex compiler/lower compiler/back compiler/tools
 CC_INC  := -Icompiler $(addprefix -I,$(CC_DIRS)) $(RT_INC)
-CC_SRC  := compiler/main.c $(foreach d,$(CC_DIRS),$(wildcard $(d)/*.c))
+CC_SRC  := compiler/main.c compiler/help.c compiler/paths.c $(foreach d,$(CC_DIRS),$(wildcard $(d)/*.c))
 B       ?= build
 DEPFLAGS = -MMD -MP
 
-.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser embedded
+.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser embedded man release-check install
 all: $(B)/mbcc $(B)/libmbrt.a $(B)/libmbrt_float.a
 
 # objects keep the source's folders: $(B)/rt/core/x.o, $(B)/cc/front/x.o
@@ -90,6 +90,36 @@ $(WEB)/player.js: web/player.js $(WEB)/node_modules/.installed
 # the embedded target on qemu's Cortex-M4F (scripts/embedded.sh): writes docs/embedded.md
 embedded: all
 	MBCC=$(B)/mbcc bash scripts/embedded.sh
+
+# before a release: the measured documents are current (scripts/docs-fresh.sh)
+release-check:
+	bash scripts/docs-fresh.sh
+
+# the man page, from the same text as mbcc help (compiler/help.c)
+man: $(B)/mbcc
+	$(B)/mbcc help --man > docs/mbcc.1
+
+# make install PREFIX=DIR [DESTDIR=STAGE]: the command, the runtime library
+# (double and float) and its headers, the templates, pkg-config's mbcc.pc, the
+# man page and the docs.  The installed mbcc finds the rest relative to
+# itself (compiler/paths.c), so the tree can be moved as a whole.
+PREFIX  ?= /usr/local
+VERSION := $(shell sed -n 's/^\#define MBCC_VERSION "\(.*\)"/\1/p' compiler/version.h)
+RT_HDR  := $(wildcard runtime/core/*.h runtime/hosted/*.h)
+install: all
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/pkgconfig $(DESTDIR)$(PREFIX)/include/mbcc \
+	  $(DESTDIR)$(PREFIX)/share/mbcc/templates $(DESTDIR)$(PREFIX)/share/man/man1 $(DESTDIR)$(PREFIX)/share/doc/mbcc
+	install -m 755 $(B)/mbcc $(DESTDIR)$(PREFIX)/bin/mbcc
+	install -m 644 $(B)/libmbrt.a $(B)/libmbrt_float.a $(DESTDIR)$(PREFIX)/lib/
+	install -m 644 $(RT_HDR) $(DESTDIR)$(PREFIX)/include/mbcc/
+	install -d $(DESTDIR)$(PREFIX)/include/mbcc/elements
+	install -m 644 $(wildcard runtime/core/elements/*.h) $(DESTDIR)$(PREFIX)/include/mbcc/elements/
+	install -m 644 templates/*.in $(DESTDIR)$(PREFIX)/share/mbcc/templates/
+	if [ -f $(WEB)/player.js ]; then install -m 644 $(WEB)/player.js $(DESTDIR)$(PREFIX)/share/mbcc/; fi
+	install -m 644 docs/mbcc.1 $(DESTDIR)$(PREFIX)/share/man/man1/
+	install -m 644 README.md docs/*.md $(DESTDIR)$(PREFIX)/share/doc/mbcc/
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' -e 's|@LIBS@|$(filter-out -lyaml -lcholmod -larpack,$(LIBS))|' mbcc.pc.in \
+	  > $(DESTDIR)$(PREFIX)/lib/pkgconfig/mbcc.pc
 
 include tests/tests.mk
 include docs/results.mk

@@ -14,52 +14,24 @@
 #include "diag.h"
 #include "fe.h"
 #include "flex.h"
+#include "help.h"
 #include "lower.h"
 #include "mb_driver.h"
 #include "order.h"
+#include "paths.h"
+#include "plot.h"
 #include "trade.h"
+#include "version.h"
 
-#ifndef MBCC_ROOT
-#define MBCC_ROOT "."
-#endif
-#ifndef MBCC_RTLIB
-#define MBCC_RTLIB MBCC_ROOT "/build/libmbrt.a"
-#endif
 #ifndef MBCC_GEN_CFLAGS
 #define MBCC_GEN_CFLAGS "-O2"
 #endif
 
-static const char *root_dir(void) {
-  const char *r = getenv("MBCC_ROOT");
-  return r && *r ? r : MBCC_ROOT;
-}
-
-static void usage(void) {
-  fprintf(stderr,
-          "usage: mbcc check M.yaml [--scene S]\n"
-          "       mbcc compile M.yaml [--scene S] [-o DIR] [--real float|double]\n"
-          "                [--target embedded [--integrator rk4|genalpha] [--step H]]\n"
-          "       mbcc run M.yaml [--scene S] [--path generated|generic] [--solver ldl|klu|dense]\n"
-          "                [--real float|double]\n"
-          "                [--integrator rk4|dopri5|genalpha|auto] [-o results.csv] [--plot out.png|none]\n"
-          "                [--end T] [--output-step H] [--step H] [--max-step H] [--rtol R] [--atol A]\n"
-          "                [--stabilization projection|baumgarte|none] [--rho-inf R] [--max-steps N] [--quiet]\n"
-          "                [--animate]\n"
-          "       mbcc bench M.yaml [--scene S] [--csv FILE] [--reps N] [--paths a,b,...]\n"
-          "                [--integrator rk4|dopri5] [--end T] [--rtol R] [--atol A] [--ida-rtol R] [--quiet]\n"
-          "       mbcc modes M.yaml --body NAME [--scene S] [--shapes shapes.csv]\n"
-          "                [--write-modal body.modal.yaml]\n"
-          "       mbcc plot results.csv [-o out.png] [--columns a,b,...]\n"
-          "       mbcc animate results.csv [-m M.yaml] [--scene S] [-o out.html] [--scale S] [--quiet]\n"
-          "       mbcc trade M.yaml [--scene S] [--outputs a,b,...] [--max-error E] [--csv FILE]\n"
-          "                [--plot FILE.png|none] [--reps N] [--end T] [--output-step H]\n"
-          "                [--integrators rk4@H,dopri5@R,...]\n"
-          "                [--modes all,N,FHz,...] [--couplings ...] [--joints ...] [--solvers ...]\n"
-          "                [--reals double,float] [--ref-rtol R] [--workdir DIR] [--quiet]\n");
-}
+static void usage(void) { help_usage(stderr); }
 
 typedef struct {
   const char *model, *scene, *outdir, *csv, *plot, *path, *body, *shapes, *modal_out;
+  const char *results_dir; /* --results DIR: where run's CSV, units and plot go */
   int real_float;   /* --real float: single-precision generated code and runtime */
   int embedded;     /* --target embedded: a package for a microcontroller (emit_embedded.c) */
   const char *sim_args[32];
@@ -88,6 +60,7 @@ static int parse_options(int argc, char **argv, options *o) {
     else if (!strcmp(a, "--write-modal")) o->modal_out = v;
     else if (!strcmp(a, "-o")) { o->outdir = v; o->csv = v; }
     else if (!strcmp(a, "--plot")) o->plot = v;
+    else if (!strcmp(a, "--results")) o->results_dir = v;
     else if (!strcmp(a, "--path")) o->path = v;
     else if (!strcmp(a, "--target")) {
       if (!strcmp(v, "embedded")) o->embedded = 1;
@@ -103,7 +76,7 @@ static int parse_options(int argc, char **argv, options *o) {
              !strcmp(a, "--output-step") || !strcmp(a, "--step") || !strcmp(a, "--max-step") || !strcmp(a, "--rtol") ||
              !strcmp(a, "--atol") || !strcmp(a, "--stabilization") || !strcmp(a, "--columns") ||
              !strcmp(a, "--csv") || !strcmp(a, "--reps") || !strcmp(a, "--paths") || !strcmp(a, "--rho-inf") ||
-             !strcmp(a, "--max-steps") || !strcmp(a, "--ida-rtol")) {
+             !strcmp(a, "--max-steps") || !strcmp(a, "--ida-rtol") || !strcmp(a, "--precision")) {
       if (o->nsim + 2 > 30) { fprintf(stderr, "mbcc: error: too many options\n"); return 2; }
       o->sim_args[o->nsim++] = a;
       o->sim_args[o->nsim++] = v;
@@ -118,6 +91,12 @@ static int parse_options(int argc, char **argv, options *o) {
     fprintf(stderr, "mbcc: error: unknown path '%s' (expected generated or generic)\n", o->path);
     return 2;
   }
+  for (int i = 0; i + 1 < o->nsim; i++)
+    if (!strcmp(o->path, "generic") && !strcmp(o->sim_args[i], "--solver") && !strcmp(o->sim_args[i + 1], "ldl")) {
+      fprintf(stderr, "mbcc: error: '--solver ldl' is the LDL^T emitted with the generated code; "
+              "the generic path has klu or dense\n");
+      return 2;
+    }
   return 0;
 }
 
@@ -341,49 +320,6 @@ int run_command(char *const argv[]) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
 }
 
-static int plot_csv(const char *csv, const char *png, const char *columns) {
-  /* a gnuplot script: one panel per column (at most 8), against time */
-  FILE *in = fopen(csv, "r");
-  if (!in) { fprintf(stderr, "mbcc: error: cannot read '%s'\n", csv); return 2; }
-  char header[8192];
-  if (!fgets(header, sizeof header, in)) { fclose(in); fprintf(stderr, "%s:1:1: error: empty CSV file\n", csv); return 2; }
-  fclose(in);
-  header[strcspn(header, "\r\n")] = 0;
-  char *names[64];
-  int nn = 0;
-  for (char *tok = strtok(header, ","); tok && nn < 64; tok = strtok(NULL, ",")) names[nn++] = tok;
-  int pick[8], np = 0;
-  for (int c = 1; c < nn && np < 8; c++) {
-    if (columns) {
-      char list[1024];
-      snprintf(list, sizeof list, ",%s,", columns);
-      char key[300];
-      snprintf(key, sizeof key, ",%s,", names[c]);
-      if (!strstr(list, key)) continue;
-    } else if (!strncmp(names[c], "body.", 5)) {
-      continue; /* the pose columns of run --animate are for the animation */
-    }
-    pick[np++] = c;
-  }
-  if (np == 0) { fprintf(stderr, "mbcc: error: no columns to plot in '%s'\n", csv); return 2; }
-  char script[4096];
-  snprintf(script, sizeof script, "%s.gp", png);
-  FILE *g = fopen(script, "w");
-  if (!g) { fprintf(stderr, "mbcc: error: cannot write '%s'\n", script); return 2; }
-  int rows = (np + 1) / 2, cols = np > 1 ? 2 : 1;
-  fprintf(g, "set terminal pngcairo size %d,%d noenhanced font ',9'\nset output '%s'\n", 520 * cols, 300 * rows, png);
-  fprintf(g, "set datafile separator ','\nset key off\nset grid\nset multiplot layout %d,%d\n", rows, cols);
-  for (int k = 0; k < np; k++)
-    fprintf(g, "set title '%s'\nset xlabel 't [s]'\nplot '%s' every ::1 using 1:%d with lines lw 1.5\n", names[pick[k]], csv, pick[k] + 1);
-  fprintf(g, "unset multiplot\n");
-  fclose(g);
-  char *argv[] = {"gnuplot", script, NULL};
-  int st = run_command(argv);
-  remove(script);
-  if (st) { fprintf(stderr, "mbcc: error: gnuplot failed (status %d)\n", st); return 2; }
-  return 0;
-}
-
 /* the runtime settings of the model's simulation block */
 static void settings_from_ir(const ir_sim *s, mb_settings *set) {
   mb_settings_default(set);
@@ -401,10 +337,9 @@ int compile_generated(const char *dir, const char *name, const char *main_src, c
                       char *const extra[], int quiet, int real_float) {
   char src_c[8400], inc[8400], inc_hosted[8400], lib[8400];
   snprintf(src_c, sizeof src_c, "%s/%s.c", dir, name);
-  snprintf(inc, sizeof inc, "-I%s/runtime/core", root_dir());
-  snprintf(inc_hosted, sizeof inc_hosted, "-I%s/runtime/hosted", root_dir());
-  const char *rtlib = getenv("MBCC_RTLIB");
-  snprintf(lib, sizeof lib, "%s", rtlib && *rtlib ? rtlib : MBCC_RTLIB);
+  snprintf(inc, sizeof inc, "-I%s", mbcc_include_dir(0));
+  snprintf(inc_hosted, sizeof inc_hosted, "-I%s", mbcc_include_dir(1)[0] ? mbcc_include_dir(1) : mbcc_include_dir(0));
+  snprintf(lib, sizeof lib, "%s", mbcc_runtime_lib());
   if (real_float) {
     /* the single-precision runtime sits beside the double one: libmbrt_float.a */
     char *dot = strstr(lib, ".a");
@@ -435,6 +370,14 @@ int compile_generated(const char *dir, const char *name, const char *main_src, c
   return 0;
 }
 
+/* run's CSV without -o: NAME.csv in --results DIR, else in results/ (made
+   here: only the last directory) */
+static void default_csv(const options *o, const char *name, char *csv, size_t n) {
+  const char *dir = o->results_dir ? o->results_dir : "results";
+  mkdir(dir, 0777);
+  snprintf(csv, n, "%s/%s.csv", dir, name);
+}
+
 static int cmd_run(const options *o) {
   char dir[4096];
   lmodel *L = NULL;
@@ -450,10 +393,7 @@ static int cmd_run(const options *o) {
     o2.outdir = NULL;
     lmodel *Lg = build(&o2, &ir, 0);
     if (!Lg) return 2;
-    if (!o->csv) {
-      mkdir("results", 0777);
-      snprintf(csv, sizeof csv, "results/%s.csv", Lg->m.name);
-    }
+    if (!o->csv) default_csv(o, Lg->m.name, csv, sizeof csv);
     const ir_sim *s = &ir->sim;
     mb_settings set;
     settings_from_ir(s, &set);
@@ -466,6 +406,8 @@ static int cmd_run(const options *o) {
       if (strcmp(o->sim_args[i], "--columns")) args[na++] = (char *)o->sim_args[i];
       else i++;
     args[na] = NULL;
+    /* the generic path has no emitted LDL^T: a model that asks for ldl (the
+       default) runs there with KLU */
     rc = mb_main(na, args, &Lg->m, &set, s->solver == SOLVER_DENSE ? "dense" : "klu");
     lower_free(Lg);
   } else {
@@ -473,10 +415,7 @@ static int cmd_run(const options *o) {
     o2.outdir = NULL;
     rc = cmd_compile(&o2, dir, sizeof dir, &L, &ir);
     if (rc) return rc;
-    if (!o->csv) {
-      mkdir("results", 0777);
-      snprintf(csv, sizeof csv, "results/%s.csv", L->m.name);
-    }
+    if (!o->csv) default_csv(o, L->m.name, csv, sizeof csv);
     /* compile the generated code against the runtime library */
     char exe[8400], src_main[8400];
     snprintf(exe, sizeof exe, "%s/%s_sim", dir, L->m.name);
@@ -512,8 +451,8 @@ static int cmd_run(const options *o) {
     const char *columns = NULL;
     for (int i = 0; i + 1 < o->nsim; i++)
       if (!strcmp(o->sim_args[i], "--columns")) columns = o->sim_args[i + 1];
-    if (plot_csv(csv, png, columns)) return 2;
-    if (!o->quiet) printf("wrote %s\n", png);
+    const char *files[] = {csv};
+    if (plot_files(1, files, png, columns, o->quiet)) return 2;
   }
   if (o->animate) { /* the page beside the CSV: results/<model>.html */
     char html[4096];
@@ -554,32 +493,68 @@ static int cmd_bench(const options *o) {
   return run_command(args);
 }
 
+/* mbcc plot A.csv [B.csv ...] [-o OUT.png] [--columns a,b+c] [--gnuplot FILE] [--quiet] */
+static int cmd_plot(int argc, char **argv) {
+  const char *files[64], *png_opt = NULL, *columns = NULL;
+  int nfiles = 0, quiet = 0;
+  for (int i = 2; i < argc; i++) {
+    const char *a = argv[i];
+    if (!strcmp(a, "--quiet")) { quiet = 1; continue; }
+    if (a[0] != '-') {
+      if (nfiles == 64) { fprintf(stderr, "mbcc: error: more than 64 CSV files\n"); return 2; }
+      files[nfiles++] = a;
+      continue;
+    }
+    if (i + 1 >= argc) { fprintf(stderr, "mbcc: error: option '%s' needs a value\n", a); return 2; }
+    if (!strcmp(a, "-o")) png_opt = argv[++i];
+    else if (!strcmp(a, "--columns")) columns = argv[++i];
+    else if (!strcmp(a, "--gnuplot")) plot_keep_script = argv[++i];
+    else {
+      fprintf(stderr, "mbcc: error: unknown option '%s' (mbcc plot --help)\n", a);
+      return 2;
+    }
+  }
+  if (!nfiles) { usage(); return 2; }
+  char png[4096];
+  if (png_opt) snprintf(png, sizeof png, "%s", png_opt);
+  else {
+    snprintf(png, sizeof png, "%s", files[0]);
+    char *dot = strrchr(png, '.');
+    if (dot && !strchr(dot, '/')) strcpy(dot, ".png");
+    else strncat(png, ".png", sizeof png - strlen(png) - 1);
+  }
+  return plot_files(nfiles, files, png, columns, quiet);
+}
+
 int main(int argc, char **argv) {
-  if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
+  if (argc < 2) {
     usage();
-    return argc < 2 ? 2 : 0;
+    return 2;
+  }
+  if (!strcmp(argv[1], "--version")) {
+    printf("mbcc %s\n", MBCC_VERSION);
+    return 0;
+  }
+  if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
+    if (argc > 2 && !strcmp(argv[2], "--man")) { help_man(stdout); return 0; }
+    if (argc > 2 && (!strcmp(argv[2], "--help") || !strcmp(argv[2], "-h"))) return help_print(stdout, "help");
+    if (argc > 2 && help_print(stdout, argv[2])) {
+      fprintf(stderr, "mbcc: error: no command '%s' (mbcc help lists them)\n", argv[2]);
+      return 2;
+    }
+    return argc > 2 ? 0 : help_print(stdout, NULL);
   }
   const char *cmd = argv[1];
+  /* mbcc CMD --help: that command's help, whatever else is on the line */
+  for (int i = 2; i < argc; i++)
+    if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+      if (help_print(stdout, cmd)) break; /* an unknown command: reported below */
+      return 0;
+    }
   options o;
   if (!strcmp(cmd, "trade")) return cmd_trade(argc, argv);
   if (!strcmp(cmd, "animate")) return cmd_animate(argc, argv);
-  if (!strcmp(cmd, "plot")) {
-    if (parse_options(argc, argv, &o)) return 2;
-    char png[4096];
-    if (o.outdir) snprintf(png, sizeof png, "%s", o.outdir);
-    else {
-      snprintf(png, sizeof png, "%s", o.model);
-      char *dot = strrchr(png, '.');
-      if (dot) strcpy(dot, ".png");
-      else strncat(png, ".png", sizeof png - strlen(png) - 1);
-    }
-    const char *columns = NULL;
-    for (int i = 0; i + 1 < o.nsim; i++)
-      if (!strcmp(o.sim_args[i], "--columns")) columns = o.sim_args[i + 1];
-    int st = plot_csv(o.model, png, columns);
-    if (!st) printf("wrote %s\n", png);
-    return st;
-  }
+  if (!strcmp(cmd, "plot")) return cmd_plot(argc, argv);
   if (strcmp(cmd, "check") && strcmp(cmd, "compile") && strcmp(cmd, "run") && strcmp(cmd, "modes") &&
       strcmp(cmd, "bench")) {
     fprintf(stderr, "mbcc: error: unknown command '%s'\n", cmd);

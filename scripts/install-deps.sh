@@ -44,6 +44,7 @@ present() {
     gcc-arm-none-eabi)  command -v arm-none-eabi-gcc ;;
     libnewlib-arm-none-eabi) [ -e /usr/lib/arm-none-eabi/newlib/thumb/v7e-m+fp/hard/libm.a ] ;;
     qemu-system-arm)    command -v qemu-system-arm ;;
+    pkgconf)            command -v pkg-config ;;
     *)                  false ;;
   esac >/dev/null 2>&1
 }
@@ -53,10 +54,11 @@ present() {
 # chromium plays the pages in make test-browser.  A Node.js installed some
 # other way (with its own npm) counts as present.  The embedded target's cross
 # compiler, newlib (libm) and qemu (tests/test_embedded.sh): 97 MB to download,
-# 924 MB installed, about 2 minutes of apt (measured)
+# 924 MB installed, about 2 minutes of apt (measured).  pkgconf (pkg-config)
+# for tests/test_install.sh.
 packages=(build-essential libyaml-dev libsuitesparse-dev liblapack-dev libblas-dev
           libcmocka-dev libsundials-dev libarpack2-dev gnuplot-nox clang nodejs npm chromium
-          gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm)
+          gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm pkgconf)
 missing=()
 for p in "${packages[@]}"; do
   present "$p" || missing+=("$p")

@@ -160,7 +160,7 @@ never on the front; the study goes on.
 `--reps` runs (default 3): the whole simulation (set-up, integration, writing the CSV;
 process start is about a millisecond), not the code generation or the C compiler.
 
-**Error.** For the chosen outputs (`--outputs a,b`; default every output column) at the
+**Error.** For the chosen outputs (`--outputs a,b`; default every output column that varies) at the
 reference's output times: for column c and output time k,
 e_ck = |y_ck − ref_ck| / s_c, where s_c is the range (max − min) of column c over the
 reference run; the columns of one vector output (`p.x`, `p.y`, `p.z`) share the
@@ -168,8 +168,11 @@ largest range among them, so that a component that stays at round-off (a planar
 mechanism's z) is measured against the vector's scale; a column (or vector) that does
 not move is measured against its largest |value|, or in absolute terms if that is 0.
 `max_err` = max over c and k of e_ck; `rms_err` = sqrt(mean over all k and all c of
-e_ck²). A conserved output (the pendulum's total energy) has no range to speak of:
-leave it out with `--outputs`.
+e_ck²). Without `--outputs`, a column that does not vary is left out and listed with
+the reason: constant; a range below 1e-12 of the largest |value| of its vector
+(round-off); or a range within 10 times the reference's own error against the
+stricter run (a conserved output: the pendulum's total energy, whose range is only
+integration error). `--outputs` compares exactly what it names.
 
 **Pareto front.** Among the runs that did not fail, those that no other run matches or
 beats in both CPU time and `max_err` while beating it in one (marked `*`, `pareto` = 1).

@@ -6,7 +6,9 @@
 #   - when a step ends exactly on the dead point, DOPRI5 stops there with
 #     exit 1, no CSV, and a note that the constraint Jacobian is singular;
 #   - the parallelogram four-bar passes its change point (t = 0.25 s) as a
-#     parallelogram and warns that K's condition estimate collapsed there.
+#     parallelogram with KLU and warns that K's condition estimate collapsed
+#     there; with the default emitted LDL^T (static pivots) it passes too or
+#     stops at 0.25 s with the singular-configuration note.
 # Environment: MBCC (set by tests/run_tests.sh; default build/mbcc).
 set -u
 cd "$(dirname "$0")/.."
@@ -29,9 +31,24 @@ grep -q "note: at t = 0.01258650.* the constraint Jacobian is nearly singular" "
   err "no singular-configuration note: $(cat "$tmp/b.log")"
 grep "_sim: \(error\|note\)" "$tmp/b.log" | sed 's/^[^ ]*_sim: /  /'
 
-"$MBCC" run "$X/four_bar_change.yaml" -o "$tmp/c.csv" --plot none > "$tmp/c.log" 2>&1 || err "change point run: $(cat "$tmp/c.log")"
+# KLU's run-time pivoting carries the parallelogram through the change point
+"$MBCC" run "$X/four_bar_change.yaml" --solver klu -o "$tmp/c.csv" --plot none > "$tmp/c.log" 2>&1 || err "change point run: $(cat "$tmp/c.log")"
 e=$(awk -F, 'NR > 1 { d = $3 - $2; if (d < 0) d = -d; if (d > m) m = d } END { printf "%.2e", m }' "$tmp/c.csv")
 echo "  parallelogram four-bar through its change point: |rocker - crank| $e rad"
 awk -v e="$e" 'BEGIN { exit !(e <= 1e-8) }' || err "parallelogram error $e"
 grep -q "warning: near t = 0.25 the condition estimate of K fell" "$tmp/c.log" || err "no near-singular warning: $(cat "$tmp/c.log")"
+# the emitted LDL^T (the default) has its pivots fixed at compile time: it
+# passes as well, or stops at 0.25 s with the singular-configuration note
+"$MBCC" run "$X/four_bar_change.yaml" -o "$tmp/d.csv" --plot none > "$tmp/d.log" 2>&1
+rc=$?
+if [ $rc = 0 ]; then
+  e=$(awk -F, 'NR > 1 { d = $3 - $2; if (d < 0) d = -d; if (d > m) m = d } END { printf "%.2e", m }' "$tmp/d.csv")
+  awk -v e="$e" 'BEGIN { exit !(e <= 1e-8) }' || err "ldl through the change point: parallelogram error $e"
+else
+  [ $rc = 1 ] || err "ldl at the change point: exit $rc, expected 0 or 1"
+  [ -e "$tmp/d.csv" ] && err "ldl stopped at the change point but wrote a CSV"
+  grep -q "error: at t = 0.2499" "$tmp/d.log" && grep -q "note: at t = 0.2499.* nearly singular" "$tmp/d.log" ||
+    err "ldl at the change point: no stop at 0.25 s with the note: $(cat "$tmp/d.log")"
+  echo "  the default (emitted ldl) stops at the change point with the note"
+fi
 exit $fail

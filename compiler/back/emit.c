@@ -13,6 +13,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "paths.h"
 #include "diag.h"
 #include "emit_float.h"
 #include "emit_ldl.h"
@@ -849,7 +850,7 @@ const char *emit_root_dir(void) {
 /* Fill templates/<name> (@MODEL@, @SETTINGS@, @SOLVER@) into out; 0 or 2 */
 int emit_template(const lmodel *L, const char *name, const char *out) {
   char path[4200];
-  snprintf(path, sizeof path, "%s/templates/%s", emit_root_dir(), name);
+  snprintf(path, sizeof path, "%s/%s", mbcc_templates_dir(), name);
   FILE *in = fopen(path, "r");
   if (!in) {
     diag_error(NULL, (ir_loc){0, 0}, "cannot read the template '%s' (set MBCC_ROOT?)", path);
@@ -872,7 +873,7 @@ int emit_template(const lmodel *L, const char *name, const char *out) {
       if (!strncmp(p, "@MODEL@", 7)) { fputs(L->m.name, f); p += 7; }
       else if (!strncmp(p, "@SOLVER@", 8)) {
         /* single precision has only the emitted LDL^T (KLU, LAPACK are double) */
-        fputs(L->real_float ? "ldl" : L->ir->sim.solver == SOLVER_DENSE ? "dense" : "klu", f);
+        fputs(L->real_float || L->ir->sim.solver == SOLVER_LDL ? "ldl" : L->ir->sim.solver == SOLVER_DENSE ? "dense" : "klu", f);
         p += 8;
       } else fputc(*p++, f);
     }

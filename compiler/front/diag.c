@@ -9,16 +9,36 @@ static int warning_count;
 /* Notes follow the fate of the error or warning they explain. */
 static bool last_message_hidden;
 
+/* Warnings and notes already shown (hashes of the whole line): a model
+ * assembled twice in one command, or several rows removed for one reason,
+ * say each thing once. */
+enum { SEEN_MAX = 512 };
+static unsigned long long seen[SEEN_MAX];
+static int nseen;
+
+static unsigned long long line_hash(const char *s) {
+  unsigned long long h = 1469598103934665603ull; /* FNV-1a */
+  for (; *s; s++) h = (h ^ (unsigned char)*s) * 1099511628211ull;
+  return h;
+}
+
 static void print(const char *file, ir_loc loc, const char *severity,
                   const char *fmt, va_list ap) {
-  if (file == NULL)
-    fputs("mbcc", stderr);
-  else
-    fputs(file, stderr);
-  if (loc.line > 0)
-    fprintf(stderr, ":%d:%d", loc.line, loc.col > 0 ? loc.col : 1);
-  fprintf(stderr, ": %s: ", severity);
-  vfprintf(stderr, fmt, ap);
+  char line[2048];
+  int n = snprintf(line, sizeof line, "%s", file == NULL ? "mbcc" : file);
+  if (loc.line > 0 && n >= 0 && (size_t)n < sizeof line)
+    n += snprintf(line + n, sizeof line - (size_t)n, ":%d:%d", loc.line, loc.col > 0 ? loc.col : 1);
+  if (n >= 0 && (size_t)n < sizeof line)
+    n += snprintf(line + n, sizeof line - (size_t)n, ": %s: ", severity);
+  if (n >= 0 && (size_t)n < sizeof line)
+    vsnprintf(line + n, sizeof line - (size_t)n, fmt, ap);
+  if (severity[0] != 'e') {
+    unsigned long long h = line_hash(line);
+    for (int i = 0; i < nseen; i++)
+      if (seen[i] == h) return;
+    if (nseen < SEEN_MAX) seen[nseen++] = h;
+  }
+  fputs(line, stderr);
   fputc('\n', stderr);
 }
 
@@ -73,4 +93,5 @@ void diag_reset(void) {
   error_count = 0;
   warning_count = 0;
   last_message_hidden = false;
+  nseen = 0;
 }

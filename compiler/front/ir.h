@@ -293,7 +293,9 @@ typedef struct {
 /* --- simulation settings --------------------------------------------------------------- */
 /* the same numbers as the runtime's MB_RK4, MB_DOPRI5, MB_GENALPHA, MB_AUTO */
 typedef enum { INTEGRATOR_RK4, INTEGRATOR_DOPRI5, INTEGRATOR_GENALPHA, INTEGRATOR_AUTO } ir_integrator;
-typedef enum { SOLVER_KLU, SOLVER_DENSE } ir_solver;
+/* the order of the reader's names; ldl (the emitted LDL^T) last so that the
+ * numbers of the older two stay */
+typedef enum { SOLVER_KLU, SOLVER_DENSE, SOLVER_LDL } ir_solver;
 typedef enum { STAB_PROJECTION, STAB_BAUMGARTE, STAB_NONE } ir_stab;
 typedef enum { JOF_DIRECT, JOF_VIRTUAL, JOF_LIST } ir_jof;
 
@@ -304,7 +306,7 @@ typedef struct {
   double rtol, atol;    /* DOPRI5; defaults 1e-6, 1e-8 */
   double min_step, max_step; /* DOPRI5; defaults 1e-12, output_step */
   ir_integrator integrator;  /* default dopri5 */
-  ir_solver solver;          /* default klu */
+  ir_solver solver;          /* default ldl: the emitted LDL^T (the generic path: klu) */
   ir_stab stabilization;     /* default projection */
   double baumgarte_alpha, baumgarte_beta; /* defaults 10, 10 */
   double rho_inf;            /* generalized-alpha; default 0.8 */

@@ -17,7 +17,7 @@ static const char *const sim_keys[SIM_FIELDS] = {
     "solver",   "stabilization", "joints_on_flexible"};
 
 static const char *const integrator_names[] = {"rk4", "dopri5", "genalpha", "auto", NULL};
-static const char *const solver_names[] = {"klu", "dense", NULL};
+static const char *const solver_names[] = {"klu", "dense", "ldl", NULL};
 static const char *const stabilization_names[] = {"projection", "baumgarte", "none", NULL};
 static const char *const jof_names[] = {"direct", "virtual", NULL};
 
@@ -31,7 +31,7 @@ void sim_defaults(sim_settings *s) {
   s->value[SIM_BETA] = 10;
   s->value[SIM_RHO_INF] = 0.8;
   s->value[SIM_INTEGRATOR] = INTEGRATOR_DOPRI5;
-  s->value[SIM_SOLVER] = SOLVER_KLU;
+  s->value[SIM_SOLVER] = SOLVER_LDL;
   s->value[SIM_STABILIZATION] = STAB_PROJECTION;
   s->value[SIM_JOINTS_ON_FLEXIBLE] = JOF_DIRECT;
 }

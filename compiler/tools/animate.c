@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "paths.h"
 #include "animate.h"
 #include "diag.h"
 #include "flex.h"
@@ -29,15 +30,13 @@
 #define MBCC_PLAYER_JS MBCC_ROOT "/build/web/player.js"
 #endif
 
-static const char *template_root(void) {
-  const char *r = getenv("MBCC_ROOT");
-  return r && *r ? r : MBCC_ROOT;
-}
-
-/* the bundled player: $MBCC_PLAYER_JS, or the one `make web` built */
+/* the bundled player: $MBCC_PLAYER_JS, an installed one (PREFIX/share/mbcc,
+   compiler/paths.c), or the one `make web` built */
 static const char *player_path(void) {
   const char *p = getenv("MBCC_PLAYER_JS");
-  return p && *p ? p : MBCC_PLAYER_JS;
+  if (p && *p) return p;
+  p = mbcc_installed_file("player.js");
+  return p ? p : MBCC_PLAYER_JS;
 }
 
 static char *read_all(const char *path, size_t *len) {
@@ -340,7 +339,7 @@ static void body_from_model(sbuf *b, const lmodel *L, int ib, const csv_table *t
 
 static int write_page(const char *html, const char *title, const sbuf *data, int quiet) {
   char tpl_path[4200];
-  snprintf(tpl_path, sizeof tpl_path, "%s/templates/animate.html.in", template_root());
+  snprintf(tpl_path, sizeof tpl_path, "%s/animate.html.in", mbcc_templates_dir());
   char *tpl = read_all(tpl_path, NULL);
   if (!tpl) {
     fprintf(stderr, "mbcc: error: cannot read the template '%s' (set MBCC_ROOT?)\n", tpl_path);

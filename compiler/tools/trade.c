@@ -147,6 +147,75 @@ static double *pick_columns(const table *tb, const int *sel, int nsel, int nrows
   return y;
 }
 
+/* --- which outputs to compare ---------------------------------------------------- */
+
+/* Without --outputs, compare only the outputs that vary: an output that is
+ * constant, whose variation is round-off (below 1e-12 of the largest of its
+ * output's columns), or that varies no more than the reference's own error
+ * (a conserved quantity: total energy, momentum of a free system) measures
+ * nothing but noise, and an error relative to its range is meaningless.
+ * Says which it left out and why; -1 (after a message) when none is left. */
+static int drop_flat_outputs(const table *ref, const table *strict, int *sel, char (*selnames)[128], int *nsel) {
+  int kept = 0, nrows = ref->nrows < strict->nrows ? ref->nrows : strict->nrows;
+  const char *cn[MAXCOL];
+  int group[MAXCOL];
+  double range[MAXCOL], big[MAXCOL], noise[MAXCOL];
+  for (int c = 0; c < *nsel; c++) {
+    cn[c] = selnames[c];
+    double lo = INFINITY, hi = -INFINITY, mx = 0, dmax = 0;
+    for (int k = 0; k < ref->nrows; k++) {
+      double y = ref->y[(size_t)k * (size_t)ref->ncols + (size_t)sel[c]];
+      if (y < lo) lo = y;
+      if (y > hi) hi = y;
+      if (fabs(y) > mx) mx = fabs(y);
+    }
+    for (int k = 0; k < nrows; k++) {
+      double d = fabs(ref->y[(size_t)k * (size_t)ref->ncols + (size_t)sel[c]] -
+                      strict->y[(size_t)k * (size_t)strict->ncols + (size_t)sel[c]]);
+      if (d > dmax) dmax = d;
+    }
+    range[c] = ref->nrows ? hi - lo : 0;
+    big[c] = mx;
+    noise[c] = dmax;
+  }
+  trade_column_groups(cn, *nsel, group);
+  static char left[MAXCOL][320];
+  int nleft = 0;
+  for (int c = 0; c < *nsel; c++) {
+    double kin = big[c];
+    for (int d = 0; d < *nsel; d++)
+      if (group[d] == group[c] && big[d] > kin) kin = big[d];
+    const char *why = NULL;
+    char buf[160];
+    if (range[c] == 0) why = "constant";
+    else if (range[c] <= 1e-12 * kin) {
+      snprintf(buf, sizeof buf, "varies %.2g, round-off of its scale %.2g", range[c], kin);
+      why = buf;
+    } else if (range[c] <= 10 * noise[c]) {
+      snprintf(buf, sizeof buf, "conserved: varies %.2g, within 10x the reference's own error %.2g", range[c], noise[c]);
+      why = buf;
+    }
+    if (why) {
+      if (nleft < MAXCOL) snprintf(left[nleft++], sizeof left[0], "%.127s (%.180s)", selnames[c], why);
+      continue;
+    }
+    sel[kept] = sel[c];
+    if (kept != c) memcpy(selnames[kept], selnames[c], sizeof selnames[0]);
+    kept++;
+  }
+  if (nleft) {
+    printf("left out %d output%s that do%s not vary (name them with --outputs to compare them):\n", nleft,
+           nleft > 1 ? "s" : "", nleft > 1 ? "" : "es");
+    for (int i = 0; i < nleft; i++) printf("  %s\n", left[i]);
+  }
+  if (!kept) {
+    fprintf(stderr, "mbcc: error: no output varies; name the outputs to compare with --outputs\n");
+    return -1;
+  }
+  *nsel = kept;
+  return 0;
+}
+
 /* --- options ------------------------------------------------------------------ */
 
 static void trade_usage(void) {
@@ -823,6 +892,7 @@ int cmd_trade(int argc, char **argv) {
       if (!strcmp(reft.names[d], selnames[c])) sel[c] = d;
     if (sel[c] < 0) { fprintf(stderr, "mbcc: error: the reference has no output '%s'\n", selnames[c]); return 1; }
   }
+  if (!o.outputs && drop_flat_outputs(&reft, &strictt, sel, selnames, &nsel)) return 1;
   double *refy = pick_columns(&reft, sel, nsel, reft.nrows);
   double scale[MAXCOL];
   int group[MAXCOL];

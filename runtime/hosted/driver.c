@@ -17,6 +17,7 @@ typedef struct {
   double end_time, last_report, wall0;
   int progress;
   int nonfinite;   /* 1 + the output column that was not finite, or 0 */
+  int digits;      /* significant digits of the values (--precision) */
 } writer;
 
 static double wall(void) {
@@ -32,8 +33,8 @@ static int write_row(void *user, double t, const mb_real *q, const mb_real *v, c
   mb_model_outputs(m, t, q, v, vd, lambda, w->have_prev ? w->prev : NULL, w->out, w->work);
   for (int j = 0; j < m->ncols; j++)
     if (!isfinite(w->out[j])) { w->nonfinite = j + 1; return 1; } /* never print NaN as data */
-  fprintf(w->csv, "%.10g", t);
-  for (int j = 0; j < m->ncols; j++) fprintf(w->csv, ",%.12g", w->out[j]);
+  fprintf(w->csv, "%.*g", w->digits > 10 ? w->digits : 10, t);
+  for (int j = 0; j < m->ncols; j++) fprintf(w->csv, ",%.*g", w->digits, (double)w->out[j]);
   fputc('\n', w->csv);
   memcpy(w->prev, w->out, sizeof(mb_real) * (size_t)m->ncols);
   w->have_prev = 1;
@@ -83,6 +84,46 @@ static void diagnose_configuration(mb_sim *sim, const char *prog) {
 }
 #endif
 
+/* the SI unit of output column k of o (o->col <= k < o->col + o->ncols) */
+static const char *base_unit(const mb_outputdef *o, int k) {
+  int first3 = k - o->col < 3; /* reaction, momentum: force/linear first, then moment */
+  switch (o->kind) {
+  case MB_OUT_POSITION: case MB_OUT_DEFLECTION: return "m";
+  case MB_OUT_ORIENTATION: return "1";
+  case MB_OUT_ANGLE: return "rad";
+  case MB_OUT_VELOCITY: return "m/s";
+  case MB_OUT_ANGULAR_VELOCITY: return "rad/s";
+  case MB_OUT_ACCELERATION: return "m/s^2";
+  case MB_OUT_ANGULAR_ACCELERATION: return "rad/s^2";
+  case MB_OUT_REACTION: return first3 ? "N" : "N m";
+  case MB_OUT_EFFORT: return o->driver_rotation ? "N m" : "N";
+  case MB_OUT_KINETIC_ENERGY: case MB_OUT_POTENTIAL_ENERGY: case MB_OUT_TOTAL_ENERGY: return "J";
+  case MB_OUT_MODAL: return "kg^(1/2) m"; /* mass-normalized modal coordinate */
+  case MB_OUT_MOMENTUM: return first3 ? "kg m/s" : "kg m^2/s";
+  default: return "";
+  }
+}
+
+/* CSV.units beside the results: "column,unit" and a row per CSV column; an
+   output with a scale s is in units of 1/s of its SI unit ("0.001 m") */
+static int write_units(const mb_model *m, const char *csv_path) {
+  char path[4200], tmp[4300];
+  snprintf(path, sizeof path, "%s.units", csv_path);
+  snprintf(tmp, sizeof tmp, "%s.part", path);
+  FILE *f = fopen(tmp, "w");
+  if (!f) return -1;
+  fprintf(f, "column,unit\nt,s\n");
+  for (int i = 0; i < m->noutput; i++) {
+    const mb_outputdef *o = &m->output[i];
+    for (int k = o->col; k < o->col + o->ncols; k++) {
+      if (o->scale == 1) fprintf(f, "%s,%s\n", m->col_name[k], base_unit(o, k));
+      else fprintf(f, "%s,%.6g %s\n", m->col_name[k], 1 / (double)o->scale, base_unit(o, k));
+    }
+  }
+  if (fclose(f) || rename(tmp, path)) { remove(tmp); return -1; }
+  return 0;
+}
+
 int mb_settings_option(mb_settings *set, const char *opt, const char *val, const char *prog) {
   if (!strcmp(opt, "--integrator")) {
     if (!strcmp(val, "rk4")) set->integrator = MB_RK4;
@@ -125,7 +166,7 @@ static void usage(const char *prog) {
           "usage: %s [-o results.csv] [--solver ldl|klu|dense] [--integrator rk4|dopri5|genalpha|auto]\n"
           "          [--end T] [--output-step H] [--step H] [--max-step H] [--rtol R] [--atol A]\n"
           "          [--rho-inf R] [--max-steps N]\n"
-          "          [--stabilization projection|baumgarte|none] [--quiet]\n",
+          "          [--stabilization projection|baumgarte|none] [--precision N] [--quiet]\n",
           prog);
 }
 
@@ -134,7 +175,7 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
   mb_settings set = *defaults;
   const char *csv_path = "results.csv";
   int output_given = 0, max_given = 0;
-  int quiet = 0;
+  int quiet = 0, digits = 12;
   for (int i = 1; i < argc; i++) {
     const char *a = argv[i], *val = (i + 1 < argc) ? argv[i + 1] : NULL;
     int takes = 1;
@@ -142,6 +183,15 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
     else if (!val) { usage(argv[0]); return 2; }
     else if (!strcmp(a, "-o")) csv_path = val;
     else if (!strcmp(a, "--solver")) solver = val;
+    else if (!strcmp(a, "--precision")) {
+      char *end;
+      long d = strtol(val, &end, 10);
+      if (*end || d < 1 || d > 17) {
+        fprintf(stderr, "%s: error: '--precision' needs a number of digits from 1 to 17, got '%s'\n", argv[0], val);
+        return 2;
+      }
+      digits = (int)d;
+    }
     else {
       int k = mb_settings_option(&set, a, val, argv[0]);
       if (k < 0) return 2;
@@ -181,7 +231,14 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
   if (set.max_step > set.output_step) set.max_step = set.output_step;
 
   mb_solver *ls = mb_solver_new(solver, m);
-  if (!ls) { fprintf(stderr, "%s: error: unknown solver '%s' (expected ldl, klu or dense)\n", argv[0], solver); return 2; }
+  if (!ls) {
+    if (!strcmp(solver, "ldl"))
+      fprintf(stderr, "%s: error: solver 'ldl' is the LDL^T emitted with generated code, which this "
+              "model has not (expected %s)\n", argv[0], mb_solver_choices(m));
+    else
+      fprintf(stderr, "%s: error: unknown solver '%s' (expected %s)\n", argv[0], solver, mb_solver_choices(m));
+    return 2;
+  }
   /* write to a temporary file, renamed on success: nothing half-written */
   char tmp[4096];
   snprintf(tmp, sizeof tmp, "%s.part", csv_path);
@@ -195,6 +252,7 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
   w.end_time = set.end_time;
   w.wall0 = wall();
   w.progress = !quiet;
+  w.digits = digits;
   fprintf(w.csv, "t");
   for (int j = 0; j < m->ncols; j++) fprintf(w.csv, ",%s", m->col_name[j]);
   fputc('\n', w.csv);
@@ -226,6 +284,9 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
     rc = 1;
   } else if (rename(tmp, csv_path)) {
     fprintf(stderr, "%s: error: cannot write '%s'\n", argv[0], csv_path);
+    rc = 2;
+  } else if (write_units(m, csv_path)) {
+    fprintf(stderr, "%s: error: cannot write '%s.units'\n", argv[0], csv_path);
     rc = 2;
   }
   if (!rc && !quiet) {

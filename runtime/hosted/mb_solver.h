@@ -62,5 +62,7 @@ mb_solver *mb_solver_ldl(const mb_model *m);
 #define MB_LDL_PASS_TOL 1e-13
 /* by name: "klu" or "dense"; NULL if unknown or out of memory */
 mb_solver *mb_solver_new(const char *name, const mb_model *m);
+/* the names mb_solver_new accepts for m, as a phrase for messages */
+const char *mb_solver_choices(const mb_model *m);
 
 #endif

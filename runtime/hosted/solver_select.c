@@ -14,3 +14,14 @@ mb_solver *mb_solver_new(const char *name, const mb_model *m) {
 #endif
   return NULL;
 }
+
+/* the names mb_solver_new accepts for model m, for messages: the emitted
+   LDL^T only with generated code, KLU and LAPACK only in double */
+const char *mb_solver_choices(const mb_model *m) {
+#ifdef MB_REAL_FLOAT
+  (void)m;
+  return "ldl";
+#else
+  return m->ldl_factor ? "ldl, klu or dense" : "klu or dense";
+#endif
+}
