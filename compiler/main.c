@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -17,6 +18,7 @@
 #include "lower.h"
 #include "mb_driver.h"
 #include "order.h"
+#include "proc.h"
 #include "trade.h"
 
 #ifndef MBCC_ROOT
@@ -114,8 +116,16 @@ static int parse_options(int argc, char **argv, options *o) {
   return 0;
 }
 
+/* an output that would replace the model file: refused (exit 2) */
+static int refuse_input_as_output(const options *o, const char *out, const char *what) {
+  if (!out || !proc_same_file(o->model, out)) return 0;
+  fprintf(stderr, "mbcc: error: %s '%s' is the model file itself; choose another name\n", what, out);
+  return 2;
+}
+
 /* read, lower and assemble; NULL after reporting */
 static lmodel *build(const options *o, ir_model **irp, int verbose) {
+  mb_lapack_context = o->model; /* a LAPACK argument error names the model */
   ir_model *ir = ir_read(o->model, o->scene);
   if (!ir) return NULL;
   if (o->animate && animate_add_pose_outputs(ir)) {
@@ -280,19 +290,16 @@ static int cmd_compile(const options *o, char *dir_out, size_t n, lmodel **Lp, i
   return st;
 }
 
-int run_command(char *const argv[]) {
-  fflush(stdout);
-  fflush(stderr);
-  pid_t pid = fork();
-  if (pid < 0) return -1;
-  if (pid == 0) {
-    execvp(argv[0], argv);
-    fprintf(stderr, "mbcc: error: cannot run '%s': %s\n", argv[0], strerror(errno));
-    _exit(127);
+int run_command(char *const argv[]) { return proc_run(argv); }
+
+/* 'text' inside a gnuplot single-quoted string ('' stands for a quote) */
+static void gp_quoted(FILE *g, const char *text) {
+  fputc('\'', g);
+  for (const char *p = text; *p; p++) {
+    if (*p == '\'') fputc('\'', g);
+    fputc(*p == '\n' || *p == '\r' ? ' ' : *p, g);
   }
-  int status = 0;
-  if (waitpid(pid, &status, 0) < 0) return -1;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+  fputc('\'', g);
 }
 
 static int plot_csv(const char *csv, const char *png, const char *columns) {
@@ -320,21 +327,73 @@ static int plot_csv(const char *csv, const char *png, const char *columns) {
     pick[np++] = c;
   }
   if (np == 0) { fprintf(stderr, "mbcc: error: no columns to plot in '%s'\n", csv); return 2; }
-  char script[4096];
-  snprintf(script, sizeof script, "%s.gp", png);
-  FILE *g = fopen(script, "w");
-  if (!g) { fprintf(stderr, "mbcc: error: cannot write '%s'\n", script); return 2; }
+  /* the script and the picture under names of this process's own; the
+     picture renamed into place only when gnuplot finished it */
+  char script[4200], part[4200];
+  snprintf(script, sizeof script, "%s.gp.XXXXXX", png);
+  snprintf(part, sizeof part, "%s.XXXXXX", png);
+  int sfd = mkstemp(script);
+  if (sfd < 0) { fprintf(stderr, "mbcc: error: cannot write '%s': %s\n", png, strerror(errno)); return 2; }
+  int pfd = mkstemp(part);
+  if (pfd < 0) {
+    fprintf(stderr, "mbcc: error: cannot write '%s': %s\n", png, strerror(errno));
+    close(sfd); unlink(script);
+    return 2;
+  }
+  close(pfd);
+  proc_cleanup_add(script);
+  proc_cleanup_add(part);
+  FILE *g = fdopen(sfd, "w");
   int rows = (np + 1) / 2, cols = np > 1 ? 2 : 1;
-  fprintf(g, "set terminal pngcairo size %d,%d noenhanced font ',9'\nset output '%s'\n", 520 * cols, 300 * rows, png);
-  fprintf(g, "set datafile separator ','\nset key off\nset grid\nset multiplot layout %d,%d\n", rows, cols);
-  for (int k = 0; k < np; k++)
-    fprintf(g, "set title '%s'\nset xlabel 't [s]'\nplot '%s' every ::1 using 1:%d with lines lw 1.5\n", names[pick[k]], csv, pick[k] + 1);
-  fprintf(g, "unset multiplot\n");
-  fclose(g);
+  fprintf(g, "set terminal pngcairo size %d,%d noenhanced font ',9'\nset output ", 520 * cols, 300 * rows);
+  gp_quoted(g, part);
+  fprintf(g, "\nset datafile separator ','\nset key off\nset grid\nset multiplot layout %d,%d\n", rows, cols);
+  for (int k = 0; k < np; k++) {
+    /* a constant column gets a range of its own (gnuplot would warn) */
+    fprintf(g, "stats ");
+    gp_quoted(g, csv);
+    fprintf(g, " every ::1 using %d nooutput\n"
+            "if (STATS_max == STATS_min) { set yrange [STATS_min-1:STATS_max+1] } else { set autoscale y }\n",
+            pick[k] + 1);
+    fprintf(g, "set title ");
+    gp_quoted(g, names[pick[k]]);
+    fprintf(g, "\nset xlabel 't [s]'\nplot ");
+    gp_quoted(g, csv);
+    fprintf(g, " every ::1 using 1:%d with lines lw 1.5\n", pick[k] + 1);
+  }
+  fprintf(g, "unset multiplot\nunset output\n");
+  int bad = ferror(g);
+  if (fclose(g) || bad) {
+    fprintf(stderr, "mbcc: error: cannot write '%s'\n", script);
+    unlink(script); unlink(part);
+    proc_cleanup_remove(script); proc_cleanup_remove(part);
+    return 2;
+  }
   char *argv[] = {"gnuplot", script, NULL};
   int st = run_command(argv);
-  remove(script);
-  if (st) { fprintf(stderr, "mbcc: error: gnuplot failed (status %d)\n", st); return 2; }
+  unlink(script);
+  proc_cleanup_remove(script);
+  if (!st) {
+    /* gnuplot may say nothing of a failed write (a full disk): the picture
+       must end with PNG's closing IEND chunk, and reach the disk, before it
+       replaces the old one */
+    static const unsigned char iend[8] = {'I', 'E', 'N', 'D', 0xae, 0x42, 0x60, 0x82};
+    unsigned char tail[8];
+    int fd = open(part, O_RDONLY);
+    struct stat ps;
+    if (fd < 0 || fstat(fd, &ps) || ps.st_size < 8 || pread(fd, tail, 8, ps.st_size - 8) != 8 ||
+        memcmp(tail, iend, 8))
+      st = -2;
+    else if (fsync(fd))
+      st = -3;
+    if (fd >= 0) close(fd);
+  }
+  if (!st && rename(part, png)) st = -3;
+  if (st) unlink(part);
+  proc_cleanup_remove(part);
+  if (st == -3) { fprintf(stderr, "mbcc: error: cannot write '%s': %s\n", png, strerror(errno)); return 2; }
+  if (st == -2) { fprintf(stderr, "mbcc: error: gnuplot wrote no complete picture (a full disk?); '%s' left as it was\n", png); return 2; }
+  if (st) { fprintf(stderr, "mbcc: error: gnuplot failed (status %d); '%s' left as it was\n", st, png); return 2; }
   return 0;
 }
 
@@ -420,7 +479,8 @@ static int cmd_run(const options *o) {
       if (strcmp(o->sim_args[i], "--columns")) args[na++] = (char *)o->sim_args[i];
       else i++;
     args[na] = NULL;
-    rc = mb_main(na, args, &Lg->m, &set, s->solver == SOLVER_DENSE ? "dense" : "klu");
+    rc = refuse_input_as_output(o, csv, "the results file");
+    if (!rc) rc = mb_main(na, args, &Lg->m, &set, s->solver == SOLVER_DENSE ? "dense" : "klu");
     lower_free(Lg);
   } else {
     options o2 = *o;
@@ -432,10 +492,24 @@ static int cmd_run(const options *o) {
       snprintf(csv, sizeof csv, "results/%s.csv", L->m.name);
     }
     /* compile the generated code against the runtime library */
-    char exe[8400], src_main[8400];
-    snprintf(exe, sizeof exe, "%s/%s_sim", dir, L->m.name);
+    /* the simulator under a name of this process's own (two runs of one
+       model at once must not build over each other), then put in place */
+    char exe[8420], exe_final[8400], src_main[8400];
+    snprintf(exe_final, sizeof exe_final, "%s/%s_sim", dir, L->m.name);
+    snprintf(exe, sizeof exe, "%s.XXXXXX", exe_final);
     snprintf(src_main, sizeof src_main, "%s/main.c", dir);
+    int efd = mkstemp(exe);
+    if (efd < 0) {
+      fprintf(stderr, "mbcc: error: cannot write '%s': %s\n", exe_final, strerror(errno));
+      lower_free(L);
+      ir_free(ir);
+      return 2;
+    }
+    close(efd);
+    proc_cleanup_add(exe);
     if (compile_generated(dir, L->m.name, src_main, exe, NULL, o->quiet, o->real_float)) {
+      unlink(exe);
+      proc_cleanup_remove(exe);
       lower_free(L);
       ir_free(ir);
       return 2;
@@ -449,7 +523,10 @@ static int cmd_run(const options *o) {
       if (strcmp(o->sim_args[i], "--columns")) args[na++] = (char *)o->sim_args[i];
       else i++;
     args[na] = NULL;
-    rc = run_command(args);
+    if (refuse_input_as_output(o, csv, "the results file")) rc = 2;
+    else rc = run_command(args);
+    if (rename(exe, exe_final)) unlink(exe);
+    proc_cleanup_remove(exe);
     lower_free(L);
   }
   ir_free(ir);
@@ -466,6 +543,7 @@ static int cmd_run(const options *o) {
     const char *columns = NULL;
     for (int i = 0; i + 1 < o->nsim; i++)
       if (!strcmp(o->sim_args[i], "--columns")) columns = o->sim_args[i + 1];
+    if (refuse_input_as_output(o, png, "the plot")) return 2;
     if (plot_csv(csv, png, columns)) return 2;
     if (!o->quiet) printf("wrote %s\n", png);
   }
@@ -530,6 +608,10 @@ int main(int argc, char **argv) {
     const char *columns = NULL;
     for (int i = 0; i + 1 < o.nsim; i++)
       if (!strcmp(o.sim_args[i], "--columns")) columns = o.sim_args[i + 1];
+    if (proc_same_file(o.model, png)) {
+      fprintf(stderr, "mbcc: error: the plot '%s' is the CSV file itself; choose another name\n", png);
+      return 2;
+    }
     int st = plot_csv(o.model, png, columns);
     if (!st) printf("wrote %s\n", png);
     return st;
@@ -541,6 +623,10 @@ int main(int argc, char **argv) {
     return 2;
   }
   if (parse_options(argc, argv, &o)) return 2;
+  if (refuse_input_as_output(&o, o.plot, "the plot") || refuse_input_as_output(&o, o.shapes, "the shapes file") ||
+      refuse_input_as_output(&o, o.modal_out, "the modal file") ||
+      (strcmp(cmd, "compile") && refuse_input_as_output(&o, o.csv, "the output")))
+    return 2;
   if (!strcmp(cmd, "check")) return cmd_check(&o);
   if (!strcmp(cmd, "modes")) return cmd_modes(&o);
   if (!strcmp(cmd, "compile")) return cmd_compile(&o, NULL, 0, NULL, NULL);
