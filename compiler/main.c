@@ -516,16 +516,20 @@ static int cmd_run(const options *o) {
     }
     char *args[40];
     int na = 0;
-    args[na++] = exe;
+    args[na++] = exe_final;
     args[na++] = "-o";
     args[na++] = csv;
     for (int i = 0; i < o->nsim; i++)
       if (strcmp(o->sim_args[i], "--columns")) args[na++] = (char *)o->sim_args[i];
       else i++;
     args[na] = NULL;
-    if (refuse_input_as_output(o, csv, "the results file")) rc = 2;
+    /* in place, whole (a rename), before it runs under its own name */
+    if (rename(exe, exe_final)) {
+      fprintf(stderr, "mbcc: error: cannot write '%s': %s\n", exe_final, strerror(errno));
+      unlink(exe);
+      rc = 2;
+    } else if (refuse_input_as_output(o, csv, "the results file")) rc = 2;
     else rc = run_command(args);
-    if (rename(exe, exe_final)) unlink(exe);
     proc_cleanup_remove(exe);
     lower_free(L);
   }

@@ -94,24 +94,23 @@ fi
 old png" ] || err "full disk: the old CSV or PNG changed"
 [ "$(grep -v '^fill$' ls.txt | tr '\n' ' ')" = "old.csv old.png " ] || err "full disk left: $(cat ls.txt)"
 grep -q 'cannot write\|no complete picture' sim.log plot.log || err "full disk: no error message"
-cd "$tmp" || exit 1
 
-# 4. a read-only output directory
-mkdir r && cd r && mkdir ro || exit 1
+# 4. a read-only output directory (the simulator built above)
+mkdir r || exit 1
 ro_run() { cat > ro.sh <<EOS
 cd "\$1"
-"$MBCC" run "$wheel" -o ro/w.csv --plot none --quiet > ro.log 2>&1; echo \$? > rc
+gen/wheel_sim -o r/w.csv --quiet > ro.log 2>&1; echo \$? > ro.rc
 EOS
 "$@" bash ro.sh "$PWD"; }
 if [ "$(id -u)" != 0 ]; then
-  chmod a-w ro && ro_run env
+  chmod a-w r && ro_run env
 elif unshare -m true 2> /dev/null; then
-  ro_run unshare -m bash -c 'mount -t tmpfs -o ro tmpfs "$1/ro" && exec "${@:2}"' mount "$PWD"
+  ro_run unshare -m bash -c 'mount -t tmpfs -o ro tmpfs "$1/r" && exec "${@:2}"' mount "$PWD"
 fi
-if [ -e rc ]; then
-  [ "$(cat rc)" = 2 ] || err "read-only directory: exit $(cat rc), expected 2: $(cat ro.log)"
-  grep -q "cannot write 'ro/w.csv'" ro.log || err "read-only directory: message: $(cat ro.log)"
-  [ -z "$(ls ro)" ] || err "read-only directory: written: $(ls ro)"
+if [ -e ro.rc ]; then
+  [ "$(cat ro.rc)" = 2 ] || err "read-only directory: exit $(cat ro.rc), expected 2: $(cat ro.log)"
+  grep -q "cannot write 'r/w.csv'" ro.log || err "read-only directory: message: $(cat ro.log)"
+  [ -z "$(ls r)" ] || err "read-only directory: written: $(ls r)"
 else
   echo "note: read-only directory not tested (root without mount namespaces)"
 fi

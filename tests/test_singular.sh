@@ -3,8 +3,12 @@
 # (the quick cases of tests/extremes/run.sh):
 #   - the slider-crank with rod = crank passes its dead point (theta = pi/2)
 #     on the branch x = 2 r cos(theta), to 1e-8 of the stroke;
-#   - when a step ends exactly on the dead point, DOPRI5 stops there with
-#     exit 1, no CSV, and a note that the constraint Jacobian is singular;
+#   - an output time on the dead point no longer makes a step end there
+#     (dense output): the run passes it, exit 0, with a warning that K's
+#     condition estimate collapsed near it;
+#   - when a step ends exactly on the dead point (the run ends there), DOPRI5
+#     stops with exit 1, no CSV, and a note that the constraint Jacobian is
+#     singular;
 #   - the parallelogram four-bar passes its change point (t = 0.25 s) as a
 #     parallelogram and warns that K's condition estimate collapsed there.
 # Environment: MBCC (set by tests/run_tests.sh; default build/mbcc).
@@ -20,7 +24,12 @@ echo "  slider-crank r = L through the dead point: x vs 2 r cos(theta) $e of the
 awk -v e="$e" 'BEGIN { exit !(e <= 1e-8) }' || err "branch error $e"
 
 h=$(awk 'BEGIN { printf "%.17g", atan2(1, 0) / 124.8 / 100 }')
-"$MBCC" run "$X/slider_crank_equal.yaml" --output-step "$h" -o "$tmp/b.csv" --plot none > "$tmp/b.log" 2>&1
+"$MBCC" run "$X/slider_crank_equal.yaml" --output-step "$h" -o "$tmp/g.csv" --plot none > "$tmp/g.log" 2>&1 ||
+  err "output grid on the dead point: exit $?: $(cat "$tmp/g.log")"
+grep -q "warning: near t = 0.01258650.* the condition estimate of K fell" "$tmp/g.log" ||
+  err "output grid on the dead point: no near-singular warning: $(cat "$tmp/g.log")"
+end=$(awk 'BEGIN { printf "%.17g", atan2(1, 0) / 124.8 }')
+"$MBCC" run "$X/slider_crank_equal.yaml" --end "$end" --output-step "$h" -o "$tmp/b.csv" --plot none > "$tmp/b.log" 2>&1
 rc=$?
 [ $rc = 1 ] || err "step on the dead point: exit $rc, expected 1"
 [ -e "$tmp/b.csv" ] && err "step on the dead point: a CSV was written"
