@@ -14,3 +14,25 @@ SAN_FLAGS := -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sa
 sanitize:
 	$(MAKE) B=build-san CFLAGS="$(SAN_FLAGS)" all build-san/web/player.js
 	ASAN_OPTIONS=detect_leaks=0 B=build-san CFLAGS="$(SAN_FLAGS)" bash tests/run_tests.sh
+
+# `make fuzz FUZZ_SECONDS=N`: the libFuzzer harness of the front end
+# (tests/fuzz/fuzz_front.c: YAML -> IR -> checks -> lowering and pattern ->
+# assembly analysis) built with clang's AddressSanitizer, UBSan with
+# float-cast-overflow, and LeakSanitizer; seeded with models/, tests/models/
+# and tests/bad_models/, with tests/fuzz/yaml.dict.  tests/fuzz/run.sh prints
+# the executions and findings; a finding is copied to tests/fuzz_regressions/
+# (replayed by tests/test_fuzz_regressions.sh).
+.PHONY: fuzz
+FUZZ_B       ?= build-fuzz
+FUZZ_SECONDS ?= 60
+FUZZ_CC      ?= clang
+FUZZ_FLAGS   := -O1 -g -fno-omit-frame-pointer \
+                -fsanitize=fuzzer,address,undefined,float-cast-overflow \
+                -fno-sanitize-recover=undefined,float-cast-overflow
+FUZZ_SRC     := tests/fuzz/fuzz_front.c runtime/core/model_generic.c \
+                $(filter-out compiler/main.c compiler/tools/%,$(CC_SRC))
+$(FUZZ_B)/fuzz_front: $(FUZZ_SRC) $(wildcard compiler/*/*.h runtime/*/*.h)
+	@mkdir -p $(@D)
+	$(FUZZ_CC) $(STD) $(FUZZ_FLAGS) $(CC_INC) -DMBCC_ROOT='"$(ROOT)"' $(FUZZ_SRC) $(LIBS) -lcamd -o $@
+fuzz: $(FUZZ_B)/fuzz_front
+	bash tests/fuzz/run.sh $(FUZZ_B) $(FUZZ_SECONDS)

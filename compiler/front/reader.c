@@ -22,7 +22,7 @@
 #include <yaml.h>
 
 #include "diag.h"
-#include "limits.h"
+#include "bounds.h"
 #include "names.h"
 #include "quantities.h"
 #include "reader.h"

@@ -9,7 +9,7 @@
 #include <string.h>
 
 #include "reader.h"
-#include "limits.h"
+#include "bounds.h"
 
 /* ---------------------------------------------------------------------------
  * scenes

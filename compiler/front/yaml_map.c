@@ -4,7 +4,7 @@
  * tables, choices, unit axes).  Used by reader.c, names.c, the element
  * parsers of compiler/elements/ and fe.c. */
 #include "yaml_map.h"
-#include "limits.h"
+#include "bounds.h"
 
 #include <errno.h>
 #include <setjmp.h>

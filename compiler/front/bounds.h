@@ -1,9 +1,9 @@
-/* limits.h: the resource limits of the compiler's front end, each checked
+/* bounds.h: the resource limits of the compiler's front end, each checked
  * before the work it bounds starts (docs/reliability.md lists them).  The
  * ones a large but sensible model may reach can be lifted by an environment
  * variable, named in the error message. */
-#ifndef MBCC_LIMITS_H
-#define MBCC_LIMITS_H
+#ifndef MBCC_BOUNDS_H
+#define MBCC_BOUNDS_H
 
 #include <stdlib.h>
 

@@ -1,5 +1,5 @@
-/* limits.c: the bounds the front end checks before the work they bound. */
-#include "limits.h"
+/* bounds.c: the bounds the front end checks before the work they bound. */
+#include "bounds.h"
 
 #include <string.h>
 #include <strings.h>
