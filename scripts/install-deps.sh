@@ -41,6 +41,7 @@ present() {
     nodejs)             command -v node ;;
     npm)                command -v npm ;;
     chromium)           command -v chromium ;;
+    libclang-rt-14-dev) [ -e "$(clang -print-file-name=libclang_rt.fuzzer-x86_64.a)" ] ;; # make fuzz
     *)                  false ;;
   esac >/dev/null 2>&1
 }
@@ -50,7 +51,7 @@ present() {
 # chromium plays the pages in make test-browser.  A Node.js installed some
 # other way (with its own npm) counts as present.
 packages=(build-essential libyaml-dev libsuitesparse-dev liblapack-dev libblas-dev
-          libcmocka-dev libsundials-dev libarpack2-dev gnuplot-nox clang nodejs npm chromium)
+          libcmocka-dev libsundials-dev libarpack2-dev gnuplot-nox clang nodejs npm chromium libclang-rt-14-dev)
 missing=()
 for p in "${packages[@]}"; do
   present "$p" || missing+=("$p")

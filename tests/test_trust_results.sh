@@ -9,7 +9,13 @@
 #     the times two output grids share, to round-off (the steps alone decide
 #     the error, ~1e-5 here: a grid that changed the steps would show it);
 #   - finite but absurd time spans (--end 1e308, --output-step 1e-300) are
-#     refused with the limit named, exit 2, nothing written.
+#     refused with the limit named, exit 2, nothing written;
+#   - free text reaching the generated C (a scene name with '*/' and a line
+#     break, a file path) stays inside its comment: the code compiles and
+#     holds no injected declaration; a scene that would name the code
+#     'bench_main' is refused;
+#   - a LAPACK argument error (xerbla_) stops the process with exit 1 and a
+#     message, not garbage and exit 0.
 set -u
 cd "$(dirname "$0")/.."
 . tests/shell_setup.sh
@@ -49,4 +55,42 @@ for args in "--end 1e308" "--end 1e300 --output-step 1e-300" "--end 1e12 --outpu
   [ -e span.csv ] && err "'$args': a CSV was written"
   ls span.csv.* > /dev/null 2>&1 && err "'$args': a temporary file was left"
 done
+# 4. free text in the generated code
+evil='x */ int injected_by_scene; /*
+'
+{ cat "$root/tests/trust/wheel.yaml"; printf 'scenes:\n  "x */ int injected_by_scene; /*\\n": {}\n'; } > 'we*ird.yaml'
+if "$MBCC" compile 'we*ird.yaml' --scene "$evil" -o gen > gen.log 2>&1; then
+  c=$(ls gen/wheel_*.c | grep -v main.c)
+  cc -std=c99 -Wall -Werror -c -I"$root/runtime/core" "$c" -o evil.o 2> cc.log || err "the scene's code does not compile: $(head -5 cc.log)"
+  nm evil.o 2> /dev/null | grep -qw injected_by_scene && err "the scene name injected a symbol"
+else
+  err "compile with an odd scene name: $(cat gen.log)"
+fi
+{ sed 's/^name: wheel/name: bench/' "$root/tests/trust/wheel.yaml"; printf 'scenes:\n  main: {}\n'; } > bench.yaml
+"$MBCC" check bench.yaml --scene main > bench.log 2>&1
+[ $? = 2 ] && grep -q "bench.yaml:[0-9]*:[0-9]*: error: scene 'main' would name the code 'bench_main'" bench.log ||
+  err "scene naming the code bench_main: $(cat bench.log)"
+
+# 5. LAPACK's argument errors
+cat > xerbla.c <<'EOS'
+#include <stdio.h>
+void dgesv_(const int *n, const int *nrhs, double *a, const int *lda, int *ipiv, double *b,
+            const int *ldb, int *info);
+int main(void) {
+  int n = -1, one = 1, ipiv[1], info = 0;
+  double a[1] = {1}, b[1] = {1};
+  dgesv_(&n, &one, a, &one, ipiv, b, &one, &info);
+  printf("returned with info %d\n", info);
+  return 0;
+}
+EOS
+if cc -I"$root/runtime/core" -I"$root/runtime/hosted" xerbla.c -Wl,--undefined=xerbla_ "$root/${B:-build}/libmbrt.a" \
+     -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig -llapack -lblas -lm -o xerbla 2> cc.log; then
+  ./xerbla > xerbla.log 2>&1
+  rc=$?
+  [ $rc = 1 ] || err "LAPACK argument error: exit $rc, expected 1: $(cat xerbla.log)"
+  grep -q "error: LAPACK routine DGESV got an illegal value in argument 1" xerbla.log || err "xerbla_ message: $(cat xerbla.log)"
+else
+  err "cannot build the xerbla_ check: $(cat cc.log)"
+fi
 exit $fail

@@ -1,5 +1,6 @@
 # tests.mk: `make test` builds mbcc and runs every test (tests/run_tests.sh);
-# `make sanitize` does the same with AddressSanitizer and UBSan in build-san/;
+# `make sanitize` does the same with AddressSanitizer, LeakSanitizer and UBSan
+# (with float-cast-overflow) in build-san/;
 # `make test-browser` plays animation pages in headless Chromium (tests/browser.sh,
 # about 30 s: not part of make test; .ci/run runs it after make test).
 .PHONY: test sanitize test-browser
@@ -10,10 +11,13 @@ test: all $(WEB)/player.js
 test-browser: all $(WEB)/player.js
 	B=$(B) SHOTS=$(SHOTS) bash tests/browser.sh
 
-SAN_FLAGS := -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
+# float-cast-overflow: a double converted to an int it does not fit (not
+# part of -fsanitize=undefined); leaks are errors too (detect_leaks=1)
+SAN_FLAGS := -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined,float-cast-overflow \
+             -fno-sanitize-recover=undefined,float-cast-overflow
 sanitize:
 	$(MAKE) B=build-san CFLAGS="$(SAN_FLAGS)" all build-san/web/player.js
-	ASAN_OPTIONS=detect_leaks=0 B=build-san CFLAGS="$(SAN_FLAGS)" bash tests/run_tests.sh
+	ASAN_OPTIONS=detect_leaks=1 B=build-san CFLAGS="$(SAN_FLAGS)" bash tests/run_tests.sh
 
 # `make fuzz FUZZ_SECONDS=N`: the libFuzzer harness of the front end
 # (tests/fuzz/fuzz_front.c: YAML -> IR -> checks -> lowering and pattern ->

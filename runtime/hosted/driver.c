@@ -84,8 +84,9 @@ const char *mb_lapack_context;
 void xerbla_(const char *routine, const int *info, size_t routine_len);
 void xerbla_(const char *routine, const int *info, size_t routine_len) {
   int n = routine_len > 0 && routine_len < 32 ? (int)routine_len : 6;
+  while (n > 0 && (routine[n - 1] == ' ' || routine[n - 1] == 0)) n--; /* Fortran pads with blanks */
   fprintf(stderr, "%s: error: LAPACK routine %.*s got an illegal value in argument %d (a value out of "
-          "range reached it); stopped\n", mb_lapack_context ? mb_lapack_context : "mbcc", n, routine,
+          "range reached it); stopped\n", mb_lapack_context ? mb_lapack_context : "runtime", n, routine,
           info ? *info : 0);
   fflush(stderr);
   exit(1);
