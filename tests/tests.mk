@@ -17,7 +17,7 @@ SAN_FLAGS := -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined,float-c
              -fno-sanitize-recover=undefined,float-cast-overflow
 sanitize:
 	$(MAKE) B=build-san CFLAGS="$(SAN_FLAGS)" all build-san/web/player.js
-	ASAN_OPTIONS=detect_leaks=1 B=build-san CFLAGS="$(SAN_FLAGS)" bash tests/run_tests.sh
+	ASAN_OPTIONS=detect_leaks=1 B=build-san CFLAGS="$(SAN_FLAGS)" bash -c 'set -o pipefail; bash tests/run_tests.sh 2>&1 | tee build-san/sanitize.log'
 
 # `make fuzz FUZZ_SECONDS=N`: the libFuzzer harness of the front end
 # (tests/fuzz/fuzz_front.c: YAML -> IR -> checks -> lowering and pattern ->
@@ -40,3 +40,9 @@ $(FUZZ_B)/fuzz_front: $(FUZZ_SRC) $(wildcard compiler/*/*.h runtime/*/*.h)
 	$(FUZZ_CC) $(STD) $(FUZZ_FLAGS) $(CC_INC) -DMBCC_ROOT='"$(ROOT)"' $(FUZZ_SRC) $(LIBS) -lcamd -o $@
 fuzz: $(FUZZ_B)/fuzz_front
 	bash tests/fuzz/run.sh $(FUZZ_B) $(FUZZ_SECONDS)
+
+# `make reliability`: docs/reliability.md (scripts/reliability.sh): fuzzing,
+# limits, the fault suite, the sanitizer runs
+.PHONY: reliability
+reliability: all
+	MBCC=$(B)/mbcc FUZZ_SECONDS=$(FUZZ_SECONDS) bash scripts/reliability.sh
