@@ -46,7 +46,7 @@ fi
 last_san="no log (make sanitize writes build-san/sanitize.log)"
 [ -f build-san/sanitize.log ] && last_san=$(grep -E '^[0-9]+ passed, [0-9]+ failed$' build-san/sanitize.log | tail -1)
 
-limit() { sed -n "s/^#define $1 *//p" compiler/front/bounds.h; }
+limit() { awk "BEGIN { printf \"%.10g\", $(sed -n "s/^#define $1 *//p" compiler/front/bounds.h) }"; }
 {
 cat <<EOF2
 # Reliability
@@ -85,7 +85,7 @@ Each is checked before the work it bounds, with a message naming it.
 
 | what | limit | where checked | lift it with |
 |---|---|---|---|
-| size of a model or modal file | $(limit LIMIT_INPUT_BYTES | tr -d '()') bytes (16 MiB) | before parsing | \`MBCC_MAX_INPUT=BYTES\` |
+| size of a model or modal file | $(limit LIMIT_INPUT_BYTES) bytes (16 MiB) | before parsing | \`MBCC_MAX_INPUT=BYTES\` |
 | nesting of brackets in YAML | $(limit LIMIT_YAML_DEPTH) | before parsing (linear scan) | — |
 | magnitude of any number | $(limit LIMIT_MAGNITUDE) | reader, file:line:col | — |
 | counts and indices (modes, nodes, mode numbers) | $(limit LIMIT_COUNT) | reader, before any conversion to int | — |

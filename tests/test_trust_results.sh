@@ -7,7 +7,7 @@
 #   - Dormand-Prince's dense output: the output grid neither caps nor changes
 #     the steps, so the pendulum at a loose tolerance gives the same values at
 #     the times two output grids share, to round-off (the steps alone decide
-#     the error, ~1e-5 here: a grid that changed the steps would show it);
+#     the error: the grid changing the steps showed as 1.3e-7 here);
 #   - finite but absurd time spans (--end 1e308, --output-step 1e-300) are
 #     refused with the limit named, exit 2, nothing written;
 #   - free text reaching the generated C (a scene name with '*/' and a line
@@ -33,7 +33,7 @@ fi
 
 # 2. two output grids, one solution
 for h in 0.01 0.025; do
-  "$MBCC" run "$root/models/pendulum.yaml" --rtol 1e-5 --atol 1e-7 --end 1 --output-step $h \
+  "$MBCC" run "$root/models/pendulum.yaml" --rtol 1e-3 --atol 1e-6 --end 1 --output-step $h \
     -o "p$h.csv" --plot none --quiet > "p$h.log" 2>&1 || err "pendulum at output step $h failed: $(tail -3 "p$h.log")"
 done
 if [ -s p0.01.csv ] && [ -s p0.025.csv ]; then
