@@ -1222,6 +1222,14 @@ static int modes_from_fe(const ir_flex *fx, fe_modes *out, fe_ctx *c) {
       rc = modes_sparse(fx, out, state, nfree, c);
       goto done;
     }
+    /* the dense path's time grows with the cube: refused before it starts */
+    double max_dofs = limit_value("MBCC_MAX_FE_DOFS", LIMIT_FE_DOFS);
+    if (nfree > max_dofs) {
+      fail_at(c, fx->loc, "%d free FE degrees of freedom, more than the limit %g of the dense modal analysis "
+              "(eigensolver: sparse or auto takes larger bodies without interface nodes; MBCC_MAX_FE_DOFS=N "
+              "lifts the limit)", nfree, max_dofs);
+      goto done;
+    }
   }
   if (fe_assemble_at(fx, &sys, c->err, c->nerr, c->where)) goto done;
   fold_links(fx, sys.K, ndof);

@@ -20,8 +20,9 @@
 /* bodies (with virtual ones), checked before the dense constraint analysis
    whose time grows with the cube (MBCC_MAX_BODIES=N) */
 #define LIMIT_BODIES 400.0
-/* the order of a dense FE eigenproblem (6 per node), whose time grows with
-   the cube and memory with the square (MBCC_MAX_FE_DOFS=N) */
+/* the free DOFs of a dense FE eigenproblem (eigensolver: dense, or
+   Craig-Bampton), whose time grows with the cube and memory with the square
+   (MBCC_MAX_FE_DOFS=N); eigensolver auto goes sparse above 3000 anyway */
 #define LIMIT_FE_DOFS 3000.0
 
 /* a limit: the environment variable's value if it is a positive number */

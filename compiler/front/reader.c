@@ -623,12 +623,6 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
           error_at(r, loc_of(line), "'line' has zero length");
           ok = false;
         }
-        double max_dofs = limit_value("MBCC_MAX_FE_DOFS", LIMIT_FE_DOFS);
-        if (ok && 6 * (ne + 1) > max_dofs) {
-          error_at(r, lm.last_loc, "%g elements make %g FE degrees of freedom, more than the limit %g of the "
-                   "dense modal analysis (MBCC_MAX_FE_DOFS=N lifts it)", ne, 6 * (ne + 1), max_dofs);
-          ok = false;
-        }
         if (ok) {
           int n = (int)ne;
           fx->nnodes = n + 1;
@@ -651,12 +645,8 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
       map_reject(m, "beams", "'beams' does not go with 'line' (the line makes its own elements)");
     } else {
       int n = nodes->type == YAML_SEQUENCE_NODE ? seq_length(nodes) : 0;
-      double max_dofs = limit_value("MBCC_MAX_FE_DOFS", LIMIT_FE_DOFS);
       if (n < 2) {
         error_at(r, loc_of(nodes), "'nodes': expected a list of at least 2 points [x, y, z]");
-      } else if (6.0 * n > max_dofs) {
-        error_at(r, loc_of(nodes), "%d nodes make %d FE degrees of freedom, more than the limit %g of the "
-                 "dense modal analysis (MBCC_MAX_FE_DOFS=N lifts it)", n, 6 * n, max_dofs);
       } else {
         fx->nnodes = n;
         global = xcalloc(3 * (size_t)n, sizeof *global);
