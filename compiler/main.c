@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -20,6 +21,7 @@
 #include "order.h"
 #include "paths.h"
 #include "plot.h"
+#include "proc.h"
 #include "trade.h"
 #include "version.h"
 
@@ -100,8 +102,16 @@ static int parse_options(int argc, char **argv, options *o) {
   return 0;
 }
 
+/* an output that would replace the model file: refused (exit 2) */
+static int refuse_input_as_output(const options *o, const char *out, const char *what) {
+  if (!out || !proc_same_file(o->model, out)) return 0;
+  fprintf(stderr, "mbcc: error: %s '%s' is the model file itself; choose another name\n", what, out);
+  return 2;
+}
+
 /* read, lower and assemble; NULL after reporting */
 static lmodel *build(const options *o, ir_model **irp, int verbose) {
+  mb_lapack_context = o->model; /* a LAPACK argument error names the model */
   ir_model *ir = ir_read(o->model, o->scene);
   if (!ir) return NULL;
   if (o->animate && animate_add_pose_outputs(ir)) {
@@ -305,20 +315,7 @@ static int cmd_compile(const options *o, char *dir_out, size_t n, lmodel **Lp, i
   return st;
 }
 
-int run_command(char *const argv[]) {
-  fflush(stdout);
-  fflush(stderr);
-  pid_t pid = fork();
-  if (pid < 0) return -1;
-  if (pid == 0) {
-    execvp(argv[0], argv);
-    fprintf(stderr, "mbcc: error: cannot run '%s': %s\n", argv[0], strerror(errno));
-    _exit(127);
-  }
-  int status = 0;
-  if (waitpid(pid, &status, 0) < 0) return -1;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
-}
+int run_command(char *const argv[]) { return proc_run(argv); }
 
 /* the runtime settings of the model's simulation block */
 static void settings_from_ir(const ir_sim *s, mb_settings *set) {
@@ -408,7 +405,8 @@ static int cmd_run(const options *o) {
     args[na] = NULL;
     /* the generic path has no emitted LDL^T: a model that asks for ldl (the
        default) runs there with KLU */
-    rc = mb_main(na, args, &Lg->m, &set, s->solver == SOLVER_DENSE ? "dense" : "klu");
+    rc = refuse_input_as_output(o, csv, "the results file");
+    if (!rc) rc = mb_main(na, args, &Lg->m, &set, s->solver == SOLVER_DENSE ? "dense" : "klu");
     lower_free(Lg);
   } else {
     options o2 = *o;
@@ -417,24 +415,45 @@ static int cmd_run(const options *o) {
     if (rc) return rc;
     if (!o->csv) default_csv(o, L->m.name, csv, sizeof csv);
     /* compile the generated code against the runtime library */
-    char exe[8400], src_main[8400];
-    snprintf(exe, sizeof exe, "%s/%s_sim", dir, L->m.name);
+    /* the simulator under a name of this process's own (two runs of one
+       model at once must not build over each other), then put in place */
+    char exe[8420], exe_final[8400], src_main[8400];
+    snprintf(exe_final, sizeof exe_final, "%s/%s_sim", dir, L->m.name);
+    snprintf(exe, sizeof exe, "%s.XXXXXX", exe_final);
     snprintf(src_main, sizeof src_main, "%s/main.c", dir);
+    int efd = mkstemp(exe);
+    if (efd < 0) {
+      fprintf(stderr, "mbcc: error: cannot write '%s': %s\n", exe_final, strerror(errno));
+      lower_free(L);
+      ir_free(ir);
+      return 2;
+    }
+    close(efd);
+    proc_cleanup_add(exe);
     if (compile_generated(dir, L->m.name, src_main, exe, NULL, o->quiet, o->real_float)) {
+      unlink(exe);
+      proc_cleanup_remove(exe);
       lower_free(L);
       ir_free(ir);
       return 2;
     }
     char *args[40];
     int na = 0;
-    args[na++] = exe;
+    args[na++] = exe_final;
     args[na++] = "-o";
     args[na++] = csv;
     for (int i = 0; i < o->nsim; i++)
       if (strcmp(o->sim_args[i], "--columns")) args[na++] = (char *)o->sim_args[i];
       else i++;
     args[na] = NULL;
-    rc = run_command(args);
+    /* in place, whole (a rename), before it runs under its own name */
+    if (rename(exe, exe_final)) {
+      fprintf(stderr, "mbcc: error: cannot write '%s': %s\n", exe_final, strerror(errno));
+      unlink(exe);
+      rc = 2;
+    } else if (refuse_input_as_output(o, csv, "the results file")) rc = 2;
+    else rc = run_command(args);
+    proc_cleanup_remove(exe);
     lower_free(L);
   }
   ir_free(ir);
@@ -451,6 +470,7 @@ static int cmd_run(const options *o) {
     const char *columns = NULL;
     for (int i = 0; i + 1 < o->nsim; i++)
       if (!strcmp(o->sim_args[i], "--columns")) columns = o->sim_args[i + 1];
+    if (refuse_input_as_output(o, png, "the plot")) return 2;
     const char *files[] = {csv};
     if (plot_files(1, files, png, columns, o->quiet)) return 2;
   }
@@ -562,6 +582,10 @@ int main(int argc, char **argv) {
     return 2;
   }
   if (parse_options(argc, argv, &o)) return 2;
+  if (refuse_input_as_output(&o, o.plot, "the plot") || refuse_input_as_output(&o, o.shapes, "the shapes file") ||
+      refuse_input_as_output(&o, o.modal_out, "the modal file") ||
+      (strcmp(cmd, "compile") && refuse_input_as_output(&o, o.csv, "the output")))
+    return 2;
   if (!strcmp(cmd, "check")) return cmd_check(&o);
   if (!strcmp(cmd, "modes")) return cmd_modes(&o);
   if (!strcmp(cmd, "compile")) return cmd_compile(&o, NULL, 0, NULL, NULL);

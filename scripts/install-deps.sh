@@ -45,6 +45,7 @@ present() {
     libnewlib-arm-none-eabi) [ -e /usr/lib/arm-none-eabi/newlib/thumb/v7e-m+fp/hard/libm.a ] ;;
     qemu-system-arm)    command -v qemu-system-arm ;;
     pkgconf)            command -v pkg-config ;;
+    libclang-rt-14-dev) [ -e "$(clang -print-file-name=libclang_rt.fuzzer-x86_64.a)" ] ;; # make fuzz
     *)                  false ;;
   esac >/dev/null 2>&1
 }
@@ -59,6 +60,7 @@ present() {
 packages=(build-essential libyaml-dev libsuitesparse-dev liblapack-dev libblas-dev
           libcmocka-dev libsundials-dev libarpack2-dev gnuplot-nox clang nodejs npm chromium
           gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm pkgconf)
+          libcmocka-dev libsundials-dev libarpack2-dev gnuplot-nox clang nodejs npm chromium libclang-rt-14-dev)
 missing=()
 for p in "${packages[@]}"; do
   present "$p" || missing+=("$p")

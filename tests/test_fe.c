@@ -7,6 +7,7 @@
  * and the errors for bad FE data. */
 #include "../compiler/flex/fe.c"
 #include "../compiler/flex/fe_sparse.c"
+#include "../compiler/front/bounds.c" /* fe.c bounds the modal data file */
 
 #include <stdio.h>
 #include <stdlib.h>

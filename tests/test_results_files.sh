@@ -2,7 +2,8 @@
 # test_results_files.sh: what `mbcc run` writes (exit 0 = pass).
 #   - --precision 17: the pendulum's bob stays on its unit circle,
 #     |x^2 + y^2 - 1| < 1e-13 in the CSV itself (12 digits, the default, only
-#     resolve ~1e-12: the check fails there), on both paths; the default still
+#     resolve ~1e-12: the check fails there), on both paths, with steps small
+#     enough (--max-step) that the projected rows are exact to round-off; the default still
 #     prints at most 12 significant digits; --precision 0 and 18 are errors;
 #   - the units file CSV.units has a row per CSV column, in order, with the
 #     unit of the output's kind (s, rad, m, rad/s, J, N, N m), and a scaled
@@ -18,7 +19,7 @@ cd "$(dirname "$0")/.."
 circle() { awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
   { d = $c["bob_position.x"] ^ 2 + $c["bob_position.y"] ^ 2 - 1; if (d < 0) d = -d; if (d > m) m = d } END { print m + 0 }' "$1"; }
 for p in generated generic; do
-  "$MBCC" run "$root/models/pendulum.yaml" --path $p --end 0.2 --precision 17 -o "p17_$p.csv" --plot none --quiet > "$p.log" 2>&1 \
+  "$MBCC" run "$root/models/pendulum.yaml" --path $p --end 0.2 --max-step 1e-3 --precision 17 -o "p17_$p.csv" --plot none --quiet > "$p.log" 2>&1 \
     || { err "--precision 17 ($p) failed: $(tail -3 "$p.log")"; continue; }
   m=$(circle "p17_$p.csv")
   awk -v m="$m" 'BEGIN { exit !(m < 1e-13) }' || err "--precision 17 ($p): |x^2 + y^2 - 1| reaches $m in the CSV"

@@ -36,6 +36,7 @@
 #include <string.h>
 #include <yaml.h>
 
+#include "bounds.h"
 #include "fe.h"
 
 /* LAPACK / BLAS (Fortran interfaces; one-character arguments, no hidden lengths,
@@ -1221,6 +1222,14 @@ static int modes_from_fe(const ir_flex *fx, fe_modes *out, fe_ctx *c) {
       rc = modes_sparse(fx, out, state, nfree, c);
       goto done;
     }
+    /* the dense path's time grows with the cube: refused before it starts */
+    double max_dofs = limit_value("MBCC_MAX_FE_DOFS", LIMIT_FE_DOFS);
+    if (nfree > max_dofs) {
+      fail_at(c, fx->loc, "%d free FE degrees of freedom, more than the limit %g of the dense modal analysis "
+              "(eigensolver: sparse or auto takes larger bodies without interface nodes; MBCC_MAX_FE_DOFS=N "
+              "lifts the limit)", nfree, max_dofs);
+      goto done;
+    }
   }
   if (fe_assemble_at(fx, &sys, c->err, c->nerr, c->where)) goto done;
   fold_links(fx, sys.K, ndof);
@@ -1474,17 +1483,35 @@ static int modes_from_file(const ir_flex *fx, fe_modes *out, fe_ctx *c) {
     fclose(f);
     return fail_at(c, no_loc, "%s: error: out of memory", path);
   }
-  yaml_parser_set_input_file(&parser, f);
+  /* bounded like a model file: the size, then the bracket depth (bounds.h) */
+  double max_input = limit_value("MBCC_MAX_INPUT", LIMIT_INPUT_BYTES);
+  size_t cap = (size_t)fmin(max_input, 1e12) + 1, len = 0;
+  char *text = malloc(cap);
+  if (text) len = fread(text, 1, cap, f);
+  size_t deep_at = 0;
+  const char *why = !text ? "out of memory" : ferror(f) ? "cannot read it"
+                    : (double)len > max_input ? "larger than the limit of MBCC_MAX_INPUT bytes"
+                    : yaml_flow_depth(text, len, LIMIT_YAML_DEPTH, &deep_at) > LIMIT_YAML_DEPTH
+                        ? "brackets nested too deep" : NULL;
+  if (why) {
+    free(text);
+    yaml_parser_delete(&parser);
+    fclose(f);
+    return fail_at(c, no_loc, "%s: error: the modal data file: %s", path, why);
+  }
+  yaml_parser_set_input_string(&parser, (const unsigned char *)text, len);
   if (!yaml_parser_load(&parser, &doc)) {
     const yaml_mark_t *mk = &parser.problem_mark;
     fail_at(c, no_loc, "%s:%lu:%lu: error: %s%s%s", path, (unsigned long)mk->line + 1,
             (unsigned long)mk->column + 1, parser.problem ? parser.problem : "invalid YAML",
             parser.context ? " " : "", parser.context ? parser.context : "");
     yaml_parser_delete(&parser);
+    free(text);
     fclose(f);
     return -1;
   }
   yaml_parser_delete(&parser);
+  free(text);
   fclose(f);
   mf_ctx m = {path, &doc, c};
   int rc = -1, nn = 0, nm = 0, *sel = NULL;

@@ -304,7 +304,7 @@ typedef struct {
   double output_step;   /* default end_time / 100 */
   double step;          /* RK4 step, DOPRI5 initial step; default output_step / 10 */
   double rtol, atol;    /* DOPRI5; defaults 1e-6, 1e-8 */
-  double min_step, max_step; /* DOPRI5; defaults 1e-12, output_step */
+  double min_step, max_step; /* DOPRI5; defaults 1e-12, end_time */
   ir_integrator integrator;  /* default dopri5 */
   ir_solver solver;          /* default ldl: the emitted LDL^T (the generic path: klu) */
   ir_stab stabilization;     /* default projection */

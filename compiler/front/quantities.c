@@ -138,7 +138,7 @@ void parse_orientation(reader *r, yaml_node_t *n, const char *owner, double e[4]
     double v[4];
     if (!to_vector(r, n, "'orientation'", 4, v))
       return;
-    double length = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3]);
+    double length = safe_norm(v, 4);
     if (!(length >= ZERO_LENGTH)) {
       error_at(r, loc_of(n), "'orientation': the Euler parameters have zero length");
       return;

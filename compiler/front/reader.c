@@ -22,6 +22,7 @@
 #include <yaml.h>
 
 #include "diag.h"
+#include "bounds.h"
 #include "names.h"
 #include "quantities.h"
 #include "reader.h"
@@ -51,7 +52,7 @@ static int to_fe_node(reader *r, yaml_node_t *n, const ir_body *b) {
     return k;
   }
   int nn = b->flex && b->flex->nodes ? b->flex->nnodes : -1;
-  if (v != floor(v) || v < 0 || (nn >= 0 && v >= nn)) {
+  if (v != floor(v) || v < 0 || (nn >= 0 && v >= nn) || v > LIMIT_COUNT) {
     if (nn >= 0)
       error_at(r, loc_of(n), "body '%s' has no node %g (its nodes are numbered 0 to %d)", b->name, v, nn - 1);
     else
@@ -250,7 +251,7 @@ static int *to_node_list(reader *r, yaml_node_t *n, const char *label, int nnode
     char item_label[SHOWN_SIZE];
     snprintf(item_label, sizeof item_label, "item %d of %s", i + 1, label);
     if (!to_number(r, item, item_label, &v)) continue;
-    if (v != floor(v) || v < 0 || (nnodes >= 0 && v >= nnodes)) {
+    if (v != floor(v) || v < 0 || (nnodes >= 0 && v >= nnodes) || v > LIMIT_COUNT) {
       error_at(r, loc_of(item), "%s: node %g does not exist (nodes are numbered 0 to %d)", label, v,
                nnodes - 1);
       continue;
@@ -327,9 +328,13 @@ void parse_modal_settings(mapping *m, ir_flex *fx) {
     } else if (modes->type == YAML_SCALAR_NODE) {
       double k;
       if (to_number(r, modes, "'modes'", &k)) {
-        if (k != floor(k) || k < 1) error_at(r, loc_of(modes), "'modes' must be a positive whole number, 'all' or a mapping (got %g)", k);
-        fx->select = MODES_COUNT;
-        fx->count = (int)k;
+        if (k != floor(k) || k < 1 || k > LIMIT_COUNT)
+          error_at(r, loc_of(modes), "'modes' must be a positive whole number up to %g, 'all' or a mapping (got %g)",
+                   LIMIT_COUNT, k);
+        else {
+          fx->select = MODES_COUNT;
+          fx->count = (int)k;
+        }
       }
     } else {
       mapping mm;
@@ -339,7 +344,11 @@ void parse_modal_settings(mapping *m, ir_flex *fx) {
         double v;
         if (map_has(&mm, "count") + map_has(&mm, "max_frequency") + map_has(&mm, "list") != 1)
           error_at(r, loc_of(modes), "'modes' takes exactly one of 'count', 'max_frequency', 'list'");
-        if (get_positive(&mm, "count", false, &v)) { fx->select = MODES_COUNT; fx->count = (int)v; }
+        if (get_positive(&mm, "count", false, &v)) {
+          if (v != floor(v) || v > LIMIT_COUNT)
+            error_at(r, mm.last_loc, "'count' must be a whole number up to %g (got %g)", LIMIT_COUNT, v);
+          else { fx->select = MODES_COUNT; fx->count = (int)v; }
+        }
         if (get_positive(&mm, "max_frequency", false, &v)) { fx->select = MODES_MAX_FREQUENCY; fx->max_frequency = v; }
         yaml_node_t *l = map_get(&mm, "list");
         if (l != NULL) {
@@ -1353,8 +1362,10 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
   } else if (k == OUT_MODAL) {
     double mode;
     if (get_positive(&m, "mode", true, &mode)) {
-      if (mode != floor(mode)) error_at(r, m.last_loc, "'mode' must be a mode number (1, 2, ...)");
-      o->mode = (int)mode - 1;
+      if (mode != floor(mode) || mode > LIMIT_COUNT)
+        error_at(r, m.last_loc, "'mode' must be a mode number (1, 2, ... up to %g)", LIMIT_COUNT);
+      else
+        o->mode = (int)mode - 1;
     }
   }
   get_number(&m, "scale", false, &o->scale);
@@ -1424,8 +1435,12 @@ static void parse_model(reader *r, yaml_node_t *root, const char *chosen_scene_n
   yaml_node_t *name = map_require(&top, "name", true, "a C identifier");
   if (name != NULL && name->type != YAML_SCALAR_NODE)
     error_at(r, loc_of(name), "'name' must be a C identifier (got %s)", show_node(r, name));
-  else if (name != NULL && check_identifier(r, name))
+  else if (name != NULL && check_identifier(r, name)) {
     model->name = xstrndup(scalar_text(name), scalar_length(name));
+    const char *why = reserved_c_name(model->name);
+    if (why != NULL)
+      error_at(r, loc_of(name), "'%s' cannot name a model: %s", model->name, why);
+  }
 
   get_vector(&top, "gravity", 3, false, model->gravity);
 
@@ -1438,6 +1453,14 @@ static void parse_model(reader *r, yaml_node_t *root, const char *chosen_scene_n
   model->bodies[0].orientation[0] = 1;
   name_entry ground = {model->bodies[0].name, NAME_BODY, 0, {0, 0}};
   table_add(&r->names, ground);
+  double max_bodies = limit_value("MBCC_MAX_BODIES", LIMIT_BODIES);
+  if (bodies != NULL && mapping_size(bodies) > max_bodies) {
+    /* alone: the joints on them would only repeat it */
+    error_at(r, loc_of(bodies), "%d bodies, more than the limit %g (the constraint analysis is dense: "
+             "its time grows with the cube; MBCC_MAX_BODIES=N lifts the limit)", mapping_size(bodies), max_bodies);
+    map_close(&top);
+    return;
+  }
   if (bodies != NULL)
     parse_bodies(r, bodies);
 
@@ -1487,7 +1510,9 @@ static void parse_model(reader *r, yaml_node_t *root, const char *chosen_scene_n
  * files and YAML syntax
  * ------------------------------------------------------------------------- */
 
-static char *read_file(const char *path, size_t *size) {
+/* the whole file, or NULL (errno set; EFBIG past 'limit' bytes: /dev/zero
+   and its kind stop there) */
+static char *read_file(const char *path, size_t *size, double limit) {
   FILE *f = fopen(path, "rb");
   if (f == NULL)
     return NULL;
@@ -1495,6 +1520,12 @@ static char *read_file(const char *path, size_t *size) {
   char *data = xcalloc(capacity, 1);
   for (;;) {
     length += fread(data + length, 1, capacity - length, f);
+    if ((double)length > limit) {
+      fclose(f);
+      free(data);
+      errno = EFBIG;
+      return NULL;
+    }
     if (length < capacity)
       break;
     capacity *= 2;
@@ -1560,10 +1591,22 @@ static void report_yaml_error(const char *path, const yaml_parser_t *parser, con
 static ir_model *read_model(const char *path, const char *scene) {
   int errors_before = diag_errors();
   size_t size = 0;
-  char *data = read_file(path, &size);
+  double max_input = limit_value("MBCC_MAX_INPUT", LIMIT_INPUT_BYTES);
+  char *data = read_file(path, &size, max_input);
   if (data == NULL) {
     ir_loc nowhere = {0, 0};
-    diag_error(path, nowhere, "cannot read the model: %s", strerror(errno));
+    if (errno == EFBIG)
+      diag_error(path, nowhere, "the model file is larger than the limit of %.0f bytes "
+                 "(MBCC_MAX_INPUT=BYTES lifts it)", max_input);
+    else
+      diag_error(path, nowhere, "cannot read the model: %s", strerror(errno));
+    return NULL;
+  }
+  size_t deep_at = 0;
+  if (yaml_flow_depth(data, size, LIMIT_YAML_DEPTH, &deep_at) > LIMIT_YAML_DEPTH) {
+    diag_error(path, loc_of_offset(data, size, deep_at),
+               "brackets nested more than %d deep (the limit of the model reader)", LIMIT_YAML_DEPTH);
+    free(data);
     return NULL;
   }
 

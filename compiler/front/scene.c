@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "reader.h"
+#include "bounds.h"
 
 /* ---------------------------------------------------------------------------
  * scenes
@@ -197,6 +198,15 @@ void parse_scenes(reader *r, yaml_node_t *n, const sim_settings *base_sim,
     bool is_chosen = chosen != NULL && strlen(chosen) == scalar_length(key) &&
                      memcmp(chosen, scalar_text(key), scalar_length(key)) == 0;
     parse_scene(r, key, map_value_node(&m, i), base_sim, is_chosen);
+    if (is_chosen && r->model->name != NULL) {
+      /* the scene's code is named <model>_<scene> */
+      char combined[SHOWN_SIZE];
+      snprintf(combined, sizeof combined, "%s_%.*s", r->model->name, (int)scalar_length(key), scalar_text(key));
+      const char *why = reserved_c_name(combined);
+      if (why != NULL)
+        error_at(r, loc_of(key), "scene '%s' would name the code '%s': %s",
+                 show_text(r, scalar_text(key), scalar_length(key)), combined, why);
+    }
   }
   map_close(&m);
 }

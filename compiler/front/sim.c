@@ -111,9 +111,10 @@ bool sim_finish(reader *r, sim_settings *s, bool is_scene, ir_sim *out) {
   if (s->source[SIM_STEP] == FROM_DEFAULT)
     sim_set(s, SIM_STEP, v[SIM_OUTPUT_STEP] / 10, s->source[SIM_OUTPUT_STEP],
             s->loc[SIM_OUTPUT_STEP]);
+  /* the error control alone decides the step (dense output serves the output
+     times): the largest step is the whole run unless given */
   if (s->source[SIM_MAX_STEP] == FROM_DEFAULT)
-    sim_set(s, SIM_MAX_STEP, v[SIM_OUTPUT_STEP], s->source[SIM_OUTPUT_STEP],
-            s->loc[SIM_OUTPUT_STEP]);
+    sim_set(s, SIM_MAX_STEP, v[SIM_END_TIME], s->source[SIM_END_TIME], s->loc[SIM_END_TIME]);
 
   static const int smaller[][2] = {{SIM_OUTPUT_STEP, SIM_END_TIME}, {SIM_MIN_STEP, SIM_MAX_STEP}};
   bool ok = true;

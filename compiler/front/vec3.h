@@ -8,7 +8,22 @@ static inline double dot3(const double a[3], const double b[3]) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-static inline double norm3(const double a[3]) { return sqrt(dot3(a, a)); }
+/* The length of a[0..n): the plain sum of squares where it cannot overflow
+ * or underflow (so the usual values keep their usual bits), else scaled by
+ * the largest component first ([0, 0, 1e308] has length 1e308, not inf). */
+static inline double safe_norm(const double *a, int n) {
+  double big = 0, sum = 0;
+  for (int i = 0; i < n; i++) big = fmax(big, fabs(a[i]));
+  if (big > 1e-150 && big < 1e150) {
+    for (int i = 0; i < n; i++) sum += a[i] * a[i];
+    return sqrt(sum);
+  }
+  if (big == 0 || !isfinite(big)) return big;
+  for (int i = 0; i < n; i++) sum += (a[i] / big) * (a[i] / big);
+  return big * sqrt(sum);
+}
+
+static inline double norm3(const double a[3]) { return safe_norm(a, 3); }
 
 static inline double distance3(const double a[3], const double b[3]) {
   double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};

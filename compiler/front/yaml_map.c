@@ -4,6 +4,7 @@
  * tables, choices, unit axes).  Used by reader.c, names.c, the element
  * parsers of compiler/elements/ and fe.c. */
 #include "yaml_map.h"
+#include "bounds.h"
 
 #include <errno.h>
 #include <setjmp.h>
@@ -300,9 +301,14 @@ bool to_number(reader *r, yaml_node_t *n, const char *label, double *out) {
     bool blank_start = text[0] == ' ' || text[0] == '\t' || text[0] == '\n' || text[0] == '\r';
     double value = blank_start ? 0 : strtod(text, &end);
     if (!blank_start && end == text + scalar_length(n)) {
-      if (isfinite(value)) {
+      if (isfinite(value) && fabs(value) <= LIMIT_MAGNITUDE) {
         *out = value;
         return true;
+      }
+      if (isfinite(value)) {
+        error_at(r, loc_of(n), "%s is %s, beyond the limit %g on the size of a number", label,
+                 show_node(r, n), LIMIT_MAGNITUDE);
+        return false;
       }
       error_at(r, loc_of(n), "%s must be a finite number (got %s)", label, show_node(r, n));
       return false;

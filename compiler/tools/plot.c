@@ -3,14 +3,17 @@
  * writes the gnuplot script.  gnuplot's own chatter goes to a file that is
  * shown only when gnuplot fails. */
 #define _POSIX_C_SOURCE 200809L
+#include <errno.h>
 #include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include "plot.h"
+#include "proc.h"
 
 enum { PANELS_PER_PAGE = 8, MAX_CURVES = 16 };
 
@@ -137,22 +140,40 @@ static const char *base_name(const char *p) {
   return s ? s + 1 : p;
 }
 
-/* gnuplot SCRIPT, its output in LOG; its exit status */
+/* gnuplot SCRIPT, its output in LOG; its exit status.  Through proc_run, so
+ * that gnuplot dies with mbcc and the temporary files go with it. */
 static int run_gnuplot(const char *script, const char *log) {
-  fflush(stdout);
-  fflush(stderr);
-  pid_t pid = fork();
-  if (pid < 0) return -1;
-  if (pid == 0) {
-    int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0666);
-    if (fd >= 0) { dup2(fd, 1); dup2(fd, 2); close(fd); }
-    execlp("gnuplot", "gnuplot", script, (char *)NULL);
-    fprintf(stderr, "cannot run gnuplot\n");
-    _exit(127);
-  }
-  int status = 0;
-  if (waitpid(pid, &status, 0) < 0) return -1;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+  char *argv[] = {"sh", "-c", "exec gnuplot \"$1\" > \"$2\" 2>&1", "sh", (char *)script, (char *)log, NULL};
+  return proc_run(argv);
+}
+
+/* gnuplot may say nothing of a failed write (a full disk): a picture is
+ * complete when it ends with PNG's closing IEND chunk and has reached the disk */
+static int png_complete(const char *path) {
+  static const unsigned char iend[8] = {'I', 'E', 'N', 'D', 0xae, 0x42, 0x60, 0x82};
+  unsigned char tail[8];
+  int fd = open(path, O_RDONLY);
+  struct stat ps;
+  int ok = fd >= 0 && !fstat(fd, &ps) && ps.st_size >= 8 && pread(fd, tail, 8, ps.st_size - 8) == 8 &&
+           !memcmp(tail, iend, 8) && !fsync(fd);
+  if (fd >= 0) close(fd);
+  return ok;
+}
+
+/* a temporary name of this process's own beside 'path' (mkstemp), registered
+ * for removal if mbcc is killed; 0 or -1 */
+static int temp_beside(const char *path, char *out, size_t n) {
+  if (snprintf(out, n, "%s.XXXXXX", path) >= (int)n) { errno = ENAMETOOLONG; return -1; }
+  int fd = mkstemp(out);
+  if (fd < 0) return -1;
+  close(fd);
+  proc_cleanup_add(out);
+  return 0;
+}
+
+static void temp_drop(const char *path) {
+  unlink(path);
+  proc_cleanup_remove(path);
 }
 
 /* page k (from 0) of png: png itself, then NAME-2.png, NAME-3.png ... */
@@ -282,28 +303,52 @@ int plot_files(int ncsv, const char *const *csv, const char *png, const char *co
       st = 2;
     }
   }
+  /* the script, gnuplot's log and every page under names of this process's
+     own; a page replaces the old picture only when gnuplot finished it */
   char script[4200], log[4200];
-  snprintf(script, sizeof script, "%s", plot_keep_script ? plot_keep_script : png);
-  if (!plot_keep_script) strncat(script, ".gp", sizeof script - strlen(script) - 1);
-  snprintf(log, sizeof log, "%s.gnuplot.log", png);
+  int npages = (npanel + PANELS_PER_PAGE - 1) / PANELS_PER_PAGE;
+  char (*part)[4300] = st ? NULL : calloc((size_t)npages + 1, sizeof *part);
+  int nparts = 0;
+  if (!st && !part) st = 2;
+  if (!st && plot_keep_script) snprintf(script, sizeof script, "%s", plot_keep_script);
+  else if (!st && temp_beside(png, script, sizeof script)) {
+    fprintf(stderr, "mbcc: error: cannot write beside '%s': %s\n", png, strerror(errno));
+    st = 2;
+  }
+  int have_script = !st && !plot_keep_script, have_log = 0;
+  if (!st) {
+    if (temp_beside(png, log, sizeof log)) {
+      fprintf(stderr, "mbcc: error: cannot write beside '%s': %s\n", png, strerror(errno));
+      st = 2;
+    } else have_log = 1;
+  }
+  for (; !st && nparts < npages; nparts++) {
+    char out[4300];
+    page_name(png, nparts, out, sizeof out);
+    if (temp_beside(out, part[nparts], sizeof part[nparts])) {
+      fprintf(stderr, "mbcc: error: cannot write beside '%s': %s\n", out, strerror(errno));
+      st = 2;
+      break;
+    }
+  }
   FILE *g = st ? NULL : fopen(script, "w");
   if (!st && !g) { fprintf(stderr, "mbcc: error: cannot write '%s'\n", script); st = 2; }
-  int npages = (npanel + PANELS_PER_PAGE - 1) / PANELS_PER_PAGE;
   for (int page = 0; g && page < npages; page++) {
     int first = page * PANELS_PER_PAGE, count = npanel - first;
     if (count > PANELS_PER_PAGE) count = PANELS_PER_PAGE;
     int rows = (count + 1) / 2, cols = count > 1 ? 2 : 1;
-    char out[4300];
-    page_name(png, page, out, sizeof out);
     fprintf(g, "set terminal pngcairo size %d,%d noenhanced font ',9'\nset output ", 560 * cols, 320 * rows);
-    quoted(g, out);
+    quoted(g, part[page]);
     fprintf(g, "\nset datafile separator ','\nset grid\nset xlabel 't [%s]'\nset multiplot layout %d,%d\n",
             F[0].col[0].unit[0] ? F[0].col[0].unit : "s", rows, cols);
     for (int p = first; p < first + count; p++)
       if (panel_script(g, F, ncsv, panel[p])) st = 2;
-    fprintf(g, "unset multiplot\n");
+    fprintf(g, "unset multiplot\nunset output\n");
   }
-  if (g && fclose(g)) { fprintf(stderr, "mbcc: error: cannot write '%s'\n", script); st = 2; }
+  if (g) {
+    int bad = ferror(g);
+    if (fclose(g) || bad) { fprintf(stderr, "mbcc: error: cannot write '%s'\n", script); st = 2; }
+  }
   if (!st) {
     int rc = run_gnuplot(script, log);
     if (rc) {
@@ -315,14 +360,27 @@ int plot_files(int ncsv, const char *const *csv, const char *png, const char *co
       if (l) fclose(l);
       st = 2;
     }
-    for (int page = 0; !st && !quiet && page < npages; page++) {
+    for (int page = 0; !st && page < npages; page++)
+      if (!png_complete(part[page])) {
+        fprintf(stderr, "mbcc: error: gnuplot wrote no complete picture (a full disk?); '%s' left as it was\n", png);
+        st = 2;
+      }
+    for (int page = 0; !st && page < npages; page++) {
       char out[4300];
       page_name(png, page, out, sizeof out);
-      printf("wrote %s\n", out);
+      if (rename(part[page], out)) {
+        fprintf(stderr, "mbcc: error: cannot write '%s': %s\n", out, strerror(errno));
+        st = 2;
+      } else {
+        proc_cleanup_remove(part[page]);
+        if (!quiet) printf("wrote %s\n", out);
+      }
     }
   }
-  if (!plot_keep_script) remove(script);
-  remove(log);
+  for (int page = 0; page < nparts; page++) temp_drop(part[page]);
+  free(part);
+  if (have_script) temp_drop(script);
+  if (have_log) temp_drop(log);
   free(panel);
   free(spec);
   for (int f = 0; f < nf; f++) csv_free(&F[f]);

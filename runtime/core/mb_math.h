@@ -31,6 +31,7 @@
 #define MB_CEIL(x) ceilf(x)
 #define MB_FMAX(x, y) fmaxf(x, y)
 #define MB_FMIN(x, y) fminf(x, y)
+#define MB_NEARBYINT(x) nearbyintf(x)
 #else
 #define MB_R(x) x
 #define MB_SQRT(x) sqrt(x)
@@ -48,6 +49,7 @@
 #define MB_CEIL(x) ceil(x)
 #define MB_FMAX(x, y) fmax(x, y)
 #define MB_FMIN(x, y) fmin(x, y)
+#define MB_NEARBYINT(x) nearbyint(x)
 #endif
 
 /* isfinite is type-generic (a macro of <math.h>): no promotion either way */

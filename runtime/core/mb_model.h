@@ -185,11 +185,23 @@ void mb_model_qincrement(const mb_model *m, mb_real *q, const mb_real *dv);
 /* normalize Euler parameters */
 void mb_model_normalize(const mb_model *m, mb_real *q);
 /* Outputs at one instant: vd and lambda are the accelerations and multipliers
- * (from the same solve).  'prev' holds the previous outputs (for unwrapping
- * angles) or NULL.  Writes m->ncols values. */
+ * (from the same solve).  'prev' holds, at the columns of angle outputs, the
+ * unwrapped angles in radians a moment ago (mb_model_track_angles) or is NULL
+ * (the first row); angles are unwrapped against it, then scaled.  Writes
+ * m->ncols values. */
 void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
                       const mb_real *vd, const mb_real *lambda, const mb_real *prev,
                       mb_real *out, void *work);
+/* The unwrapped angle outputs (radians, unscaled) at q into ref[col] of their
+ * columns, each the branch nearest ref's value unless have_ref is 0.  Called
+ * after every accepted step, so that an angle is unwrapped however far apart
+ * the output rows are. */
+void mb_model_track_angles(const struct mb_model *m, const mb_real *q, const mb_real *v,
+                           mb_real *ref, int have_ref, void *work);
+/* The largest step after which every body with an angle output has turned by
+ * at most a quarter turn at its present angular velocity (INFINITY without
+ * angle outputs): beyond it unwrapping would be ambiguous. */
+double mb_model_angle_step(const struct mb_model *m, const mb_real *q, const mb_real *v, void *work);
 /* kinetic and potential energy (gravity and force elements) */
 void mb_model_energy(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
                      mb_real *kinetic, mb_real *potential, void *work);

@@ -364,17 +364,48 @@ void mb_model_energy(const mb_model *m, mb_real t, const mb_real *q, const mb_re
 }
 
 /* the angle of a body-fixed direction about a global axis, measured from its
- * initial direction, unwrapped against the previous value */
-static mb_real body_angle(const mb_outputdef *o, const mb_frame *f, const mb_real *prev) {
+ * initial direction, in radians; with a reference (the unwrapped angle a
+ * moment ago, radians, less than pi away) the branch nearest to it.  Closed
+ * form, not a loop: a huge or non-finite reference cannot make it spin. */
+static mb_real body_angle(const mb_outputdef *o, const mb_frame *f, const mb_real *ref) {
   mb_real u[3], c[3];
   mb_mul3(f->A, o->u, u);
   mb_cross3(o->u_g, u, c);
   mb_real a = MB_ATAN2(mb_dot3(o->axis_g, c), mb_dot3(o->u_g, u));
-  if (prev) {
-    while (a - *prev > MB_R(MB_PI)) a -= 2 * MB_R(MB_PI);
-    while (a - *prev < -MB_R(MB_PI)) a += 2 * MB_R(MB_PI);
-  }
+  if (ref && MB_ISFINITE(*ref)) a += 2 * MB_R(MB_PI) * MB_NEARBYINT((*ref - a) / (2 * MB_R(MB_PI)));
   return a;
+}
+
+void mb_model_track_angles(const mb_model *m, const mb_real *q, const mb_real *v, mb_real *ref,
+                           int have_ref, void *work) {
+  int any = 0;
+  for (int k = 0; k < m->noutput; k++) any |= m->output[k].kind == MB_OUT_ANGLE;
+  if (!any) return;
+  mb_frame *F = (mb_frame *)work;
+  mb_marker *MK = (mb_marker *)(F + m->nbody);
+  frames_and_markers(m, q, v, F, MK);
+  for (int k = 0; k < m->noutput; k++) {
+    const mb_outputdef *o = &m->output[k];
+    if (o->kind == MB_OUT_ANGLE) ref[o->col] = body_angle(o, &F[o->body], have_ref ? ref + o->col : 0);
+  }
+}
+
+double mb_model_angle_step(const mb_model *m, const mb_real *q, const mb_real *v, void *work) {
+  int any = 0;
+  for (int k = 0; k < m->noutput; k++) any |= m->output[k].kind == MB_OUT_ANGLE;
+  if (!any) return INFINITY;
+  mb_frame *F = (mb_frame *)work;
+  mb_marker *MK = (mb_marker *)(F + m->nbody);
+  frames_and_markers(m, q, v, F, MK);
+  mb_real wmax = 0;
+  for (int k = 0; k < m->noutput; k++) {
+    const mb_outputdef *o = &m->output[k];
+    if (o->kind != MB_OUT_ANGLE) continue;
+    const mb_real *w = F[o->body].w;
+    wmax = MB_FMAX(wmax, MB_SQRT(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]));
+  }
+  /* a quarter turn at most between two unwrappings (pi would be ambiguous) */
+  return wmax > 0 ? (double)(MB_R(0.25) * MB_R(MB_PI) / wmax) : (double)INFINITY;
 }
 
 void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,

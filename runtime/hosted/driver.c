@@ -1,18 +1,23 @@
 /* driver.c: the simulator's command line: options, progress on stderr,
  * CSV output, and the closing statistics. */
-#define _POSIX_C_SOURCE 199309L
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
 #include <math.h>
+#include <signal.h>
+#include <sys/stat.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 #include "mb_driver.h"
 
 typedef struct {
   const mb_model *m;
   FILE *csv;
-  mb_real *out, *prev;
-  int have_prev;
+  mb_real *out, *angle_ref; /* angle_ref: unwrapped angles, radians (mb_model_track_angles) */
+  int have_ref;
+  int write_failed;         /* a write to the CSV failed (e.g. a full disk) */
   void *work;
   double end_time, last_report, wall0;
   int progress;
@@ -30,14 +35,15 @@ static int write_row(void *user, double t, const mb_real *q, const mb_real *v, c
                      const mb_real *lambda) {
   writer *w = user;
   const mb_model *m = w->m;
-  mb_model_outputs(m, t, q, v, vd, lambda, w->have_prev ? w->prev : NULL, w->out, w->work);
+  mb_model_outputs(m, t, q, v, vd, lambda, w->have_ref ? w->angle_ref : NULL, w->out, w->work);
   for (int j = 0; j < m->ncols; j++)
     if (!isfinite(w->out[j])) { w->nonfinite = j + 1; return 1; } /* never print NaN as data */
-  fprintf(w->csv, "%.*g", w->digits > 10 ? w->digits : 10, t);
-  for (int j = 0; j < m->ncols; j++) fprintf(w->csv, ",%.*g", w->digits, (double)w->out[j]);
-  fputc('\n', w->csv);
-  memcpy(w->prev, w->out, sizeof(mb_real) * (size_t)m->ncols);
-  w->have_prev = 1;
+  int bad = fprintf(w->csv, "%.*g", w->digits > 10 ? w->digits : 10, t) < 0;
+  for (int j = 0; j < m->ncols; j++) bad |= fprintf(w->csv, ",%.*g", w->digits, (double)w->out[j]) < 0;
+  bad |= fputc('\n', w->csv) == EOF;
+  if (bad) { w->write_failed = errno ? errno : EIO; return 1; }
+  mb_model_track_angles(m, q, v, w->angle_ref, w->have_ref, w->work);
+  w->have_ref = 1;
   double now = wall();
   if (w->progress && now - w->wall0 > 1.0 && now - w->last_report > 0.5) {
     fprintf(stderr, "\r  t = %.6g / %.6g (%3.0f%%)", t, w->end_time, 100 * t / w->end_time);
@@ -46,7 +52,47 @@ static int write_row(void *user, double t, const mb_real *q, const mb_real *v, c
   return 0;
 }
 
+/* after every accepted step: angles unwrapped however far apart the rows are */
+static void track_angles(void *user, double t, const mb_real *q, const mb_real *v) {
+  writer *w = user;
+  (void)t;
+  mb_model_track_angles(w->m, q, v, w->angle_ref, w->have_ref, w->work);
+  w->have_ref = 1;
+}
+
+/* the temporary CSV, removed if the simulator is interrupted or killed by a signal */
+static char partial_csv[4200];
+static void remove_partial_and_die(int sig) {
+  if (partial_csv[0]) unlink(partial_csv);
+  signal(sig, SIG_DFL);
+  raise(sig);
+}
+
+/* The largest number of output rows a run may write (1e7, about a gigabyte of
+ * CSV): more is refused before the run starts.  MB_MAX_ROWS lifts it. */
+static double max_rows(void) {
+  const char *e = getenv("MB_MAX_ROWS");
+  double x = e && *e ? strtod(e, NULL) : 0;
+  return x > 0 ? x : 1e7;
+}
+
+const char *mb_lapack_context;
+
 #ifndef MB_REAL_FLOAT
+/* LAPACK reports an illegal argument (often a NaN or an overflowed size that
+ * reached it) through xerbla_, whose reference version prints a line and
+ * returns, leaving garbage results: this one stops with a located failure. */
+void xerbla_(const char *routine, const int *info, size_t routine_len);
+void xerbla_(const char *routine, const int *info, size_t routine_len) {
+  int n = routine_len > 0 && routine_len < 32 ? (int)routine_len : 6;
+  while (n > 0 && (routine[n - 1] == ' ' || routine[n - 1] == 0)) n--; /* Fortran pads with blanks */
+  fprintf(stderr, "%s: error: LAPACK routine %.*s got an illegal value in argument %d (a value out of "
+          "range reached it); stopped\n", mb_lapack_context ? mb_lapack_context : "runtime", n, routine,
+          info ? *info : 0);
+  fflush(stderr);
+  exit(1);
+}
+
 void dgesvd_(const char *jobu, const char *jobvt, const int *m, const int *n, double *a,
              const int *lda, double *s, double *u, const int *ldu, double *vt, const int *ldvt,
              double *work, const int *lwork, int *info);
@@ -170,6 +216,12 @@ static void usage(const char *prog) {
           prog);
 }
 
+static mode_t current_umask(void) {
+  mode_t u = umask(022);
+  umask(u);
+  return u;
+}
+
 int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *defaults,
             const char *solver) {
   mb_settings set = *defaults;
@@ -225,10 +277,20 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
   }
 #endif
   if (set.output_step > set.end_time) set.output_step = set.end_time;
-  /* the model's largest step is its output step unless said otherwise: a new
-     output step given on the command line carries it along */
-  if (output_given && !max_given) set.max_step = set.output_step;
-  if (set.max_step > set.output_step) set.max_step = set.output_step;
+  (void)output_given; (void)max_given;
+  /* finite but absurd time spans: refused, not truncated to a row or two */
+  double rows = floor(set.end_time / set.output_step) + 1;
+  if (!(rows <= max_rows())) {
+    fprintf(stderr, "%s: error: end time %g with output step %g means %.3g output rows, more than the "
+            "limit %.3g (choose a larger --output-step or a smaller --end; MB_MAX_ROWS=N lifts the limit)\n",
+            argv[0], set.end_time, set.output_step, rows, max_rows());
+    return 2;
+  }
+  if (set.end_time > 1e9 || set.end_time + set.output_step == set.end_time) {
+    fprintf(stderr, "%s: error: end time %g s is beyond what the time steps resolve (at most 1e9 s)\n",
+            argv[0], set.end_time);
+    return 2;
+  }
 
   mb_solver *ls = mb_solver_new(solver, m);
   if (!ls) {
@@ -239,15 +301,28 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
       fprintf(stderr, "%s: error: unknown solver '%s' (expected %s)\n", argv[0], solver, mb_solver_choices(m));
     return 2;
   }
-  /* write to a temporary file, renamed on success: nothing half-written */
-  char tmp[4096];
-  snprintf(tmp, sizeof tmp, "%s.part", csv_path);
+  /* write to a temporary file of this process's own (mkstemp: two runs of one
+     model never share it) beside the result, renamed on success: nothing
+     half-written, nothing mixed */
+  char *tmp = partial_csv;
+  snprintf(tmp, sizeof partial_csv, "%s.XXXXXX", csv_path);
   writer w = {0};
   w.m = m;
-  w.csv = fopen(tmp, "w");
-  if (!w.csv) { fprintf(stderr, "%s: error: cannot write '%s'\n", argv[0], tmp); ls->destroy(ls); return 2; }
+  int fd = mkstemp(tmp);
+  w.csv = fd >= 0 ? fdopen(fd, "w") : NULL;
+  if (!w.csv) {
+    fprintf(stderr, "%s: error: cannot write '%s': %s\n", argv[0], csv_path, strerror(errno));
+    if (fd >= 0) { close(fd); unlink(tmp); }
+    tmp[0] = 0;
+    ls->destroy(ls);
+    return 2;
+  }
+  fchmod(fd, 0644 & ~current_umask());
+  signal(SIGINT, remove_partial_and_die);
+  signal(SIGTERM, remove_partial_and_die);
+  signal(SIGHUP, remove_partial_and_die);
   w.out = calloc((size_t)m->ncols + 1, sizeof(mb_real));
-  w.prev = calloc((size_t)m->ncols + 1, sizeof(mb_real));
+  w.angle_ref = calloc((size_t)m->ncols + 1, sizeof(mb_real));
   w.work = malloc(mb_model_worksize(m) + 16);
   w.end_time = set.end_time;
   w.wall0 = wall();
@@ -264,13 +339,24 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
   }
   mb_sim sim;
   int st = mb_sim_init(&sim, m, ls, &set);
+  sim.on_step = track_angles;
+  sim.on_step_user = &w;
   if (!st) st = mb_sim_run(&sim, write_row, &w);
   if (w.progress && wall() - w.wall0 > 1.0) fprintf(stderr, "\n");
   int nonfinite_output = !st && w.nonfinite;
-  fclose(w.csv);
+  /* every byte on the disk before the rename, or an error */
+  errno = 0;
+  if (!w.write_failed && (fflush(w.csv) || ferror(w.csv) || fsync(fileno(w.csv))))
+    w.write_failed = errno ? errno : EIO;
+  if (fclose(w.csv) && !w.write_failed) w.write_failed = errno ? errno : EIO;
   int rc = 0;
-  if (st || nonfinite_output) {
-    remove(tmp);
+  if (w.write_failed) {
+    unlink(tmp);
+    fprintf(stderr, "%s: error: cannot write '%s': %s; no results written\n", argv[0], csv_path,
+            strerror(w.write_failed));
+    rc = 2;
+  } else if (st || nonfinite_output) {
+    unlink(tmp);
     if (nonfinite_output)
       fprintf(stderr, "%s: error: at t = %.9g: output '%s' is not finite; no results written\n", argv[0],
               sim.t, m->col_name[w.nonfinite - 1]);
@@ -283,12 +369,14 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
 #endif
     rc = 1;
   } else if (rename(tmp, csv_path)) {
-    fprintf(stderr, "%s: error: cannot write '%s'\n", argv[0], csv_path);
+    fprintf(stderr, "%s: error: cannot write '%s': %s\n", argv[0], csv_path, strerror(errno));
+    unlink(tmp);
     rc = 2;
   } else if (write_units(m, csv_path)) {
     fprintf(stderr, "%s: error: cannot write '%s.units'\n", argv[0], csv_path);
     rc = 2;
   }
+  tmp[0] = 0;
   if (!rc && !quiet) {
     const mb_stats *s = &sim.stats;
     printf("model %s: %d bodies, %d coordinates (q), %d velocities, %d constraint rows, n = %d, nnz(K) = %d\n",
@@ -320,6 +408,6 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
   }
   mb_sim_free(&sim);
   ls->destroy(ls);
-  free(w.out); free(w.prev); free(w.work);
+  free(w.out); free(w.angle_ref); free(w.work);
   return rc;
 }

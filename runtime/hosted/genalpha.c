@@ -203,6 +203,7 @@ int mb_genalpha_run(mb_sim *s, mb_output_fn out, void *user) {
   double h = fmin(set->step, set->max_step);
 
   if (set->stabilization == MB_STAB_PROJECTION && (st = mb_sim_project(s, 0, s->q, s->v))) goto done;
+  s->angle_hmax = mb_model_angle_step(m, s->q, s->v, s->work);
   /* consistent accelerations at t = 0 start the recurrence: a_0 = vd_0 */
   if ((st = mb_sim_accel(s, 0, s->q, s->v, g.vd, g.lam))) goto done;
   memcpy(g.a, g.vd, sizeof(mb_real) * (size_t)nv);
@@ -222,7 +223,7 @@ int mb_genalpha_run(mb_sim *s, mb_output_fn out, void *user) {
     }
     double hmax = tout - s->t;
     for (;;) {
-      double hh = fmin(h, hmax);
+      double hh = fmin(fmin(h, s->angle_hmax), hmax); /* angle_hmax: see mb_model_angle_step */
       if (hmax - hh < 1e-9 * set->output_step) hh = hmax;
       double rate = 0;
       int ns = MB_OK;

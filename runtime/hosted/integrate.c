@@ -69,7 +69,9 @@ int mb_sim_init(mb_sim *s, const mb_model *m, mb_solver *ls, const mb_settings *
   s->qsave = calloc((size_t)m->nq + 1, sizeof(mb_real));
   s->dv = calloc((size_t)m->n + 1, sizeof(mb_real));
   s->work = malloc(mb_model_worksize(m) + 16);
-  if (!s->q || !s->v || !s->Kx || !s->rhs || !s->x || !s->phi || !s->nu || !s->y || !s->ytmp ||
+  s->yout = calloc(ny + 1, sizeof(mb_real));
+  s->angle_hmax = INFINITY;
+  if (!s->yout || !s->q || !s->v || !s->Kx || !s->rhs || !s->x || !s->phi || !s->nu || !s->y || !s->ytmp ||
       !s->qsave || !s->dv || !s->work)
     return MB_ERR_NOMEM;
   for (int i = 0; i < 7; i++)
@@ -84,7 +86,7 @@ int mb_sim_init(mb_sim *s, const mb_model *m, mb_solver *ls, const mb_settings *
 
 void mb_sim_free(mb_sim *s) {
   free(s->q); free(s->v); free(s->Kx); free(s->rhs); free(s->x); free(s->phi); free(s->nu);
-  free(s->y); free(s->ytmp); free(s->qsave); free(s->dv); free(s->work);
+  free(s->y); free(s->ytmp); free(s->qsave); free(s->dv); free(s->work); free(s->yout);
   for (int i = 0; i < 7; i++) free(s->k[i]);
   memset(s, 0, sizeof *s);
 }
@@ -199,6 +201,8 @@ int mb_sim_finish_step(mb_sim *s, double t) {
     if (!isfinite(s->q[i])) return mb_sim_fail(s, t, MB_ERR_NONFINITE, "positions");
   for (int i = 0; i < m->nv; i++)
     if (!isfinite(s->v[i])) return mb_sim_fail(s, t, MB_ERR_NONFINITE, "velocities");
+  s->angle_hmax = mb_model_angle_step(m, s->q, s->v, s->work);
+  if (s->on_step) s->on_step(s->on_step_user, t, s->q, s->v);
   return MB_OK;
 }
 
@@ -320,10 +324,155 @@ int mb_integrator_auto(const mb_model *m, const mb_settings *set, char *why, siz
   return implicit ? MB_GENALPHA : MB_DOPRI5;
 }
 
+/* Dormand-Prince's continuous extension (the dense output of Hairer, Norsett
+ * and Wanner, II.6): y(t + theta h) from the step's start y0, its end y1 and
+ * its stages, fifth order in the step like the step itself */
+static const double DP_D[7] = {-12715105075.0 / 11282082432.0, 0, 87487479700.0 / 32700410799.0,
+                               -10690763975.0 / 1880347072.0, 701980252875.0 / 199316789632.0,
+                               -1453857185.0 / 822651844.0, 69997945.0 / 29380423.0};
+static void dp_dense(int ny, const mb_real *y0, const mb_real *y1, mb_real *const *k, double h,
+                     double theta, mb_real *out) {
+  double theta1 = 1 - theta;
+  for (int i = 0; i < ny; i++) {
+    double ydiff = y1[i] - y0[i];
+    double bspl = h * k[0][i] - ydiff;
+    double r4 = ydiff - h * k[6][i] - bspl;
+    double r5 = 0;
+    for (int j = 0; j < 7; j++) r5 += DP_D[j] * k[j][i];
+    r5 *= h;
+    out[i] = y0[i] + theta * (ydiff + theta1 * (bspl + theta * (r4 + theta1 * r5)));
+  }
+}
+
+/* one output row at (t, q, v): a consistent state, then its accelerations */
+static int dp_output(mb_sim *s, double t, mb_real *q, mb_real *v, mb_real *vd, mb_real *lam,
+                     mb_output_fn out, void *user, int *stop) {
+  const mb_model *m = s->m;
+  int st;
+  if (s->set.stabilization == MB_STAB_PROJECTION) st = mb_sim_project(s, t, q, v);
+  else { mb_model_normalize(m, q); st = MB_OK; }
+  if (!st) st = mb_sim_accel(s, t, q, v, vd, lam);
+  if (st) {
+    /* the failure is at this row's state, not at the last step's: that is
+       the state the diagnosis (a singular configuration?) must look at */
+    if (q != s->q) memcpy(s->q, q, sizeof(mb_real) * (size_t)m->nq);
+    if (v != s->v) memcpy(s->v, v, sizeof(mb_real) * (size_t)m->nv);
+    s->t = t;
+    return st;
+  }
+  double mx = max_abs(s->phi, m->nc);
+  if (mx > s->stats.max_phi) s->stats.max_phi = mx;
+  *stop = out && out(user, t, q, v, vd, lam);
+  return MB_OK;
+}
+
+/* Adaptive Dormand-Prince 5(4).  The steps follow the error control alone:
+ * output rows inside a step come from the continuous extension, so the output
+ * grid neither caps nor changes the steps (only the last one ends on the last
+ * output time). */
+static int dp_run(mb_sim *s, mb_output_fn out, void *user) {
+  const mb_model *m = s->m;
+  const mb_settings *set = &s->set;
+  int nq = m->nq, nv = m->nv, ny = nq + nv;
+  mb_real *vd = malloc(sizeof(mb_real) * (size_t)(nv + 1));
+  mb_real *lam = malloc(sizeof(mb_real) * (size_t)(m->nc + 1));
+  if (!vd || !lam) { free(vd); free(lam); return MB_ERR_NOMEM; }
+  int st = MB_OK, stop = 0;
+  s->t = 0;
+  long nout = (long)floor(set->end_time / set->output_step + 1e-9), iout = 0;
+  double t_end = (double)nout * set->output_step, tiny = 1e-9 * set->output_step;
+  double h = fmin(set->step, set->max_step);
+  if (set->stabilization == MB_STAB_PROJECTION && (st = mb_sim_project(s, 0, s->q, s->v))) goto done;
+  s->angle_hmax = mb_model_angle_step(m, s->q, s->v, s->work);
+  if ((st = dp_output(s, 0, s->q, s->v, vd, lam, out, user, &stop)) || stop) goto done;
+  iout = 1;
+  while (iout <= nout) {
+    if ((st = mb_sim_step_budget(s, h))) goto done;
+    /* the first stage at (t, y) */
+    memcpy(s->y, s->q, sizeof(mb_real) * (size_t)nq);
+    memcpy(s->y + nq, s->v, sizeof(mb_real) * (size_t)nv);
+    if ((st = mb_sim_accel(s, s->t, s->q, s->v, vd, lam))) goto done;
+    memcpy(s->k[0] + nq, vd, sizeof(mb_real) * (size_t)nv);
+    mb_model_qdot(m, s->q, s->v, s->k[0]);
+    double hrest = t_end - s->t, hh;
+    char stage_failure[160] = ""; /* why a stage failed in this step's attempts */
+    double stage_failure_t = 0;
+    for (;;) {
+      hh = fmin(fmin(h, s->angle_hmax), hrest);
+      if (hrest - hh < tiny) hh = hrest;
+      for (int j = 1; j < 7; j++) {
+        dp_stage(ny, s->y, hh, s->k, j, s->ytmp);
+        if ((st = deriv(s, s->t + DP_C[j] * hh, s->ytmp, s->k[j]))) {
+          /* a failed stage (e.g. a singular matrix far from the path):
+             retry with a smaller step before giving up */
+          snprintf(stage_failure, sizeof stage_failure, "%s", s->fail_detail);
+          stage_failure_t = s->fail_time;
+          if (hh > 4 * set->min_step) { st = MB_OK; h = hh / 4; goto retry; }
+          goto done;
+        }
+      }
+      /* ytmp holds the 5th-order solution (FSAL stage); error estimate */
+      double err = dp_error(ny, s->y, s->ytmp, hh, s->k, set->atol, set->rtol);
+      if (!isfinite(err)) err = 1e10;
+      double fac = err > 0 ? 0.9 * pow(err, -0.2) : 5;
+      fac = fmin(5, fmax(0.2, fac));
+      if (err <= 1) {
+        h = fmin(hh * fac, set->max_step);
+        if (hh == hrest && hh < h) h = fmax(h, hh);
+        break;
+      }
+      s->stats.rejected++;
+      h = hh * fmax(0.2, fac);
+    retry:
+      if (h < set->min_step) {
+        st = mb_sim_fail(s, s->t, MB_ERR_STEP_TOO_SMALL, "adaptive step");
+        if (stage_failure[0]) {
+          char detail[sizeof s->fail_detail];
+          snprintf(detail, sizeof detail, "adaptive step fell below %.3g s; a stage failed: %.80s at t = %.9g",
+                   set->min_step, stage_failure, stage_failure_t);
+          memcpy(s->fail_detail, detail, sizeof detail);
+        }
+        goto done;
+      }
+    }
+    double t0 = s->t, t1 = hh == hrest ? t_end : s->t + hh;
+    s->stats.steps++;
+    /* rows strictly inside the step, from the continuous extension */
+    for (; iout <= nout; iout++) {
+      double tout = (double)iout * set->output_step;
+      if (tout > t1 - tiny) break;
+      dp_dense(ny, s->y, s->ytmp, s->k, hh, (tout - t0) / hh, s->yout);
+      if ((st = dp_output(s, tout, s->yout, s->yout + nq, vd, lam, out, user, &stop)) || stop) goto done;
+    }
+    memcpy(s->q, s->ytmp, sizeof(mb_real) * (size_t)nq);
+    memcpy(s->v, s->ytmp + nq, sizeof(mb_real) * (size_t)nv);
+    s->t = t1;
+    if ((st = mb_sim_finish_step(s, s->t))) goto done;
+    /* a row at the step's end: the stabilized state itself */
+    if (iout <= nout && fabs((double)iout * set->output_step - t1) <= tiny) {
+      if ((st = dp_output(s, (double)iout * set->output_step, s->q, s->v, vd, lam, out, user, &stop)) || stop)
+        goto done;
+      iout++;
+    }
+  }
+done:
+  free(vd);
+  free(lam);
+  return st;
+}
+
 int mb_sim_run(mb_sim *s, mb_output_fn out, void *user) {
   if (s->set.integrator == MB_GENALPHA) {
     double t0 = mb_sim_clock();
     int st = mb_genalpha_run(s, out, user);
+    s->stats.factorizations = s->ls->factorizations;
+    s->stats.full_factorizations = s->ls->full_factorizations;
+    s->stats.t_total = mb_sim_clock() - t0;
+    return st;
+  }
+  if (s->set.integrator == MB_DOPRI5) {
+    double t0 = mb_sim_clock();
+    int st = dp_run(s, out, user);
     s->stats.factorizations = s->ls->factorizations;
     s->stats.full_factorizations = s->ls->full_factorizations;
     s->stats.t_total = mb_sim_clock() - t0;
@@ -392,53 +541,6 @@ int mb_sim_run(mb_sim *s, mb_output_fn out, void *user) {
       memcpy(s->v, s->ytmp + nq, sizeof(mb_real) * (size_t)nv);
       s->t = (h == hmax) ? tout : s->t + h;
       s->stats.steps++;
-      if ((st = mb_sim_finish_step(s, s->t))) goto done;
-    } else {
-      /* adaptive Dormand-Prince 5(4); steps end on output times */
-      char stage_failure[160] = ""; /* why a stage failed in this step's attempts */
-      double stage_failure_t = 0;
-      for (;;) {
-        double hh = fmin(h, hmax);
-        if (hmax - hh < 1e-9 * set->output_step) hh = hmax;
-        for (int j = 1; j < 7; j++) {
-          dp_stage(ny, s->y, hh, s->k, j, s->ytmp);
-          if ((st = deriv(s, s->t + DP_C[j] * hh, s->ytmp, s->k[j]))) {
-            /* a failed stage (e.g. a singular matrix far from the path):
-               retry with a smaller step before giving up */
-            snprintf(stage_failure, sizeof stage_failure, "%s", s->fail_detail);
-            stage_failure_t = s->fail_time;
-            if (hh > 4 * set->min_step) { st = MB_OK; h = hh / 4; goto retry; }
-            goto done;
-          }
-        }
-        /* ytmp holds the 5th-order solution (FSAL stage); error estimate */
-        double err = dp_error(ny, s->y, s->ytmp, hh, s->k, set->atol, set->rtol);
-        if (!isfinite(err)) err = 1e10;
-        double fac = err > 0 ? 0.9 * pow(err, -0.2) : 5;
-        fac = fmin(5, fmax(0.2, fac));
-        if (err <= 1) {
-          memcpy(s->q, s->ytmp, sizeof(mb_real) * (size_t)nq);
-          memcpy(s->v, s->ytmp + nq, sizeof(mb_real) * (size_t)nv);
-          s->t = (hh == hmax) ? tout : s->t + hh;
-          s->stats.steps++;
-          h = fmin(hh * fac, set->max_step);
-          if (hh == hmax && hh < h) h = fmax(h, hh); /* a short step to an output time */
-          break;
-        }
-        s->stats.rejected++;
-        h = hh * fmax(0.2, fac);
-      retry:
-        if (h < set->min_step) {
-          st = mb_sim_fail(s, s->t, MB_ERR_STEP_TOO_SMALL, "adaptive step");
-          if (stage_failure[0]) {
-            char detail[sizeof s->fail_detail];
-            snprintf(detail, sizeof detail, "adaptive step fell below %.3g s; a stage failed: %.80s at t = %.9g",
-                     set->min_step, stage_failure, stage_failure_t);
-            memcpy(s->fail_detail, detail, sizeof detail);
-          }
-          goto done;
-        }
-      }
       if ((st = mb_sim_finish_step(s, s->t))) goto done;
     }
   }

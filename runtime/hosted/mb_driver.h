@@ -15,4 +15,8 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
  * 1 if applied, 0 if opt is not one of them, -1 after printing an error. */
 int mb_settings_option(mb_settings *set, const char *opt, const char *val, const char *prog);
 
+/* What a LAPACK argument error (xerbla_, driver.c) names: the model file in
+ * mbcc, NULL in a simulator.  Such an error stops the process with status 1. */
+extern const char *mb_lapack_context;
+
 #endif

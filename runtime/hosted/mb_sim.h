@@ -52,6 +52,11 @@ typedef struct {
   mb_real *Kx, *rhs, *x, *phi, *nu, *y, *ytmp, *k[7], *qsave, *dv; /* nu: phid = D v - nu */
   void *work;
   int factored_valid;       /* Kx factorization matches qsave */
+  /* called after every accepted step (e.g. to unwrap angles); set after mb_sim_init */
+  void (*on_step)(void *user, double t, const mb_real *q, const mb_real *v);
+  void *on_step_user;
+  double angle_hmax;        /* largest next step that keeps angle outputs unwrappable */
+  mb_real *yout;            /* Dormand-Prince: the state at an output time inside a step */
 } mb_sim;
 
 void mb_settings_default(mb_settings *s);

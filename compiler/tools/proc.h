@@ -1,0 +1,20 @@
+/* proc.h: running child programs (the C compiler, the simulator, gnuplot)
+ * so that they die with mbcc, and files that must not be half-written. */
+#ifndef MBCC_PROC_H
+#define MBCC_PROC_H
+
+/* Run argv and wait for it: its exit status, 128 + its signal, or -1.  The
+ * child stays in mbcc's process group (a ^C reaches both); a SIGINT, SIGTERM
+ * or SIGHUP sent to mbcc alone is passed on to it, and once it is reaped mbcc
+ * removes the registered temporary files and dies of the same signal.  On
+ * Linux the child also gets SIGTERM if mbcc is killed outright. */
+int proc_run(char *const argv[]);
+
+/* Temporary files removed if mbcc is killed while a child runs (at most 8). */
+void proc_cleanup_add(const char *path);
+void proc_cleanup_remove(const char *path);
+
+/* 1 if both paths name one existing file (same device and inode) */
+int proc_same_file(const char *a, const char *b);
+
+#endif
