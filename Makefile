@@ -52,8 +52,9 @@ $(B)/cc/%.o: compiler/%.c
 	$(CC) $(STD) $(WARN) $(CFLAGS) $(DEPFLAGS) $(CC_INC) $(CC_DEFS) -c $< -o $@
 
 CC_OBJ := $(patsubst compiler/%.c,$(B)/cc/%.o,$(CC_SRC))
+# the assembly analysis (compiler/lower/assemble.c) uses SuiteSparseQR and CHOLMOD
 $(B)/mbcc: $(CC_OBJ) $(B)/libmbrt.a
-	$(CC) $(CFLAGS) $(CC_OBJ) $(B)/libmbrt.a $(LIBS) -lcamd -o $@
+	$(CC) $(CFLAGS) $(CC_OBJ) $(B)/libmbrt.a -lspqr $(LIBS) -lcamd -o $@
 
 -include $(CC_OBJ:.o=.d) $(patsubst runtime/%.c,$(B)/rt/%.d,$(RT_SRC)) \
          $(patsubst runtime/%.c,$(B)/rt-float/%.d,$(RT_FLOAT_SRC))

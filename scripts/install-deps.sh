@@ -30,7 +30,8 @@ present() {
     build-essential)    command -v cc && command -v make && [ -e /usr/include/stdio.h ] ;;
     libyaml-dev)        [ -e /usr/include/yaml.h ] && links yaml ;;
     libsuitesparse-dev) [ -e /usr/include/suitesparse/klu.h ] && links klu &&
-                        [ -e /usr/include/suitesparse/cholmod.h ] && links cholmod ;;
+                        [ -e /usr/include/suitesparse/cholmod.h ] && links cholmod &&
+                        [ -e /usr/include/suitesparse/SuiteSparseQR_C.h ] && links spqr ;;
     liblapack-dev)      links lapack ;;
     libblas-dev)        links blas ;;
     libcmocka-dev)      [ -e /usr/include/cmocka.h ] && links cmocka ;;

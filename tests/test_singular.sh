@@ -4,7 +4,9 @@
 #   - the slider-crank with rod = crank passes its dead point (theta = pi/2)
 #     on the branch x = 2 r cos(theta), to 1e-8 of the stroke;
 #   - when a step ends exactly on the dead point, DOPRI5 stops there with
-#     exit 1, no CSV, and a note that the constraint Jacobian is singular;
+#     exit 1, no CSV, and a note that the constraint Jacobian is singular --
+#     or, when K's pivot there is at round-off rather than exactly zero, goes
+#     on with a warning that K's condition estimate fell below 1e-12 there;
 #   - the parallelogram four-bar passes its change point (t = 0.25 s) as a
 #     parallelogram and warns that K's condition estimate collapsed there.
 # Environment: MBCC (set by tests/run_tests.sh; default build/mbcc).
@@ -22,12 +24,23 @@ awk -v e="$e" 'BEGIN { exit !(e <= 1e-8) }' || err "branch error $e"
 h=$(awk 'BEGIN { printf "%.17g", atan2(1, 0) / 124.8 / 100 }')
 "$MBCC" run "$X/slider_crank_equal.yaml" --output-step "$h" -o "$tmp/b.csv" --plot none > "$tmp/b.log" 2>&1
 rc=$?
-[ $rc = 1 ] || err "step on the dead point: exit $rc, expected 1"
-[ -e "$tmp/b.csv" ] && err "step on the dead point: a CSV was written"
-grep -q "error: at t = 0.01258650" "$tmp/b.log" || err "no error at the dead point: $(cat "$tmp/b.log")"
-grep -q "note: at t = 0.01258650.* the constraint Jacobian is nearly singular" "$tmp/b.log" ||
-  err "no singular-configuration note: $(cat "$tmp/b.log")"
-grep "_sim: \(error\|note\)" "$tmp/b.log" | sed 's/^[^ ]*_sim: /  /'
+# Whether K's pivot at the dead point comes out exactly zero (a stop) or at
+# round-off (the run goes on, warned) depends on the last bits of the
+# assembled initial state; either way the dead point must be named.
+if [ $rc = 1 ]; then
+  [ -e "$tmp/b.csv" ] && err "step on the dead point: a CSV was written"
+  grep -q "error: at t = 0.01258650" "$tmp/b.log" || err "no error at the dead point: $(cat "$tmp/b.log")"
+  grep -q "note: at t = 0.01258650.* the constraint Jacobian is nearly singular" "$tmp/b.log" ||
+    err "no singular-configuration note: $(cat "$tmp/b.log")"
+  grep "_sim: \(error\|note\)" "$tmp/b.log" | sed 's/^[^ ]*_sim: /  /'
+elif [ $rc = 0 ]; then
+  w=$(grep -o "warning: near t = 0.01258650[0-9]* the condition estimate of K fell to [0-9.e+-]*" "$tmp/b.log")
+  [ -n "$w" ] || err "step on the dead point: neither a stop nor a near-singular warning there: $(cat "$tmp/b.log")"
+  awk -v c="${w##* }" 'BEGIN { exit !(c < 1e-12) }' || err "condition estimate at the dead point only fell to ${w##* }"
+  echo "  $w"
+else
+  err "step on the dead point: exit $rc, expected 1 (stop) or 0 (warned)"
+fi
 
 "$MBCC" run "$X/four_bar_change.yaml" -o "$tmp/c.csv" --plot none > "$tmp/c.log" 2>&1 || err "change point run: $(cat "$tmp/c.log")"
 e=$(awk -F, 'NR > 1 { d = $3 - $2; if (d < 0) d = -d; if (d > m) m = d } END { printf "%.2e", m }' "$tmp/c.csv")
