@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <dirent.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -349,8 +350,72 @@ static void settings_from_ir(const ir_sim *s, mb_settings *set) {
   set->alpha = s->baumgarte_alpha; set->beta = s->baumgarte_beta;
 }
 
+/* --- the rebuild stamp: a content hash of what goes into an executable --- */
+
+typedef struct { unsigned long long h; } build_hash;
+
+static void hash_bytes(build_hash *b, const void *data, size_t n) {
+  const unsigned char *p = data;
+  for (size_t i = 0; i < n; i++) { b->h ^= p[i]; b->h *= 1099511628211ULL; } /* FNV-1a */
+}
+
+/* the file's name and contents (a missing file hashes as such) */
+static void hash_file(build_hash *b, const char *path) {
+  hash_bytes(b, path, strlen(path) + 1);
+  FILE *f = fopen(path, "rb");
+  if (!f) { hash_bytes(b, "(missing)", 10); return; }
+  char buf[65536];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, f)) > 0) hash_bytes(b, buf, n);
+  fclose(f);
+}
+
+static int name_cmp(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
+
+/* every .c and .h file of a folder, in name order */
+static void hash_sources_in(build_hash *b, const char *dir) {
+  DIR *d = opendir(dir);
+  if (!d) { hash_bytes(b, dir, strlen(dir) + 1); return; }
+  char *names[512];
+  int nn = 0;
+  for (struct dirent *e; (e = readdir(d)) && nn < 512;) {
+    size_t len = strlen(e->d_name);
+    if (len > 2 && e->d_name[len - 2] == '.' && (e->d_name[len - 1] == 'c' || e->d_name[len - 1] == 'h'))
+      names[nn++] = strdup(e->d_name);
+  }
+  closedir(d);
+  qsort(names, (size_t)nn, sizeof names[0], name_cmp);
+  for (int i = 0; i < nn; i++) {
+    char path[8400];
+    if (names[i]) {
+      snprintf(path, sizeof path, "%s/%s", dir, names[i]);
+      hash_file(b, path);
+    }
+    free(names[i]);
+  }
+}
+
+/* exe's stamp: the compiler command, the generated sources, the runtime
+ * headers and library -- an executable is reused only if all are unchanged */
+static void build_stamp(char *out, size_t n, char *const ccargs[], const char *dir, const char *main_src,
+                        const char *rtlib) {
+  build_hash b = {14695981039346656037ULL};
+  hash_bytes(&b, "mbcc build stamp 1", 19);
+  for (int i = 0; ccargs[i]; i++) hash_bytes(&b, ccargs[i], strlen(ccargs[i]) + 1);
+  hash_sources_in(&b, dir);
+  hash_file(&b, main_src);
+  char rt[8400];
+  snprintf(rt, sizeof rt, "%s/runtime/core", root_dir());
+  hash_sources_in(&b, rt);
+  snprintf(rt, sizeof rt, "%s/runtime/hosted", root_dir());
+  hash_sources_in(&b, rt);
+  hash_file(&b, rtlib);
+  snprintf(out, n, "%016llx", b.h);
+}
+
 /* cc the generated model DIR/NAME.c and the main program 'main_src' against the
- * runtime library into 'exe'; 'extra' are more libraries (NULL-terminated) */
+ * runtime library into 'exe'; 'extra' are more libraries (NULL-terminated).
+ * Not recompiled when EXE.stamp holds the stamp of the same inputs. */
 int compile_generated(const char *dir, const char *name, const char *main_src, const char *exe,
                       char *const extra[], int quiet, int real_float) {
   char src_c[8400], inc[8400], inc_hosted[8400], lib[8400];
@@ -381,15 +446,63 @@ int compile_generated(const char *dir, const char *name, const char *main_src, c
                   "-lblas", "-lm", NULL};
   for (int i = 0; libs[i]; i++) ccargs[nc++] = libs[i];
   ccargs[nc] = NULL;
+  char stamp[32], stamp_path[8500], old[32] = "";
+  build_stamp(stamp, sizeof stamp, ccargs, dir, main_src, lib);
+  snprintf(stamp_path, sizeof stamp_path, "%s.stamp", exe);
+  FILE *sf = fopen(stamp_path, "r");
+  if (sf) {
+    if (!fgets(old, sizeof old, sf)) old[0] = 0;
+    fclose(sf);
+    old[strcspn(old, "\n")] = 0;
+  }
+  if (!strcmp(old, stamp) && access(exe, X_OK) == 0) {
+    if (!quiet) fprintf(stderr, "mbcc: %s is up to date (same generated code, compiler, flags and runtime)\n", exe);
+    return 0;
+  }
+  remove(stamp_path); /* a failed compile leaves no stamp behind */
   if (!quiet) fprintf(stderr, "mbcc: compiling %s\n", src_c);
   if (run_command(ccargs)) {
     fprintf(stderr, "mbcc: error: the C compiler failed on %s\n", src_c);
     return 2;
   }
+  sf = fopen(stamp_path, "w");
+  if (sf) {
+    fprintf(sf, "%s\n", stamp);
+    if (fclose(sf)) remove(stamp_path);
+  }
+  return 0;
+}
+
+/* the simulator's options checked before anything is compiled: the values
+ * the simulator would refuse, and options of other commands */
+static int check_run_options(const options *o) {
+  mb_settings scratch;
+  mb_settings_default(&scratch);
+  for (int i = 0; i < o->nsim; i++) {
+    const char *a = o->sim_args[i], *v = i + 1 < o->nsim ? o->sim_args[i + 1] : "";
+    if (!strcmp(a, "--quiet")) continue;
+    i++;
+    if (!strcmp(a, "--columns")) continue;
+    if (!strcmp(a, "--solver")) {
+      if (strcmp(v, "ldl") && strcmp(v, "klu") && strcmp(v, "dense")) {
+        fprintf(stderr, "mbcc: error: unknown solver '%s' (expected ldl, klu or dense)\n", v);
+        return 2;
+      }
+      continue;
+    }
+    int k = mb_settings_option(&scratch, a, v, "mbcc");
+    if (k < 0) return 2;
+    if (k == 0) {
+      fprintf(stderr, "mbcc: error: '%s' is not an option of mbcc run\n", a);
+      usage();
+      return 2;
+    }
+  }
   return 0;
 }
 
 static int cmd_run(const options *o) {
+  if (check_run_options(o)) return 2;
   char dir[4096];
   lmodel *L = NULL;
   ir_model *ir = NULL;
