@@ -321,6 +321,26 @@ static int plot_csv(const char *csv, const char *png, const char *columns) {
     pick[np++] = c;
   }
   if (np == 0) { fprintf(stderr, "mbcc: error: no columns to plot in '%s'\n", csv); return 2; }
+  /* a column that never changes gets its own y range (gnuplot would warn
+     about an empty one): e.g. a planar mechanism's out-of-plane reactions */
+  double lo[8], hi[8];
+  for (int k = 0; k < np; k++) { lo[k] = INFINITY; hi[k] = -INFINITY; }
+  in = fopen(csv, "r");
+  if (in) {
+    char line[8192];
+    if (!fgets(line, sizeof line, in)) line[0] = 0; /* the header */
+    while (fgets(line, sizeof line, in)) {
+      int c = 0, k = 0;
+      for (char *tok = strtok(line, ",\r\n"); tok && k < np; tok = strtok(NULL, ",\r\n"), c++) {
+        if (c != pick[k]) continue;
+        double x = strtod(tok, NULL);
+        if (x < lo[k]) lo[k] = x;
+        if (x > hi[k]) hi[k] = x;
+        k++;
+      }
+    }
+    fclose(in);
+  }
   char script[4096];
   snprintf(script, sizeof script, "%s.gp", png);
   FILE *g = fopen(script, "w");
@@ -328,8 +348,13 @@ static int plot_csv(const char *csv, const char *png, const char *columns) {
   int rows = (np + 1) / 2, cols = np > 1 ? 2 : 1;
   fprintf(g, "set terminal pngcairo size %d,%d noenhanced font ',9'\nset output '%s'\n", 520 * cols, 300 * rows, png);
   fprintf(g, "set datafile separator ','\nset key off\nset grid\nset multiplot layout %d,%d\n", rows, cols);
-  for (int k = 0; k < np; k++)
+  for (int k = 0; k < np; k++) {
+    if (lo[k] == hi[k] && isfinite(lo[k])) {
+      double d = lo[k] ? 0.01 * fabs(lo[k]) : 1;
+      fprintf(g, "set yrange [%.17g:%.17g]\n", lo[k] - d, hi[k] + d);
+    } else fprintf(g, "set autoscale y\n");
     fprintf(g, "set title '%s'\nset xlabel 't [s]'\nplot '%s' every ::1 using 1:%d with lines lw 1.5\n", names[pick[k]], csv, pick[k] + 1);
+  }
   fprintf(g, "unset multiplot\n");
   fclose(g);
   char *argv[] = {"gnuplot", script, NULL};
