@@ -22,7 +22,7 @@ CC_SRC  := compiler/main.c $(foreach d,$(CC_DIRS),$(wildcard $(d)/*.c))
 B       ?= build
 DEPFLAGS = -MMD -MP
 
-.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser
+.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser scaling
 all: $(B)/mbcc $(B)/libmbrt.a $(B)/libmbrt_float.a
 
 # objects keep the source's folders: $(B)/rt/core/x.o, $(B)/cc/front/x.o
@@ -65,6 +65,11 @@ demo: all
 # the timing comparison of every path (scripts/bench.sh): writes docs/benchmarks.md
 bench: all
 	MBCC=$(B)/mbcc sh scripts/bench.sh
+
+# build and run time against model size on pendulum chains (scripts/scaling.sh):
+# writes docs/scaling.md; SIZES="5 10 20" for a quick one
+scaling: all
+	MBCC=$(B)/mbcc bash scripts/scaling.sh
 
 # the speed/accuracy study (scripts/trade.sh): writes docs/trade.md and docs/img/trade_*.png
 trade: all

@@ -42,6 +42,7 @@ present() {
     nodejs)             command -v node ;;
     npm)                command -v npm ;;
     chromium)           command -v chromium ;;
+    time)               [ -x /usr/bin/time ] ;;
     *)                  false ;;
   esac >/dev/null 2>&1
 }
@@ -50,8 +51,9 @@ present() {
 # nodejs and npm build the animation player (make web: three.js, esbuild);
 # chromium plays the pages in make test-browser.  A Node.js installed some
 # other way (with its own npm) counts as present.
+# time (/usr/bin/time, peak memory) is for make scaling.
 packages=(build-essential libyaml-dev libsuitesparse-dev liblapack-dev libblas-dev
-          libcmocka-dev libsundials-dev libarpack2-dev gnuplot-nox clang nodejs npm chromium)
+          libcmocka-dev libsundials-dev libarpack2-dev gnuplot-nox clang nodejs npm chromium time)
 missing=()
 for p in "${packages[@]}"; do
   present "$p" || missing+=("$p")
