@@ -8,11 +8,13 @@
 # per-step times of generated+ldl and generic+klu (repetitions interleaved,
 # set-up left out).  Called by `make scaling` after `make all`.
 # Environment: MBCC (default build/mbcc), SIZES (links, default
-# "5 10 20 50 100 200 500 1000"), REPS (default 3), END (simulated time,
-# default 0.01 s), TIMEOUT (seconds allowed to one C compile, default 3600: a
+# "5 10 20 50 100 200 500 1000"), REPS (default 5), END (simulated time,
+# default 0.1 s: 20 to 50 steps), TIMEOUT (seconds allowed to one C compile, default 3600: a
 # size that does not build within it is reported as such and larger ones are
 # skipped), OUT (default docs/scaling.md), NOTE (a line about the machine).
-# Work files go to build/scaling/.
+# Work files go to build/scaling/ and are kept: a second run reuses each
+# size's benchmark executable when its inputs are unchanged (mbcc's build
+# stamp), and reports the C compile measured when it was built.
 set -euo pipefail
 export LC_ALL=C
 cd "$(dirname "$0")/.."
@@ -20,8 +22,8 @@ ROOT=$(pwd)
 MBCC=${MBCC:-build/mbcc}
 case $MBCC in /*) ;; *) MBCC=$ROOT/$MBCC ;; esac
 SIZES=${SIZES:-5 10 20 50 100 200 500 1000}
-REPS=${REPS:-3}
-END=${END:-0.01}
+REPS=${REPS:-5}
+END=${END:-0.1}
 TIMEOUT=${TIMEOUT:-3600}
 OUT=${OUT:-docs/scaling.md}
 W=$ROOT/build/scaling
@@ -29,7 +31,6 @@ die() { echo "scaling: error: $*" >&2; exit 1; }
 say() { echo "scaling: $*" >&2; }
 [ -x "$MBCC" ] || die "$MBCC not found: run 'make all' first"
 [ -x /usr/bin/time ] || die "/usr/bin/time not found (Debian package 'time': scripts/install-deps.sh)"
-rm -rf "$W"
 mkdir -p "$W"
 
 # the C compiler mbcc runs, timed: one line "wall user+sys maxrss_kB" per call
@@ -56,7 +57,7 @@ for n in $SIZES; do
   csize=$(wc -c < "$d/gen/chain$n.c")
   ldl=$("$MBCC" check "$d/chain$n.yaml" | sed -n 's/^  LDL^T code *//p' | cut -d' ' -f1)
   say "chain of $n links: mbcc bench (C compile of up to $TIMEOUT s, then $REPS interleaved rounds)"
-  : > "$d/cc.time"
+  touch "$d/cc.time" # one line a compile: kept, for an executable reused unchanged
   if ! (cd "$d" && SCALING_CC_LOG="$d/cc.time" CC="$W/timed-cc" "$MBCC" bench "chain$n.yaml" \
         --paths generated+ldl,generic+klu --reps "$REPS" --end "$END" --csv bench.csv --quiet) \
         > "$d/bench.txt" 2> "$d/bench.log"; then
@@ -67,6 +68,7 @@ for n in $SIZES; do
     fi
     die "mbcc bench of the $n-link chain failed: $(tail -3 "$d/bench.log")"
   fi
+  [ -s "$d/cc.time" ] || die "no C compile recorded for the $n-link chain (remove $d and run again)"
   read -r _ cu cs ck < <(tail -n 1 "$d/cc.time")
   read -r gen gnc < <(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
     $c["path"] == "generated+ldl" { g = $c["step_median_s"] } $c["path"] == "generic+klu" { k = $c["step_median_s"] }

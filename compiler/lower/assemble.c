@@ -237,13 +237,11 @@ static int *row_order(const lmodel *L) {
 }
 
 /* a minimum-norm correction x (nv) with D x = b on a basis of D's rows */
-static int min_norm_step(const lmodel *L, const rows_matrix *D, const int *order, const double *b, double *x,
-                         cholmod_common *cc) {
+static int min_norm_step(const rows_matrix *D, const int *order, const double *b, double *x, cholmod_common *cc) {
   row_basis B;
   if (basis_factor(D, order, &B, cc)) return -1;
   int rc = basis_min_norm(&B, D, b, x);
   basis_free(&B, cc);
-  (void)L;
   return rc;
 }
 
@@ -332,7 +330,7 @@ int assemble_model(lmodel *L, int verbose) {
     /* deform the bodies only if they must */
     if (rows_from_K(m, e.Kx, it < 25 ? frozen : NULL, &D)) goto out;
     for (int r = 0; r < m->nc; r++) b[r] = -e.phi[r];
-    if (min_norm_step(L, &D, order, b, dx, &cc)) goto out;
+    if (min_norm_step(&D, order, b, dx, &cc)) goto out;
     mb_model_qincrement(m, L->q0, dx);
     mb_model_normalize(m, L->q0);
   }
@@ -377,7 +375,7 @@ int assemble_model(lmodel *L, int verbose) {
   if (m->nc > 0) {
     if (rows_from_K(m, e.Kx, frozen, &D)) goto out;
     for (int r = 0; r < m->nc; r++) b[r] = -e.nu[r];
-    if (min_norm_step(L, &D, order, b, dx, &cc)) goto out;
+    if (min_norm_step(&D, order, b, dx, &cc)) goto out;
     for (int j = 0; j < m->nv; j++) L->v0[j] += dx[j];
   }
 
