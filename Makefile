@@ -22,7 +22,7 @@ CC_SRC  := compiler/main.c compiler/help.c compiler/paths.c $(foreach d,$(CC_DIR
 B       ?= build
 DEPFLAGS = -MMD -MP
 
-.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser embedded man release-check install
+.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser embedded man release-check  install scaling
 all: $(B)/mbcc $(B)/libmbrt.a $(B)/libmbrt_float.a
 
 # objects keep the source's folders: $(B)/rt/core/x.o, $(B)/cc/front/x.o
@@ -52,8 +52,9 @@ $(B)/cc/%.o: compiler/%.c
 	$(CC) $(STD) $(WARN) $(CFLAGS) $(DEPFLAGS) $(CC_INC) $(CC_DEFS) -c $< -o $@
 
 CC_OBJ := $(patsubst compiler/%.c,$(B)/cc/%.o,$(CC_SRC))
+# the assembly analysis (compiler/lower/assemble.c) uses SuiteSparseQR and CHOLMOD
 $(B)/mbcc: $(CC_OBJ) $(B)/libmbrt.a
-	$(CC) $(CFLAGS) $(CC_OBJ) $(B)/libmbrt.a $(LIBS) -lcamd -o $@
+	$(CC) $(CFLAGS) $(CC_OBJ) $(B)/libmbrt.a -lspqr $(LIBS) -lcamd -o $@
 
 -include $(CC_OBJ:.o=.d) $(patsubst runtime/%.c,$(B)/rt/%.d,$(RT_SRC)) \
          $(patsubst runtime/%.c,$(B)/rt-float/%.d,$(RT_FLOAT_SRC))
@@ -64,6 +65,11 @@ demo: all
 # the timing comparison of every path (scripts/bench.sh): writes docs/benchmarks.md
 bench: all
 	MBCC=$(B)/mbcc sh scripts/bench.sh
+
+# build and run time against model size on pendulum chains (scripts/scaling.sh):
+# writes docs/scaling.md; SIZES="5 10 20" for a quick one
+scaling: all
+	MBCC=$(B)/mbcc bash scripts/scaling.sh
 
 # the speed/accuracy study (scripts/trade.sh): writes docs/trade.md and docs/img/trade_*.png
 trade: all

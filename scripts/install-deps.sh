@@ -30,7 +30,8 @@ present() {
     build-essential)    command -v cc && command -v make && [ -e /usr/include/stdio.h ] ;;
     libyaml-dev)        [ -e /usr/include/yaml.h ] && links yaml ;;
     libsuitesparse-dev) [ -e /usr/include/suitesparse/klu.h ] && links klu &&
-                        [ -e /usr/include/suitesparse/cholmod.h ] && links cholmod ;;
+                        [ -e /usr/include/suitesparse/cholmod.h ] && links cholmod &&
+                        [ -e /usr/include/suitesparse/SuiteSparseQR_C.h ] && links spqr ;;
     liblapack-dev)      links lapack ;;
     libblas-dev)        links blas ;;
     libcmocka-dev)      [ -e /usr/include/cmocka.h ] && links cmocka ;;
@@ -46,6 +47,7 @@ present() {
     qemu-system-arm)    command -v qemu-system-arm ;;
     pkgconf)            command -v pkg-config ;;
     libclang-rt-14-dev) [ -e "$(clang -print-file-name=libclang_rt.fuzzer-x86_64.a)" ] ;; # make fuzz
+    time)               [ -x /usr/bin/time ] ;;
     *)                  false ;;
   esac >/dev/null 2>&1
 }
@@ -56,11 +58,11 @@ present() {
 # other way (with its own npm) counts as present.  The embedded target's cross
 # compiler, newlib (libm) and qemu (tests/test_embedded.sh): 97 MB to download,
 # 924 MB installed, about 2 minutes of apt (measured).  pkgconf (pkg-config)
-# for tests/test_install.sh.
+# for tests/test_install.sh; libclang-rt-14-dev (libFuzzer) for make fuzz;
+# time (/usr/bin/time, peak memory) for make scaling.
 packages=(build-essential libyaml-dev libsuitesparse-dev liblapack-dev libblas-dev
           libcmocka-dev libsundials-dev libarpack2-dev gnuplot-nox clang nodejs npm chromium
-          gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm pkgconf)
-          libcmocka-dev libsundials-dev libarpack2-dev gnuplot-nox clang nodejs npm chromium libclang-rt-14-dev)
+          gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm pkgconf libclang-rt-14-dev time)
 missing=()
 for p in "${packages[@]}"; do
   present "$p" || missing+=("$p")

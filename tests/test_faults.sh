@@ -26,8 +26,9 @@ child_of() {
     sleep 0.1
   done
 }
-# (NAME.csv.units is a result of its own, the columns' units)
-leftovers() { find . -name '*.XXXXXX' -o -name '*.tmp.*' -o -name '*.csv.*' -o -name '*.png.*' -o -name '*_sim.*' | grep -v '\.log$\|\.csv\.units$'; }
+# (NAME.csv.units is a result of its own, the columns' units; NAME_sim.stamp
+# the simulator's rebuild stamp)
+leftovers() { find . -name '*.XXXXXX' -o -name '*.tmp.*' -o -name '*.csv.*' -o -name '*.png.*' -o -name '*_sim.*' | grep -v '\.log$\|\.csv\.units$\|_sim\.stamp$'; }
 
 # 1. concurrent runs
 mkdir c && cd c || exit 1

@@ -14,6 +14,7 @@
  * the kernels' own (up to the sign of a zero); test_generic and test_ldl
  * compare the two paths. */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "emit_rows.h"
@@ -458,33 +459,49 @@ static int dot1_frames(const lmodel *L, int r, int *b0, int *b1) {
 
 static void rel_name(char *o, int b0, int b1, int k, int l) { snprintf(o, EXPR, "rr%d_%d_%d%d", b0, b1, k, l); }
 
+/* a dot-1 row of a pair of body frames: the pair first, for the sort */
+typedef struct { int b0, b1, r; } frame_pair_row;
+
+static int frame_pair_cmp(const void *x, const void *y) {
+  const frame_pair_row *a = x, *b = y;
+  if (a->b0 != b->b0) return a->b0 < b->b0 ? -1 : 1;
+  if (a->b1 != b->b1) return a->b1 < b->b1 ? -1 : 1;
+  return a->r < b->r ? -1 : a->r > b->r;
+}
+
 void emit_rows_shared(FILE *f, const lmodel *L) {
   const mb_model *m = &L->m;
-  int nb = m->nbody;
-  for (int b0 = 0; b0 < nb; b0++)
-    for (int b1 = 0; b1 < nb; b1++) {
-      int need[9] = {0}, any = 0, x0, x1;
-      for (int r = 0; r < m->nrow; r++) {
-        if (!dot1_frames(L, r, &x0, &x1) || x0 != b0 || x1 != b1) continue;
-        int i = L->row[r].a, j = L->row[r].b;
-        for (int k = 0; k < 3; k++) need[3 * k + j] = need[3 * i + k] = 1; /* column j, row i */
-        any = 1;
-      }
-      if (!any) continue;
-      fprintf(f, "  /* relative rotation A0^T A1 of body '%s' to body '%s' (the entries its dot-1 rows\n"
-                 "     use) and |w0 - w1|^2 */\n", L->body[b0].name, L->body[b1].name);
-      for (int k = 0; k < 3; k++)
-        for (int l = 0; l < 3; l++) {
-          if (!need[3 * k + l]) continue;
-          char nmv[EXPR];
-          rel_name(nmv, b0, b1, k, l);
-          fprintf(f, "  const mb_real %s = f%d.A[%d] * f%d.A[%d] + f%d.A[%d] * f%d.A[%d] + f%d.A[%d] * f%d.A[%d];\n",
-                  nmv, b0, k, b1, l, b0, 3 + k, b1, 3 + l, b0, 6 + k, b1, 6 + l);
-        }
-      fprintf(f, "  mb_real dd%d_%d;\n  {\n    mb_real dw[3] = {f%d.w[0] - f%d.w[0], f%d.w[1] - f%d.w[1], f%d.w[2] - f%d.w[2]};\n"
-                 "    dd%d_%d = dw[0] * dw[0] + dw[1] * dw[1] + dw[2] * dw[2];\n  }\n",
-              b0, b1, b0, b1, b0, b1, b0, b1, b0, b1);
+  /* the rows grouped by pair, pairs in (b0, b1) order: one pass and a sort,
+     not a pass over the rows for every pair of bodies (cubic in a chain) */
+  frame_pair_row *pr = malloc(sizeof *pr * ((size_t)m->nrow + 1));
+  int npr = 0;
+  if (!pr) { fprintf(stderr, "mbcc: error: out of memory while emitting\n"); exit(2); }
+  for (int r = 0; r < m->nrow; r++) {
+    int x0, x1;
+    if (dot1_frames(L, r, &x0, &x1)) pr[npr++] = (frame_pair_row){x0, x1, r};
+  }
+  qsort(pr, (size_t)npr, sizeof *pr, frame_pair_cmp);
+  for (int first = 0, last; first < npr; first = last) {
+    int b0 = pr[first].b0, b1 = pr[first].b1, need[9] = {0};
+    for (last = first; last < npr && pr[last].b0 == b0 && pr[last].b1 == b1; last++) {
+      int i = L->row[pr[last].r].a, j = L->row[pr[last].r].b;
+      for (int k = 0; k < 3; k++) need[3 * k + j] = need[3 * i + k] = 1; /* column j, row i */
     }
+    fprintf(f, "  /* relative rotation A0^T A1 of body '%s' to body '%s' (the entries its dot-1 rows\n"
+               "     use) and |w0 - w1|^2 */\n", L->body[b0].name, L->body[b1].name);
+    for (int k = 0; k < 3; k++)
+      for (int l = 0; l < 3; l++) {
+        if (!need[3 * k + l]) continue;
+        char nmv[EXPR];
+        rel_name(nmv, b0, b1, k, l);
+        fprintf(f, "  const mb_real %s = f%d.A[%d] * f%d.A[%d] + f%d.A[%d] * f%d.A[%d] + f%d.A[%d] * f%d.A[%d];\n",
+                nmv, b0, k, b1, l, b0, 3 + k, b1, 3 + l, b0, 6 + k, b1, 6 + l);
+      }
+    fprintf(f, "  mb_real dd%d_%d;\n  {\n    mb_real dw[3] = {f%d.w[0] - f%d.w[0], f%d.w[1] - f%d.w[1], f%d.w[2] - f%d.w[2]};\n"
+               "    dd%d_%d = dw[0] * dw[0] + dw[1] * dw[1] + dw[2] * dw[2];\n  }\n",
+            b0, b1, b0, b1, b0, b1, b0, b1, b0, b1);
+  }
+  free(pr);
 }
 
 static void emit_dot1_frames(FILE *f, const lmodel *L, int r, int b0, int b1) {

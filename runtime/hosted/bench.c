@@ -1,6 +1,7 @@
 /* bench.c: `mbcc bench`: the same simulation through every path (generated
  * and generic evaluation x ldl, klu, dense; SUNDIALS IDA), timed as medians
- * over repetitions, with the trajectories compared against the first path. */
+ * over repetitions interleaved round after round, with set-up timed apart
+ * from the steps, and the trajectories compared against the first path. */
 #define _POSIX_C_SOURCE 199309L
 #include <math.h>
 #include <stdio.h>
@@ -57,8 +58,9 @@ typedef struct {
   int state;           /* 0 not selected, 1 ran, 2 skipped, 3 failed */
   char note[200];
   int n, nnz;          /* system dimension and nnz of its matrix */
-  double step_med, run_med;
+  double step_med, run_med, setup_med;
   long steps, evals;
+  double *walls, *setups, *per; /* per repetition: whole run, its set-up, (run - set-up) / steps */
   double residual;     /* ldl: largest relative residual of a solve after refinement */
   double max_rel;      /* against the reference path, every output */
   int worst_col;
@@ -77,10 +79,12 @@ static double median(double *a, int n) {
   return n % 2 ? a[n / 2] : 0.5 * (a[n / 2 - 1] + a[n / 2]);
 }
 
-/* one run of path p; its wall time, steps and the recorded outputs */
+/* one run of path p: its wall time, the part of it spent setting up (solver
+ * creation, symbolic analysis, initial state: not in the per-step figure),
+ * steps and the recorded outputs */
 static int run_once(const path_def *p, const mb_model *m, const mb_settings *set, double ida_rtol,
                     recorder *rec,
-                    double *wall, long *steps, long *evals, double *residual, double *fail_time,
+                    double *wall, double *setup, long *steps, long *evals, double *residual, double *fail_time,
                     char *detail, size_t ndetail) {
   rec->nrows = 0;
   detail[0] = 0;
@@ -95,6 +99,7 @@ static int run_once(const path_def *p, const mb_model *m, const mb_settings *set
     }
     st = mb_ida_simulate(m, &ida_set, record, rec, &stats, fail_time);
     *wall = now() - t0;
+    *setup = stats.t_setup;
     *steps = stats.steps;
     *evals = stats.evals;
     if (st) snprintf(detail, ndetail, "%s", mb_status_text(st));
@@ -104,6 +109,7 @@ static int run_once(const path_def *p, const mb_model *m, const mb_settings *set
   if (!ls) return -1;
   mb_sim sim;
   st = mb_sim_init(&sim, m, ls, set);
+  *setup = now() - t0;
   if (!st) st = mb_sim_run(&sim, record, rec);
   *wall = now() - t0;
   *steps = sim.stats.steps;
@@ -257,10 +263,9 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
   long nout = (long)floor(set.end_time / set.output_step + 1e-9) + 1;
   path_result res[NPATH];
   memset(res, 0, sizeof res);
-  double *walls = malloc(sizeof(double) * (size_t)reps), *per = malloc(sizeof(double) * (size_t)reps);
-  if (!walls || !per) { free(walls); free(per); fprintf(stderr, "%s: error: out of memory\n", argv[0]); return 1; }
   int rc = 0, ref = -1;
 
+  /* set-up: the paths that can run, their recorders and timing slots */
   for (int p = 0; p < NPATH; p++) {
     const path_def *pd = &PATHS[p];
     path_result *r = &res[p];
@@ -282,27 +287,53 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
     r->rec.cap = (int)nout + 1;
     r->rec.y = malloc(sizeof(double) * (size_t)r->rec.cap * (size_t)(m->ncols + 1));
     r->rec.work = malloc(mb_model_worksize(m) + 16);
-    if (!r->rec.y || !r->rec.work) { r->state = 3; snprintf(r->note, sizeof r->note, "out of memory"); rc = 1; continue; }
-    if (!quiet) fprintf(stderr, "bench: %-16s", pd->name);
+    r->walls = malloc(sizeof(double) * (size_t)reps);
+    r->setups = malloc(sizeof(double) * (size_t)reps);
+    r->per = malloc(sizeof(double) * (size_t)reps);
+    if (!r->rec.y || !r->rec.work || !r->walls || !r->setups || !r->per) {
+      r->state = 3; snprintf(r->note, sizeof r->note, "out of memory"); rc = 1; continue;
+    }
     r->state = 1;
-    for (int k = 0; k < reps; k++) {
+  }
+
+  /* the repetitions interleaved, round after round (each round starting one
+     path later), so that a machine's changing load falls on every path alike
+     rather than on whichever ran during it */
+  int order[NPATH], nrun = 0;
+  for (int p = 0; p < NPATH; p++)
+    if (res[p].state == 1) order[nrun++] = p;
+  for (int k = 0; k < reps; k++) {
+    if (!quiet) fprintf(stderr, "bench: round %d/%d:", k + 1, reps);
+    for (int i = 0; i < nrun; i++) {
+      int p = order[(i + k) % nrun];
+      const path_def *pd = &PATHS[p];
+      path_result *r = &res[p];
+      if (r->state != 1) continue;
+      const mb_model *pm = pd->eval == EVAL_GENERIC ? &generic : m;
       double ft = 0;
       char detail[160];
-      int st = run_once(pd, pm, &set, ida_rtol, &r->rec, &walls[k], &r->steps, &r->evals, &r->residual, &ft,
-                        detail, sizeof detail);
+      int st = run_once(pd, pm, &set, ida_rtol, &r->rec, &r->walls[k], &r->setups[k], &r->steps, &r->evals,
+                        &r->residual, &ft, detail, sizeof detail);
       if (st) {
         r->state = 3;
         snprintf(r->note, sizeof r->note, "failed at t = %.6g: %s", ft, detail);
         rc = 1;
-        break;
+        if (!quiet) fprintf(stderr, " %s %s", pd->name, r->note);
+        continue;
       }
-      per[k] = r->steps > 0 ? walls[k] / (double)r->steps : walls[k];
-      if (!quiet) fprintf(stderr, " %.3gs", walls[k]);
+      double stepping = r->walls[k] - r->setups[k];
+      r->per[k] = r->steps > 0 ? stepping / (double)r->steps : stepping;
+      if (!quiet) fprintf(stderr, " %s %.3gs", pd->name, r->walls[k]);
     }
-    if (!quiet) fprintf(stderr, "%s%s\n", r->state == 3 ? " " : "", r->state == 3 ? r->note : "");
+    if (!quiet) fprintf(stderr, "\n");
+  }
+
+  for (int p = 0; p < NPATH; p++) {
+    path_result *r = &res[p];
     if (r->state != 1) continue;
-    r->run_med = median(walls, reps);
-    r->step_med = median(per, reps);
+    r->run_med = median(r->walls, reps);
+    r->setup_med = median(r->setups, reps);
+    r->step_med = median(r->per, reps);
     if (ref < 0) ref = p;
     r->max_rel = compare(m, &res[ref].rec, &r->rec, 0, &r->worst_col);
     r->max_rel_pos = compare(m, &res[ref].rec, &r->rec, 1, &r->worst_col_pos);
@@ -311,8 +342,6 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
     else if (r->residual > 0)
       snprintf(r->note, sizeof r->note, "solve residual <= %.1e", r->residual);
   }
-  free(walls);
-  free(per);
 
   /* run ratios against the fastest run; per-step ratios against the fastest step of the
      paths that share the integrator (IDA's BDF steps are other steps) */
@@ -337,14 +366,14 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
          reps, reps == 1 ? "" : "s");
   if (ida_rtol > 0 && selected(paths, "ida"))
     printf("ida: rtol %g, atol %g (--ida-rtol)\n", ida_rtol, set.atol * ida_rtol / set.rtol);
-  printf("\n%-16s %5s %7s %7s %8s %13s %10s %7s %7s %12s %10s\n", "path", "n", "nnz(K)", "nnz(L)",
-         "steps", "per step [s]", "run [s]", "ratio", "r.step", "max rel diff", "positions");
+  printf("\n%-16s %5s %7s %7s %8s %13s %10s %10s %7s %7s %12s %10s\n", "path", "n", "nnz(K)", "nnz(L)",
+         "steps", "per step [s]", "run [s]", "set-up [s]", "ratio", "r.step", "max rel diff", "positions");
   for (int p = 0; p < NPATH; p++) {
     const path_result *r = &res[p];
     if (!r->state) continue;
     if (r->state != 1) { printf("%-16s %5d %7d %7s  %s\n", PATHS[p].name, r->n, r->nnz, "-", r->note); continue; }
-    printf("%-16s %5d %7d %7s %8ld %13.4g %10.4g %7.2f %7.2f %12.3g %10.3g", PATHS[p].name, r->n,
-           r->nnz, PATHS[p].eval == EVAL_IDA ? "-" : nl, r->steps, r->step_med, r->run_med,
+    printf("%-16s %5d %7d %7s %8ld %13.4g %10.4g %10.3g %7.2f %7.2f %12.3g %10.3g", PATHS[p].name, r->n,
+           r->nnz, PATHS[p].eval == EVAL_IDA ? "-" : nl, r->steps, r->step_med, r->run_med, r->setup_med,
            r->run_med / best_run, r->step_med / best_step, r->max_rel, r->max_rel_pos);
     if (p == ref) printf("  (reference)");
     else if (r->worst_col >= 0 && r->max_rel > 0) {
@@ -356,7 +385,10 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
     if (r->note[0]) printf("  %s", r->note);
     printf("\n");
   }
-  printf("\nratio: whole-run time / the fastest path's; r.step: per-step time / the fastest per-step\n"
+  printf("\nrepetitions interleaved, round after round.  run: whole-run time (medians over the\n"
+         "repetitions); set-up: its part before the first step (solver, symbolic analysis, initial\n"
+         "state), left out of per step = (run - set-up) / steps.\n"
+         "ratio: whole-run time / the fastest path's; r.step: per-step time / the fastest per-step\n"
          "time of the paths that use %s.\n"
          "max rel diff: largest |difference| from the reference path over all outputs and output\n"
          "times, relative to the range of that output over the run (for a vector output, the largest\n"
@@ -370,19 +402,20 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
     snprintf(tmp, sizeof tmp, "%s.part", csv_path);
     FILE *f = fopen(tmp, "w");
     if (!f) { fprintf(stderr, "%s: error: cannot write '%s'\n", argv[0], tmp); rc = 2; goto out; }
-    fprintf(f, "path,n,nnz_K,nnz_L,step_median_s,run_s,ratio,steps,max_rel_diff,step_ratio,status,max_rel_diff_positions,worst_output,worst_output_positions\n");
+    fprintf(f, "path,n,nnz_K,nnz_L,step_median_s,run_s,ratio,steps,max_rel_diff,step_ratio,status,max_rel_diff_positions,worst_output,worst_output_positions,setup_s\n");
     for (int p = 0; p < NPATH; p++) {
       const path_result *r = &res[p];
       if (!r->state) continue;
       const char *l = PATHS[p].eval == EVAL_IDA ? "-" : nl;
       if (r->state == 1)
-        fprintf(f, "%s,%d,%d,%s,%.6g,%.6g,%.4f,%ld,%.3g,%.4f,ok,%.3g,%s,%s\n", PATHS[p].name, r->n,
+        fprintf(f, "%s,%d,%d,%s,%.6g,%.6g,%.4f,%ld,%.3g,%.4f,ok,%.3g,%s,%s,%.6g\n", PATHS[p].name, r->n,
                 r->nnz, l, r->step_med, r->run_med, r->run_med / best_run, r->steps, r->max_rel,
                 r->step_med / best_step, r->max_rel_pos,
                 r->worst_col >= 0 && r->max_rel > 0 ? m->col_name[r->worst_col] : "",
-                r->worst_col_pos >= 0 && r->max_rel_pos > 0 ? m->col_name[r->worst_col_pos] : "");
+                r->worst_col_pos >= 0 && r->max_rel_pos > 0 ? m->col_name[r->worst_col_pos] : "",
+                r->setup_med);
       else
-        fprintf(f, "%s,%d,%d,%s,,,,,,,%s,,,\n", PATHS[p].name, r->n, r->nnz, l,
+        fprintf(f, "%s,%d,%d,%s,,,,,,,%s,,,,\n", PATHS[p].name, r->n, r->nnz, l,
                 r->state == 2 ? "skipped" : "failed");
     }
     if (fclose(f) || rename(tmp, csv_path)) {
@@ -394,6 +427,9 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
     }
   }
 out:
-  for (int p = 0; p < NPATH; p++) { free(res[p].rec.y); free(res[p].rec.work); }
+  for (int p = 0; p < NPATH; p++) {
+    free(res[p].rec.y); free(res[p].rec.work);
+    free(res[p].walls); free(res[p].setups); free(res[p].per);
+  }
   return rc;
 }

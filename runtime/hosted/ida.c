@@ -203,6 +203,7 @@ int mb_ida_simulate(const mb_model *m, const mb_settings *s, mb_output_fn out, v
   if (!A || !LS) { st = MB_ERR_NOMEM; goto done; }
   if ((flag = IDASetLinearSolver(mem, LS, A))) { st = map_flag(flag); goto done; }
 
+  if (stats) stats->t_setup = now() - wall0;
   if ((st = emit(&c, 0, y, out, user, &stop)) || stop) goto done;
   for (long k = 1; k <= nout; k++) {
     double tout = (double)k * s->output_step, tret = t;

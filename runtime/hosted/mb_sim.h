@@ -31,6 +31,7 @@ typedef struct {
   long factorizations, full_factorizations;
   long newton_iterations, newton_failures; /* generalized-alpha */
   double t_assembly, t_solve, t_total; /* seconds (assembly, solve: 0 without timers) */
+  double t_setup;                      /* IDA: seconds of t_total before its first step */
   double max_phi, max_phid;            /* largest constraint violations seen at outputs */
   double rcond_first, rcond_min, rcond_min_t; /* KLU's condition estimate of K: first, smallest, when */
 } mb_stats;
