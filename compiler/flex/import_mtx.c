@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "diag.h"
+#include "yaml_map.h"
 #include "fe_import.h"
 
 typedef struct {
@@ -20,14 +21,8 @@ typedef struct {
   int errors;
 } text_file;
 
-static void *mtx_alloc(size_t n, size_t size) {
-  void *p = calloc(n ? n : 1, size);
-  if (!p) {
-    fprintf(stderr, "mbcc: out of memory\n");
-    exit(2);
-  }
-  return p;
-}
+/* the reader's allocator: out of memory unwinds to ir_read, which reports it */
+static void *mtx_alloc(size_t n, size_t size) { return xcalloc(n ? n : 1, size); }
 
 #if defined(__GNUC__) || defined(__clang__)
 __attribute__((format(printf, 3, 4)))
@@ -298,7 +293,7 @@ int fe_import_mtx(const fe_mtx_files *files, ir_flex *fx, double **global) {
       cap = cap ? 2 * cap : 64;
       long *ni = realloc(ids, (size_t)cap * sizeof *ni);
       double *nx = realloc(x, 3 * (size_t)cap * sizeof *nx);
-      if (!ni || !nx) { fprintf(stderr, "mbcc: out of memory\n"); exit(2); }
+      if (!ni || !nx) out_of_memory();
       ids = ni;
       x = nx;
     }

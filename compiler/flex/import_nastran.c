@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "diag.h"
+#include "yaml_map.h"
 #include "fe_import.h"
 
 #define NAS_PI 3.14159265358979323846
@@ -39,14 +40,8 @@ typedef struct {
   int done; /* ENDDATA seen */
 } nas_deck;
 
-static void *nas_alloc(size_t n, size_t size) {
-  void *p = calloc(n ? n : 1, size);
-  if (!p) {
-    fprintf(stderr, "mbcc: out of memory\n");
-    exit(2);
-  }
-  return p;
-}
+/* the reader's allocator: out of memory unwinds to ir_read, which reports it */
+static void *nas_alloc(size_t n, size_t size) { return xcalloc(n ? n : 1, size); }
 
 #if defined(__GNUC__) || defined(__clang__)
 __attribute__((format(printf, 4, 5)))
@@ -63,7 +58,7 @@ static nas_card *new_card(nas_deck *d, const char *name, const char *file, ir_lo
   if (d->ncards == d->cap) {
     d->cap = d->cap ? 2 * d->cap : 64;
     nas_card *c = realloc(d->cards, (size_t)d->cap * sizeof *c);
-    if (!c) { fprintf(stderr, "mbcc: out of memory\n"); exit(2); }
+    if (!c) out_of_memory();
     d->cards = c;
   }
   nas_card *c = &d->cards[d->ncards++];
@@ -81,7 +76,7 @@ static nas_card *new_card(nas_deck *d, const char *name, const char *file, ir_lo
 static void add_line_fields(nas_card *c, nas_field *data, int n) {
   int base = c->nf;
   nas_field *f = realloc(c->f, (size_t)(base + 8) * sizeof *f);
-  if (!f) { fprintf(stderr, "mbcc: out of memory\n"); exit(2); }
+  if (!f) out_of_memory();
   c->f = f;
   for (int i = 0; i < 8; i++) {
     if (i < n) c->f[base + i] = data[i];
@@ -253,7 +248,7 @@ static int read_file(nas_deck *d, const char *path, const char *from, ir_loc fro
     return -1;
   }
   char **files = realloc(d->files, (size_t)(d->nfiles + 1) * sizeof *files);
-  if (!files) { fprintf(stderr, "mbcc: out of memory\n"); exit(2); }
+  if (!files) out_of_memory();
   d->files = files;
   char *kept = nas_alloc(strlen(path) + 1, 1);
   strcpy(kept, path);
@@ -991,7 +986,7 @@ int fe_import_nastran(const char *path, ir_flex *fx, double **global) {
         if (nlinks == capl) {
           capl = capl ? 2 * capl : 16;
           ir_rigid_link *l = realloc(links, (size_t)capl * sizeof *l);
-          if (!l) { fprintf(stderr, "mbcc: out of memory\n"); exit(2); }
+          if (!l) out_of_memory();
           links = l;
         }
         links[nlinks++] = (ir_rigid_link){gn, g, comps, field_loc(c, k)};
