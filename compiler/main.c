@@ -495,6 +495,15 @@ static int check_run_options(const options *o) {
     if (!strcmp(a, "--quiet")) continue;
     i++;
     if (!strcmp(a, "--columns")) continue;
+    if (!strcmp(a, "--precision")) { /* the CSV writer's (driver.c), checked the same way */
+      char *end;
+      double d = strtod(v, &end);
+      if (end == v || *end || !(d >= 1 && d <= 17) || d != (int)d) {
+        fprintf(stderr, "mbcc: error: '--precision' needs a number of digits from 1 to 17, got '%s'\n", v);
+        return 2;
+      }
+      continue;
+    }
     if (!strcmp(a, "--solver")) {
       if (strcmp(v, "ldl") && strcmp(v, "klu") && strcmp(v, "dense")) {
         fprintf(stderr, "mbcc: error: unknown solver '%s' (expected ldl, klu or dense)\n", v);

@@ -89,7 +89,7 @@ Each is checked before the work it bounds, with a message naming it.
 | nesting of brackets in YAML | $(limit LIMIT_YAML_DEPTH) | before parsing (linear scan) | — |
 | magnitude of any number | $(limit LIMIT_MAGNITUDE) | reader, file:line:col | — |
 | counts and indices (modes, nodes, mode numbers) | $(limit LIMIT_COUNT) | reader, before any conversion to int | — |
-| bodies | $(limit LIMIT_BODIES) | reader, before the dense constraint analysis | \`MBCC_MAX_BODIES=N\` |
+| bodies | $(limit LIMIT_BODIES) | reader, before the analysis (the emitted code grows with the model) | \`MBCC_MAX_BODIES=N\` |
 | free FE degrees of freedom of a dense eigenproblem (eigensolver: dense, Craig-Bampton; auto goes sparse above 3000) | $(limit LIMIT_FE_DOFS) | FE modes, before the dense eigenproblem | \`MBCC_MAX_FE_DOFS=N\` |
 | output rows (end time / output step + 1) | 1e7 | simulator, before the run | \`MB_MAX_ROWS=N\` |
 | end time | 1e9 s, and the output step must change it | simulator, before the run | — |

@@ -37,7 +37,7 @@ FUZZ_SRC     := tests/fuzz/fuzz_front.c runtime/core/model_generic.c \
                 $(filter-out compiler/main.c compiler/tools/%,$(CC_SRC))
 $(FUZZ_B)/fuzz_front: $(FUZZ_SRC) $(wildcard compiler/*/*.h runtime/*/*.h)
 	@mkdir -p $(@D)
-	$(FUZZ_CC) $(STD) $(FUZZ_FLAGS) $(CC_INC) -DMBCC_ROOT='"$(ROOT)"' $(FUZZ_SRC) $(LIBS) -lcamd -o $@
+	$(FUZZ_CC) $(STD) $(FUZZ_FLAGS) $(CC_INC) -DMBCC_ROOT='"$(ROOT)"' $(FUZZ_SRC) -lspqr $(LIBS) -lcamd -o $@
 fuzz: $(FUZZ_B)/fuzz_front
 	bash tests/fuzz/run.sh $(FUZZ_B) $(FUZZ_SECONDS)
 

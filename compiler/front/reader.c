@@ -1456,8 +1456,8 @@ static void parse_model(reader *r, yaml_node_t *root, const char *chosen_scene_n
   double max_bodies = limit_value("MBCC_MAX_BODIES", LIMIT_BODIES);
   if (bodies != NULL && mapping_size(bodies) > max_bodies) {
     /* alone: the joints on them would only repeat it */
-    error_at(r, loc_of(bodies), "%d bodies, more than the limit %g (the constraint analysis is dense: "
-             "its time grows with the cube; MBCC_MAX_BODIES=N lifts the limit)", mapping_size(bodies), max_bodies);
+    error_at(r, loc_of(bodies), "%d bodies, more than the limit %g (the emitted code and its C "
+             "compile grow with the model; MBCC_MAX_BODIES=N lifts the limit)", mapping_size(bodies), max_bodies);
     map_close(&top);
     return;
   }
