@@ -18,7 +18,7 @@ RT_SRC  := runtime/core/model_generic.c runtime/core/mb_step.c \
 # back (ordering, LDL^T plan, C emission), tools (trade)
 CC_DIRS := compiler/front compiler/elements compiler/flex compiler/lower compiler/back compiler/tools
 CC_INC  := -Icompiler $(addprefix -I,$(CC_DIRS)) $(RT_INC)
-CC_SRC  := compiler/main.c compiler/help.c compiler/paths.c $(foreach d,$(CC_DIRS),$(wildcard $(d)/*.c))
+CC_SRC  := $(wildcard compiler/*.c) $(foreach d,$(CC_DIRS),$(wildcard $(d)/*.c))
 B       ?= build
 DEPFLAGS = -MMD -MP
 

@@ -14,6 +14,9 @@
 
 #include "animate.h"
 #include "diag.h"
+#include "emit.h"
+#include "fe.h"
+#include "emit.h"
 #include "fe.h"
 #include "flex.h"
 #include "help.h"
@@ -24,6 +27,7 @@
 #include "plot.h"
 #include "proc.h"
 #include "trade.h"
+#include "unit.h"
 #include "version.h"
 
 #ifndef MBCC_GEN_CFLAGS
@@ -110,34 +114,24 @@ static int refuse_input_as_output(const options *o, const char *out, const char 
   return 2;
 }
 
-/* read, lower and assemble; NULL after reporting */
-static lmodel *build(const options *o, ir_model **irp, int verbose) {
+/* the whole pipeline into *u, --animate's pose outputs added to the IR
+ * between reading and the rest; 0, or 2 after reporting (u is then freed) */
+static int build(const options *o, mbc_unit *u, int verbose) {
   mb_lapack_context = o->model; /* a LAPACK argument error names the model */
-  ir_model *ir = ir_read(o->model, o->scene);
-  if (!ir) return NULL;
-  if (o->animate && animate_add_pose_outputs(ir)) {
-    ir_free(ir);
-    return NULL;
+  if (mbc_unit_read(u, o->model, o->scene) || (o->animate && animate_add_pose_outputs(u->ir)) ||
+      mbc_unit_finish(u, verbose)) {
+    mbc_unit_free(u);
+    return 2;
   }
-  lmodel *L = lower_model(ir);
-  if (!L) {
-    if (!diag_errors()) diag_error(o->model, (ir_loc){0, 0}, "out of memory while lowering");
-    ir_free(ir);
-    return NULL;
-  }
-  if (assemble_model(L, verbose)) {
-    lower_free(L);
-    ir_free(ir);
-    return NULL;
-  }
-  *irp = ir;
-  return L;
+  u->real_float = o->real_float;
+  return 0;
 }
 
 static int cmd_check(const options *o) {
-  ir_model *ir;
-  lmodel *L = build(o, &ir, 1);
-  if (!L) return 2;
+  mbc_unit u;
+  if (build(o, &u, 1)) return 2;
+  const ir_model *ir = u.ir;
+  const lmodel *L = u.lowered;
   const mb_model *m = &L->m;
   int nrigid = 0, nvirtual = 0;
   for (int b = 0; b < m->nbody; b++) {
@@ -156,7 +150,7 @@ static int cmd_check(const options *o) {
   printf("  degrees of freedom %d\n", L->dof);
   printf("  system dimension  %d (K = [M D^T; D 0])\n", m->n);
   printf("  nnz(K)            %d (%.2f%% dense)\n", m->nnz, m->n ? 100.0 * m->nnz / ((double)m->n * m->n) : 0.0);
-  ldl_plan_report(L, stdout);
+  ldl_plan_report(u.have_plan ? &u.plan : NULL, stdout);
   if (L->nvirtual) printf("  virtual bodies    %d inserted for joints on flexible nodes\n", L->nvirtual);
   for (int b = 0; b < m->nbody; b++) {
     if (m->body[b].kind != MB_BODY_FLEXIBLE) continue;
@@ -175,20 +169,20 @@ static int cmd_check(const options *o) {
       printf(" %.3g", m->body[b].flex->damping[j] / (2 * 2 * MB_PI * fm->freq_hz[j] * sqrt(m->body[b].flex->Mff[j * m->body[b].nm + j])));
     printf("\n");
   }
-  lower_free(L);
-  ir_free(ir);
+  mbc_unit_free(&u);
   return 0;
 }
 
 /* mbcc modes: frequencies and (optionally) mode shapes of one flexible body */
 static int cmd_modes(const options *o) {
   if (!o->body) { fprintf(stderr, "mbcc: error: modes needs --body NAME\n"); return 2; }
-  ir_model *ir = ir_read(o->model, o->scene);
-  if (!ir) return 2;
+  mbc_unit u;
+  if (mbc_unit_read(&u, o->model, o->scene)) return 2;
+  ir_model *ir = u.ir;
   int ib = ir_find_body(ir, o->body);
   if (ib < 0 || ir->bodies[ib].kind != BODY_FLEXIBLE) {
     fprintf(stderr, "%s: error: '%s' is not a flexible body of this model\n", o->model, o->body);
-    ir_free(ir);
+    mbc_unit_free(&u);
     return 2;
   }
   fe_modes fm;
@@ -197,7 +191,7 @@ static int cmd_modes(const options *o) {
   int modes_failed = flex_compute_modes(o->model, &ir->bodies[ib], &fm);
   clock_gettime(CLOCK_MONOTONIC, &t1);
   if (modes_failed) {
-    ir_free(ir);
+    mbc_unit_free(&u);
     return 2;
   }
   const ir_flex *fx = ir->bodies[ib].flex;
@@ -250,13 +244,8 @@ static int cmd_modes(const options *o) {
     }
   }
   fe_modes_free(&fm);
-  ir_free(ir);
+  mbc_unit_free(&u);
   return st;
-}
-
-static void default_dir(const lmodel *L, const ir_model *ir, char *dir, size_t n) {
-  (void)ir;
-  snprintf(dir, n, "generated/%s", L->m.name);
 }
 
 static void settings_from_ir(const ir_sim *s, mb_settings *set);
@@ -264,7 +253,8 @@ static void settings_from_ir(const ir_sim *s, mb_settings *set);
 /* the embedded package's fixed-step integrator and step: the model's, or
  * --integrator / --step; an adaptive choice (dopri5, auto) becomes RK4 unless
  * the modes are stiff (mb_integrator_auto), then generalized-alpha */
-static int embedded_package(const options *o, const lmodel *L, const char *dir) {
+static int embedded_package(const options *o, const mbc_unit *u, const char *dir) {
+  const lmodel *L = u->lowered;
   mb_settings set;
   settings_from_ir(&L->ir->sim, &set);
   for (int i = 0; i + 1 < o->nsim; i += 2) {
@@ -283,36 +273,39 @@ static int embedded_package(const options *o, const lmodel *L, const char *dir) 
     set.integrator = mb_integrator_auto(&L->m, &set, NULL, 0) == MB_GENALPHA ? MB_GENALPHA : MB_RK4;
     if (set.step > set.output_step) set.step = set.output_step;
   }
-  int st = emit_embedded(L, dir, set.integrator, set.step);
+  int st = emit_embedded(u, dir, set.integrator, set.step);
   if (!st) printf("wrote the embedded package %s/ (%s, step %g s)\n", dir, mb_integrator_name(set.integrator), set.step);
   return st;
 }
 
-static int cmd_compile(const options *o, char *dir_out, size_t n, lmodel **Lp, ir_model **irp) {
-  ir_model *ir;
-  lmodel *L = build(o, &ir, 0);
-  if (!L) return 2;
-  L->real_float = o->real_float;
+/* build and emit into -o DIR or generated/<name>; with dir_out (run, bench)
+ * always the latter, its name in dir_out.  With up the unit is kept there
+ * for the caller to free (also on failure after building).  --target
+ * embedded: the package into -o DIR or generated/<name>-embedded. */
+static int cmd_compile(const options *o, char *dir_out, size_t n, mbc_unit *up) {
+  mbc_unit u;
+  if (build(o, &u, 0)) return 2;
+  const char *name = u.lowered->m.name;
   if (o->embedded) {
     char pdir[4096];
     if (o->outdir) snprintf(pdir, sizeof pdir, "%s", o->outdir);
-    else snprintf(pdir, sizeof pdir, "generated/%s-embedded", L->m.name);
+    else snprintf(pdir, sizeof pdir, "generated/%s-embedded", name);
     mkdir("generated", 0777);
-    int st = embedded_package(o, L, pdir);
-    lower_free(L);
-    ir_free(ir);
+    int st = embedded_package(o, &u, pdir);
+    if (up) *up = u;
+    else mbc_unit_free(&u);
     return st;
   }
   char dir[4096];
   if (o->outdir && !dir_out) snprintf(dir, sizeof dir, "%s", o->outdir);
-  else default_dir(L, ir, dir, sizeof dir);
+  else snprintf(dir, sizeof dir, "generated/%s", name);
   mkdir("generated", 0777);
-  int st = emit_model(L, dir);
+  int st = emit_model(&u, dir);
   if (!st && !dir_out)
-    printf("wrote %s/%s.c, %s/%s.h and %s/main.c\n", dir, L->m.name, dir, L->m.name, dir);
+    printf("wrote %s/%s.c, %s/%s.h and %s/main.c\n", dir, name, dir, name, dir);
   if (dir_out) snprintf(dir_out, n, "%s", dir);
-  if (Lp) { *Lp = L; *irp = ir; }
-  else { lower_free(L); ir_free(ir); }
+  if (up) *up = u;
+  else mbc_unit_free(&u);
   return st;
 }
 
@@ -533,21 +526,18 @@ static void default_csv(const options *o, const char *name, char *csv, size_t n)
 static int cmd_run(const options *o) {
   if (check_run_options(o)) return 2;
   char dir[4096];
-  lmodel *L = NULL;
-  ir_model *ir = NULL;
+  mbc_unit u;
   char csv[4096];
   if (o->csv) snprintf(csv, sizeof csv, "%s", o->csv);
   int rc;
   if (!strcmp(o->path, "generic")) {
     /* in-process, without code generation: the generic path */
-    L = NULL;
-    ir = NULL;
     options o2 = *o;
     o2.outdir = NULL;
-    lmodel *Lg = build(&o2, &ir, 0);
-    if (!Lg) return 2;
+    if (build(&o2, &u, 0)) return 2;
+    const lmodel *Lg = u.lowered;
     if (!o->csv) default_csv(o, Lg->m.name, csv, sizeof csv);
-    const ir_sim *s = &ir->sim;
+    const ir_sim *s = &u.ir->sim;
     mb_settings set;
     settings_from_ir(s, &set);
     char *args[40];
@@ -563,12 +553,13 @@ static int cmd_run(const options *o) {
        default) runs there with KLU */
     rc = refuse_input_as_output(o, csv, "the results file");
     if (!rc) rc = mb_main(na, args, &Lg->m, &set, s->solver == SOLVER_DENSE ? "dense" : "klu");
-    lower_free(Lg);
   } else {
     options o2 = *o;
     o2.outdir = NULL;
-    rc = cmd_compile(&o2, dir, sizeof dir, &L, &ir);
-    if (rc) return rc;
+    memset(&u, 0, sizeof u);
+    rc = cmd_compile(&o2, dir, sizeof dir, &u);
+    if (rc) { mbc_unit_free(&u); return rc; }
+    const lmodel *L = u.lowered;
     if (!o->csv) default_csv(o, L->m.name, csv, sizeof csv);
     /* compile the generated code against the runtime library */
     /* the simulator under a name of this process's own (two runs of one
@@ -580,8 +571,7 @@ static int cmd_run(const options *o) {
     int efd = mkstemp(exe);
     if (efd < 0) {
       fprintf(stderr, "mbcc: error: cannot write '%s': %s\n", exe_final, strerror(errno));
-      lower_free(L);
-      ir_free(ir);
+      mbc_unit_free(&u);
       return 2;
     }
     close(efd);
@@ -590,8 +580,7 @@ static int cmd_run(const options *o) {
     if (compile_generated_into(dir, L->m.name, src_main, exe, exe_final, NULL, o->quiet, o->real_float, &reused)) {
       unlink(exe);
       proc_cleanup_remove(exe);
-      lower_free(L);
-      ir_free(ir);
+      mbc_unit_free(&u);
       return 2;
     }
     char *args[40];
@@ -608,9 +597,8 @@ static int cmd_run(const options *o) {
     proc_cleanup_remove(exe);
     if (refuse_input_as_output(o, csv, "the results file")) rc = 2;
     else rc = run_command(args);
-    lower_free(L);
   }
-  ir_free(ir);
+  mbc_unit_free(&u);
   if (rc) return rc;
   if (!o->plot || strcmp(o->plot, "none")) {
     char png[4096];
@@ -640,24 +628,24 @@ static int cmd_run(const options *o) {
 /* mbcc bench: generate, compile a bench executable (with SUNDIALS IDA), run it */
 static int cmd_bench(const options *o) {
   char dir[4096];
-  lmodel *L = NULL;
-  ir_model *ir = NULL;
+  mbc_unit u;
+  memset(&u, 0, sizeof u);
   options o2 = *o;
   o2.outdir = NULL;
-  int rc = cmd_compile(&o2, dir, sizeof dir, &L, &ir);
-  if (rc) return rc;
+  int rc = cmd_compile(&o2, dir, sizeof dir, &u);
+  if (rc) { mbc_unit_free(&u); return rc; }
+  const lmodel *L = u.lowered;
   char exe[8400], src_main[8400];
   snprintf(exe, sizeof exe, "%s/%s_bench", dir, L->m.name);
   snprintf(src_main, sizeof src_main, "%s/bench_main.c", dir);
   char *ida_libs[] = {"-lsundials_ida", "-lsundials_nvecserial", NULL};
-  rc = emit_template(L, "bench_main.c.in", src_main);
+  rc = emit_template(&u, "bench_main.c.in", src_main);
   if (!rc && o->real_float) {
     fprintf(stderr, "mbcc: error: bench runs double-precision paths only (drop '--real float')\n");
     rc = 2;
   }
   if (!rc) rc = compile_generated(dir, L->m.name, src_main, exe, ida_libs, o->quiet, 0);
-  lower_free(L);
-  ir_free(ir);
+  mbc_unit_free(&u);
   if (rc) return rc;
   char *args[40];
   int na = 0;
@@ -742,7 +730,7 @@ int main(int argc, char **argv) {
     return 2;
   if (!strcmp(cmd, "check")) return cmd_check(&o);
   if (!strcmp(cmd, "modes")) return cmd_modes(&o);
-  if (!strcmp(cmd, "compile")) return cmd_compile(&o, NULL, 0, NULL, NULL);
+  if (!strcmp(cmd, "compile")) return cmd_compile(&o, NULL, 0, NULL);
   if (!strcmp(cmd, "bench")) return cmd_bench(&o);
   return cmd_run(&o);
 }

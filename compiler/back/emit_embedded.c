@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "diag.h"
+#include "emit.h"
 #include "lower.h"
 
 /* the core sources a package needs, from runtime/core */
@@ -188,12 +189,13 @@ static void remove_partial(const char *tmp, const char *nm) {
   rmdir(tmp);
 }
 
-static int write_package(const lmodel *L, const char *dir, const char *tmp, int integrator, double step) {
+static int write_package(const mbc_unit *u, const char *dir, const char *tmp, int integrator, double step) {
+  const lmodel *L = u->lowered;
   const char *nm = L->m.name;
   char U[256], path[4400], src[4400];
   upper(U, nm, sizeof U);
   /* the model itself (writes <m>.c, <m>.h and a hosted main.c, which goes) */
-  if (emit_model(L, tmp)) return 2;
+  if (emit_model(u, tmp)) return 2;
   if (join(path, sizeof path, tmp, "main.c")) return 2;
   remove(path);
   for (int k = 0; k < 2; k++) {
@@ -215,11 +217,11 @@ static int write_package(const lmodel *L, const char *dir, const char *tmp, int 
   for (size_t i = 0; i < sizeof core_files / sizeof core_files[0]; i++) {
     snprintf(src, sizeof src, "%s/runtime/core/%s", root, core_files[i]);
     if (join(path, sizeof path, tmp, core_files[i]) || copy_file(src, path, NULL, NULL, NULL)) return 2;
-    if (L->real_float && !strcmp(core_files[i], "mb_types.h") && fix_precision(path)) return 2;
+    if (u->real_float && !strcmp(core_files[i], "mb_types.h") && fix_precision(path)) return 2;
   }
   for (size_t i = 0; i < sizeof template_files / sizeof template_files[0]; i++) {
     snprintf(src, sizeof src, "%s/templates/embedded/%s", root, template_files[i]);
-    if (join(path, sizeof path, tmp, template_files[i]) || copy_file(src, path, nm, U, L->real_float ? "-DMB_REAL_FLOAT" : "")) return 2;
+    if (join(path, sizeof path, tmp, template_files[i]) || copy_file(src, path, nm, U, u->real_float ? "-DMB_REAL_FLOAT" : "")) return 2;
   }
   char name[300];
   for (int k = 0; k < 2; k++) {
@@ -265,10 +267,10 @@ static int write_package(const lmodel *L, const char *dir, const char *tmp, int 
   return 0;
 }
 
-int emit_embedded(const lmodel *L, const char *dir, int integrator, double step) {
+int emit_embedded(const mbc_unit *u, const char *dir, int integrator, double step) {
   char tmp[4096];
   snprintf(tmp, sizeof tmp, "%s.pkg", dir);
-  int st = write_package(L, dir, tmp, integrator, step);
-  if (st) remove_partial(tmp, L->m.name);
+  int st = write_package(u, dir, tmp, integrator, step);
+  if (st) remove_partial(tmp, u->lowered->m.name);
   return st;
 }

@@ -116,22 +116,21 @@ static long work_size(const ldl_plan *p) {
   return w;
 }
 
-void emit_ldl_header(FILE *f, const lmodel *L, const char *nm) {
-  ldl_plan p;
-  if (ldl_plan_build(L, &p)) return;
+void emit_ldl_header(FILE *f, const mbc_unit *u, const char *nm) {
+  if (!u->have_plan) return;
+  const ldl_plan *p = &u->plan;
   char U[256];
   upper(U, nm, sizeof U);
   fprintf(f, "/* emitted LDL^T of K (solver \"ldl\"), see %s.c */\n", nm);
-  fprintf(f, "#define %s_LDL_NNZL %ld      /* nonzeros of L (strictly lower) */\n", U, p.nnzL);
-  fprintf(f, "#define %s_LDL_FLOPS %.0f.0  /* flops of one numeric factorization */\n", U, p.flops);
+  fprintf(f, "#define %s_LDL_NNZL %ld      /* nonzeros of L (strictly lower) */\n", U, p->nnzL);
+  fprintf(f, "#define %s_LDL_FLOPS %.0f.0  /* flops of one numeric factorization */\n", U, p->flops);
   fprintf(f, "#define %s_LDL_STRAIGHT %d   /* 1: straight-line code, 0: loops over tables */\n", U,
-          p.straight);
-  fprintf(f, "#define %s_LDL_WORK %ld      /* mb_real elements of the workspace */\n", U, work_size(&p));
+          p->straight);
+  fprintf(f, "#define %s_LDL_WORK %ld      /* mb_real elements of the workspace */\n", U, work_size(p));
   fprintf(f, "#define %s_LDL_EXACT %d      /* 1: the factors are those of K (no weighted rows) */\n", U,
-          p.nw == 0);
+          p->nw == 0);
   fprintf(f, "int %s_ldl_factor(const mb_real *Kx, mb_real *work);\n", nm);
   fprintf(f, "int %s_ldl_solve(const mb_real *Kx, mb_real *work, mb_real *b, mb_real *residual);\n", nm);
-  ldl_plan_free(&p);
 }
 
 void emit_ldl_fields(FILE *f, const char *nm, int emitted) {
@@ -1868,34 +1867,35 @@ static void emit_solve(FILE *f, const ldl_plan *p, const char *nm) {
         "  return isfinite(best) ? MB_OK : MB_ERR_NONFINITE;\n}\n\n", f);
 }
 
-int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
-  ldl_plan p;
-  if (ldl_plan_build(L, &p)) {
+int emit_ldl(FILE *f, const mbc_unit *u, const char *nm) {
+  const lmodel *L = u->lowered;
+  const ldl_plan *p = &u->plan;
+  if (!u->have_plan) {
     fputs("/* --- emitted LDL^T: not available (the ordering failed) --- */\n\n", f);
     return 0;
   }
   char U[256];
   upper(U, nm, sizeof U);
-  int n = p.n;
+  int n = p->n;
   char ordering[256];
-  if (p.tree)
+  if (p->tree)
     snprintf(ordering, sizeof ordering, "CAMD with %d constraint sets from the spanning tree: each body\n"
-             " * before the rows joining it to its parent, loop rows last", p.nsets);
+             " * before the rows joining it to its parent, loop rows last", p->nsets);
   else
-    snprintf(ordering, sizeof ordering, "CAMD, the %d body unknowns before the %d constraint rows", p.nv, p.nc);
+    snprintf(ordering, sizeof ordering, "CAMD, the %d body unknowns before the %d constraint rows", p->nv, p->nc);
   fprintf(f, "/* --- emitted LDL^T of K (solver \"ldl\") ---\n"
              " * K_aug = [M + D^T W D, D^T; D, 0], right side [f + D^T W g; g]: the\n"
              " * solution of K x = b; every leading block of the order is nonsingular with\n"
              " * positive pivots for body unknowns, negative for rows.  Ordering:\n"
              " * %s.  nnz(L) = %ld,\n"
              " * %.0f flops per factorization, %.0f per solve; %s.\n",
-          ordering, p.nnzL, p.flops, p.flops_solve,
-          p.straight ? "straight-line code" : "loops over static tables (above the flop budget)");
-  fprintf(f, " * %d massless velocity unknowns; weighted rows (constraint row: w):", p.nmassless);
-  if (!p.nw) fputs(" none", f);
-  for (int k = 0; k < p.nw; k++) {
+          ordering, p->nnzL, p->flops, p->flops_solve,
+          p->straight ? "straight-line code" : "loops over static tables (above the flop budget)");
+  fprintf(f, " * %d massless velocity unknowns; weighted rows (constraint row: w):", p->nmassless);
+  if (!p->nw) fputs(" none", f);
+  for (int k = 0; k < p->nw; k++) {
     fputs(k % 4 ? ", " : "\n *  ", f);
-    fprintf(f, "%d: %.6g", p.wrow[k], p.w[k]);
+    fprintf(f, "%d: %.6g", p->wrow[k], p->w[k]);
   }
   fputs("\n * Workspace: Lx, 1/d, x, r, t, best x. */\n", f);
   fprintf(f, "#define LDL_N %d\n#define LDL_DINV %s_LDL_NNZL\n"
@@ -1905,54 +1905,54 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
              "/* a solve whose relative residual is already this small is not refined */\n"
              "#define LDL_REFINE_TOL 1e-15\n"
              "#if defined(__GNUC__)\n#define LDL_NOINLINE __attribute__((noinline))\n#define LDL_MAYBE_UNUSED __attribute__((unused))\n#else\n#define LDL_NOINLINE\n#define LDL_MAYBE_UNUSED\n#endif\n",
-          n, U, p.nelim ? p.nnzR : 0);
+          n, U, p->nelim ? p->nnzR : 0);
   /* pivot order as a comment (straight) or a table (looped) */
-  if (p.straight) {
+  if (p->straight) {
     fputs("/* pivot order: ", f);
-    for (int k = 0; k < n; k++) fprintf(f, "%s%d", k ? (k % 20 ? " " : "\n *   ") : "", p.perm[k]);
+    for (int k = 0; k < n; k++) fprintf(f, "%s%d", k ? (k % 20 ? " " : "\n *   ") : "", p->perm[k]);
     fputs(" */\n\n", f);
   } else {
     const mb_model *m = &L->m;
     fputs("/* pivot order (original unknowns) */\n", f);
-    int_array(f, "ldl_perm", p.perm, n);
+    int_array(f, "ldl_perm", p->perm, n);
     fputs("/* K_aug, upper triangle of the permuted matrix: rows, Kx slots (-1: none), and the\n"
           " * products w_r D_ri D_rj of the weighted rows (weights, Kx slots) */\n", f);
-    int_array(f, "ldl_Up", p.Up, n + 1);
-    int_array(f, "ldl_Ui", p.Ui, p.nnzA);
-    int_array(f, "ldl_Us", p.Us, p.nnzA);
-    int nt = p.Tp[p.nnzA];
+    int_array(f, "ldl_Up", p->Up, n + 1);
+    int_array(f, "ldl_Ui", p->Ui, p->nnzA);
+    int_array(f, "ldl_Us", p->Us, p->nnzA);
+    int nt = p->Tp[p->nnzA];
     if (nt > 0) {
       double *tw = malloc(sizeof(double) * (size_t)(nt + 1));
-      if (!tw) { ldl_plan_free(&p); return 0; }
-      for (int t = 0; t < nt; t++) tw[t] = p.w[p.Tw[t]];
-      int_array(f, "ldl_Tp", p.Tp, p.nnzA + 1);
+      if (!tw) { return 0; }
+      for (int t = 0; t < nt; t++) tw[t] = p->w[p->Tw[t]];
+      int_array(f, "ldl_Tp", p->Tp, p->nnzA + 1);
       real_array(f, "ldl_Tw", tw, nt);
-      int_array(f, "ldl_Ta", p.Ta, nt);
-      int_array(f, "ldl_Tb", p.Tb, nt);
+      int_array(f, "ldl_Ta", p->Ta, nt);
+      int_array(f, "ldl_Tb", p->Tb, nt);
       free(tw);
     }
     fputs("/* L: columns (strictly lower, rows ascending) and rows (columns ascending, positions) */\n", f);
-    int_array(f, "ldl_Lp", p.Lp, n + 1);
-    int_array(f, "ldl_Li", p.Li, p.nnzL);
-    int_array(f, "ldl_Rp", p.Rp, n + 1);
-    int_array(f, "ldl_Rj", p.Rj, p.nnzL);
-    int_array(f, "ldl_Rpos", p.Rpos, p.nnzL);
+    int_array(f, "ldl_Lp", p->Lp, n + 1);
+    int_array(f, "ldl_Li", p->Li, p->nnzL);
+    int_array(f, "ldl_Rp", p->Rp, n + 1);
+    int_array(f, "ldl_Rj", p->Rj, p->nnzL);
+    int_array(f, "ldl_Rpos", p->Rpos, p->nnzL);
     fputs("/* D entries of the weighted rows: target (permuted), weight, Kx slot, row in b */\n", f);
-    if (p.nw) {
-      int nd = p.Dp[p.nw];
+    if (p->nw) {
+      int nd = p->Dp[p->nw];
       int *dt = malloc(sizeof(int) * (size_t)(nd + 1)), *dr = malloc(sizeof(int) * (size_t)(nd + 1));
       double *dw = malloc(sizeof(double) * (size_t)(nd + 1));
-      if (!dt || !dr || !dw) { free(dt); free(dr); free(dw); ldl_plan_free(&p); return 0; }
-      for (int k = 0; k < p.nw; k++)
-        for (int q = p.Dp[k]; q < p.Dp[k + 1]; q++) {
-          dt[q] = p.iperm[p.Dj[q]];
-          dr[q] = p.nv + p.wrow[k];
-          dw[q] = p.w[k];
+      if (!dt || !dr || !dw) { free(dt); free(dr); free(dw); return 0; }
+      for (int k = 0; k < p->nw; k++)
+        for (int q = p->Dp[k]; q < p->Dp[k + 1]; q++) {
+          dt[q] = p->iperm[p->Dj[q]];
+          dr[q] = p->nv + p->wrow[k];
+          dw[q] = p->w[k];
         }
       fprintf(f, "#define LDL_ND %d\n", nd);
       int_array(f, "ldl_Dt", dt, nd);
       real_array(f, "ldl_Dw", dw, nd);
-      int_array(f, "ldl_Ds", p.Ds, nd);
+      int_array(f, "ldl_Ds", p->Ds, nd);
       int_array(f, "ldl_Dr", dr, nd);
       free(dt); free(dr); free(dw);
     }
@@ -1962,9 +1962,9 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
     fputc('\n', f);
   }
   /* the compile-time constants: K1's (massless bodies) and init's entries of Kx */
-  k1_map = p.nml && p.straight ? p.K1map : NULL;
-  k1_direct = p.nml && p.straight;
-  signed char *cst = p.straight ? calloc((size_t)L->m.nnz + 1, 1) : NULL;
+  k1_map = p->nml && p->straight ? p->K1map : NULL;
+  k1_direct = p->nml && p->straight;
+  signed char *cst = p->straight ? calloc((size_t)L->m.nnz + 1, 1) : NULL;
   if (cst)
     for (int r = 0; r < L->m.nrow; r++)
       for (int s = 0; s < 2; s++)
@@ -1976,29 +1976,29 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
   kx_cst = cst;
   int *kc = NULL;
   inv6_emitted = 0;
-  if (p.nml) emit_massless(f, L, &p);
-  if (p.nelim) {
-    kc = malloc(sizeof(int) * (size_t)(p.nnzR + 1));
-    if (!kc) { free(cst); ldl_plan_free(&p); return 0; }
+  if (p->nml) emit_massless(f, L, p);
+  if (p->nelim) {
+    kc = malloc(sizeof(int) * (size_t)(p->nnzR + 1));
+    if (!kc) { free(cst); return 0; }
     int nkc = 0;
-    for (int q = 0; q < p.nnzR; q++) kc[q] = p.straight ? -1 : nkc++;
-    if (p.straight) {
-      for (int k = 0; k < 2 * p.ekrp[p.nelim]; k++)
-        if (p.ekr[k] >= 0) kc[p.ekr[k]] = 0; /* mark */
+    for (int q = 0; q < p->nnzR; q++) kc[q] = p->straight ? -1 : nkc++;
+    if (p->straight) {
+      for (int k = 0; k < 2 * p->ekrp[p->nelim]; k++)
+        if (p->ekr[k] >= 0) kc[p->ekr[k]] = 0; /* mark */
       /* the others are Kx slots, or constants of K' (kval writes them as literals:
          a virtual body's decoupled diagonals) */
-      for (int q = 0; q < p.nnzR; q++) kc[q] = kc[q] == 0 ? nkc++ : -1;
+      for (int q = 0; q < p->nnzR; q++) kc[q] = kc[q] == 0 ? nkc++ : -1;
     }
     kc_of = kc;
-    kc_map = p.Krmap;
-    emit_blocks(f, L, &p);
+    kc_map = p->Krmap;
+    emit_blocks(f, L, p);
   }
-  if (p.straight) emit_factor_straight(f, L, &p, nm);
-  else emit_factor_looped(f, L, &p, nm);
-  emit_factor_entry(f, L, &p, nm);
-  if (p.straight) emit_solve_helpers_straight(f, L, &p);
-  else emit_solve_helpers_looped(f, &p);
-  emit_solve(f, &p, nm);
+  if (p->straight) emit_factor_straight(f, L, p, nm);
+  else emit_factor_looped(f, L, p, nm);
+  emit_factor_entry(f, L, p, nm);
+  if (p->straight) emit_solve_helpers_straight(f, L, p);
+  else emit_solve_helpers_looped(f, p);
+  emit_solve(f, p, nm);
   kc_of = kc_map = k1_map = NULL;
   k1_direct = 0;
   kx_cst = NULL;
@@ -2013,6 +2013,5 @@ int emit_ldl(FILE *f, const lmodel *L, const char *nm) {
   fputs("static int ldl_solve_m(const mb_model *m, const mb_real *Kx, mb_real *work, mb_real *b,\n"
         "                       mb_real *residual) {\n", f);
   fprintf(f, "  (void)m;\n  return %s_ldl_solve(Kx, work, b, residual);\n}\n\n", nm);
-  ldl_plan_free(&p);
   return 1;
 }

@@ -5,13 +5,13 @@
 
 #include <stdio.h>
 
-#include "lower.h"
+#include "unit.h"
 
 /* <model>.h: the workspace-size macros and the prototypes */
-void emit_ldl_header(FILE *f, const lmodel *L, const char *nm);
+void emit_ldl_header(FILE *f, const mbc_unit *u, const char *nm);
 /* <model>.c: tables and functions, before the model initializer; returns 1
- * when emitted, 0 when not (the analysis failed: the model then has no ldl) */
-int emit_ldl(FILE *f, const lmodel *L, const char *nm);
+ * when emitted, 0 when not (no plan, or out of memory: the model then has no ldl) */
+int emit_ldl(FILE *f, const mbc_unit *u, const char *nm);
 /* inside the initializer: the designated initializers of the ldl fields */
 void emit_ldl_fields(FILE *f, const char *nm, int emitted);
 

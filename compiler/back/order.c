@@ -1261,28 +1261,27 @@ fail:
   return -1;
 }
 
-void ldl_plan_report(const lmodel *L, FILE *out) {
-  ldl_plan p;
-  if (ldl_plan_build(L, &p)) {
+void ldl_plan_report(const ldl_plan *plan, FILE *out) {
+  if (!plan) {
     fprintf(out, "  LDL^T             not available (ordering failed)\n");
     return;
   }
-  if (p.tree)
+  const ldl_plan *p = plan;
+  if (p->tree)
     fprintf(out, "  ordering          CAMD, %d sets from the spanning tree (bodies before their joints' rows)\n",
-            p.nsets);
+            p->nsets);
   else
-    fprintf(out, "  ordering          CAMD, %d body unknowns before %d constraint rows\n", p.nv, p.nc);
-  if (p.nmassless)
+    fprintf(out, "  ordering          CAMD, %d body unknowns before %d constraint rows\n", p->nv, p->nc);
+  if (p->nmassless)
     fprintf(out, "  zero mass         %d massless unknowns: %d rows weighted (K_aug = [M + D^T W D, D^T; D, 0])\n",
-            p.nmassless, p.nw);
-  if (p.nml)
+            p->nmassless, p->nw);
+  if (p->nml)
     fprintf(out, "  massless bodies   %d eliminated with 6 of their rows each, chosen by pivoting "
-                 "(at most %.0f flops per factorization, %.0f per solve)\n", p.nml, p.flops_ml, p.flops_ml_solve);
-  if (p.nelim)
+                 "(at most %.0f flops per factorization, %.0f per solve)\n", p->nml, p->flops_ml, p->flops_ml_solve);
+  if (p->nelim)
     fprintf(out, "  block pivots      %d welded virtual bodies eliminated with their weld rows "
-                 "(at most %.0f flops per factorization, %.0f per solve)\n", p.nelim, p.flops_block, p.flops_block_solve);
-  fprintf(out, "  nnz(L)            %ld (strictly lower; L + D + L^T has %ld)\n", p.nnzL, 2 * p.nnzL + p.n);
-  fprintf(out, "  LDL^T flops       %.0f per factorization, %.0f per solve\n", p.flops, p.flops_solve);
-  fprintf(out, "  LDL^T code        %s (flop budget %.0f)\n", p.straight ? "straight-line" : "looped", p.budget);
-  ldl_plan_free(&p);
+                 "(at most %.0f flops per factorization, %.0f per solve)\n", p->nelim, p->flops_block, p->flops_block_solve);
+  fprintf(out, "  nnz(L)            %ld (strictly lower; L + D + L^T has %ld)\n", p->nnzL, 2 * p->nnzL + p->n);
+  fprintf(out, "  LDL^T flops       %.0f per factorization, %.0f per solve\n", p->flops, p->flops_solve);
+  fprintf(out, "  LDL^T code        %s (flop budget %.0f)\n", p->straight ? "straight-line" : "looped", p->budget);
 }

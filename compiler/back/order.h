@@ -140,8 +140,9 @@ int ldl_w_nonzero(const int *eu, const int *dinz, int i);
 /* dinz[36]: the structure of block pivot e's D_u^-1 (its D_u's diagonal blocks) */
 void ldl_block_dinz(const ldl_plan *p, int e, int dinz[36]);
 
-/* `mbcc check`: the ordering, nnz(L), the flop count and the code form */
-void ldl_plan_report(const lmodel *L, FILE *out);
+/* `mbcc check`: the ordering, nnz(L), the flop count and the code form of
+ * the plan (NULL: the ordering failed) */
+void ldl_plan_report(const ldl_plan *p, FILE *out);
 
 /* "body 'crank' w_z" / "constraint row 3: joint 'pin' (revolute): ..." */
 void ldl_unknown_name(const lmodel *L, int u, char *buf, size_t n);

@@ -186,3 +186,40 @@ int flex_compute_modes(const char *path, const ir_body *B, fe_modes *fm) {
     diag_error(path, B->loc, "flexible body '%s': %s", B->name, err);
   return 2;
 }
+
+int flex_reduce(const ir_model *ir, flex_product *out) {
+  memset(out, 0, sizeof *out);
+  out->nbodies = ir->nbodies;
+  out->modes = calloc((size_t)ir->nbodies + 1, sizeof *out->modes);
+  out->data = calloc((size_t)ir->nbodies + 1, sizeof *out->data);
+  if (!out->modes || !out->data) {
+    diag_error(ir->path, (ir_loc){0, 0}, "out of memory while reducing the flexible bodies");
+    flex_product_free(out);
+    return 2;
+  }
+  for (int b = 1; b < ir->nbodies; b++) {
+    const ir_body *B = &ir->bodies[b];
+    if (B->kind != BODY_FLEXIBLE) continue;
+    char err[512];
+    if (flex_compute_modes(ir->path, B, &out->modes[b])) {
+      flex_product_free(out);
+      return 2;
+    }
+    if (flex_build(B->flex, &out->modes[b], &out->data[b], err, sizeof err)) {
+      diag_error(ir->path, B->loc, "flexible body '%s': %s", B->name, err);
+      flex_product_free(out);
+      return 2;
+    }
+  }
+  return 0;
+}
+
+void flex_product_free(flex_product *fp) {
+  for (int b = 0; b < fp->nbodies; b++) {
+    if (fp->modes) fe_modes_free(&fp->modes[b]);
+    if (fp->data) flex_data_free(&fp->data[b]);
+  }
+  free(fp->modes);
+  free(fp->data);
+  memset(fp, 0, sizeof *fp);
+}

@@ -21,4 +21,18 @@ int flex_mass_entry(const mb_flex *f, int i, int l);
 /* fe_compute_modes with diagnostics at the faulty element; 0 or 2 */
 int flex_compute_modes(const char *path, const ir_body *B, fe_modes *fm);
 
+/* The flexible-body stage's product: the modes and the runtime description of
+ * every flexible body, indexed like the IR's bodies (0 is the ground; entries
+ * of other bodies are zero).  Lowering reads it; the compilation unit owns it. */
+typedef struct {
+  int nbodies;
+  fe_modes *modes;
+  flex_data *data;
+} flex_product;
+
+/* Reduce every flexible body of the IR (modes, then invariants).  Returns 0,
+ * or 2 after reporting at the body (out of memory included). */
+int flex_reduce(const ir_model *ir, flex_product *out);
+void flex_product_free(flex_product *fp);
+
 #endif

@@ -114,10 +114,12 @@ int lower_add_profile(lmodel *L, const ir_profile *p, int driver, int force) {
 
 /* a marker on mb body b (-1: ground) at global point P with global axes Cg;
  * on FE node 'node' of a flexible body when node >= 0 */
-static int add_marker(lmodel *L, int b, int node, const double P[3], const double Cg[9], char *desc) {
+static int add_marker(lmodel *L, int b, int node, const double P[3], const double Cg[9], char *desc,
+                      ir_loc loc) {
   int k = L->m.nmarker++;
   mb_markerdef *d = &L->marker[k];
   L->marker_desc[k] = desc;
+  L->marker_loc[k] = loc;
   d->body = b;
   d->node = -1;
   if (b < 0) {
@@ -134,7 +136,7 @@ static int add_marker(lmodel *L, int b, int node, const double P[3], const doubl
     const fe_modes *fm = &L->modes[b];
     d->node = node;
     if (node >= fm->nnodes) {
-      diag_error(L->ir->path, (ir_loc){0, 0}, "%s: body '%s' has no node %d (it has %d)", desc,
+      diag_error(L->ir->path, loc, "%s: body '%s' has no node %d (it has %d)", desc,
                  L->body[b].name, node, fm->nnodes);
       L->bad = 1;
       return k;
@@ -143,7 +145,7 @@ static int add_marker(lmodel *L, int b, int node, const double P[3], const doubl
     double off = 0;
     for (int j = 0; j < 3; j++) off += (d->s[j] - fm->x[3 * node + j]) * (d->s[j] - fm->x[3 * node + j]);
     if (sqrt(off) > 1e-6 * (1 + sqrt(mb_dot3(d->s, d->s)))) {
-      diag_error(L->ir->path, (ir_loc){0, 0}, "%s: the point is %g from node %d of body '%s'", desc,
+      diag_error(L->ir->path, loc, "%s: the point is %g from node %d of body '%s'", desc,
                  sqrt(off), node, L->body[b].name);
       L->bad = 1;
     }
@@ -159,7 +161,7 @@ static int add_marker(lmodel *L, int b, int node, const double P[3], const doubl
 int lower_force_marker(lmodel *L, const ir_force *F, int side, const double C[9]) {
   return add_marker(L, F->body[side] - 1, F->node[side], F->point[side], C,
                     xstrdup_printf("force '%s', on body '%s'%s", F->name,
-                                   L->ir->bodies[F->body[side]].name, ""));
+                                   L->ir->bodies[F->body[side]].name, ""), F->body_loc[side]);
 }
 
 static const char *joint_kind_name(ir_joint_kind k) {
@@ -294,7 +296,7 @@ static int section_coefficients(lmodel *L, const ir_output *o, mb_outputdef *d) 
   return 0;
 }
 
-lmodel *lower_model(const ir_model *ir) {
+lmodel *lower_model(const ir_model *ir, const flex_product *flex) {
   lmodel *L = calloc(1, sizeof *L);
   if (!L) return NULL;
   L->ir = ir;
@@ -309,12 +311,14 @@ lmodel *lower_model(const ir_model *ir) {
   int maxrow = 6 * ir->njoints + ir->ndrivers + 6 * nvirt_max + 1;
   int maxprof = ir->ndrivers + ir->nforces + 1;
   L->body = calloc((size_t)nbmax + 1, sizeof *L->body);
-  L->modes = calloc((size_t)nbmax + 1, sizeof *L->modes);
-  L->flexd = calloc((size_t)nbmax + 1, sizeof *L->flexd);
+  /* mb body b is IR body b + 1 */
+  L->modes = flex->modes + 1;
+  L->flexd = flex->data + 1;
   L->mslotf = calloc((size_t)nbmax + 1, sizeof *L->mslotf);
   L->body_name = calloc((size_t)nbmax + 1, sizeof *L->body_name);
   L->marker = calloc((size_t)maxmk, sizeof *L->marker);
   L->marker_desc = calloc((size_t)maxmk, sizeof(char *));
+  L->marker_loc = calloc((size_t)maxmk, sizeof *L->marker_loc);
   L->row = calloc((size_t)maxrow, sizeof *L->row);
   L->row_desc = calloc((size_t)maxrow, sizeof(char *));
   L->row_loc = calloc((size_t)maxrow, sizeof(ir_loc));
@@ -335,8 +339,7 @@ lmodel *lower_model(const ir_model *ir) {
   L->col_name = calloc((size_t)ncols + 1, sizeof(char *));
   if (!L->body || !L->marker || !L->marker_desc || !L->row || !L->row_desc || !L->row_loc ||
       !L->force || !L->force_ir || !L->force_prm || !L->force_law || !L->profile || !L->profile_driver || !L->profile_force ||
-      !L->spline || !L->table || !L->output || !L->joint_name || !L->col_name || !L->modes ||
-      !L->flexd || !L->mslotf || !L->body_name) {
+      !L->spline || !L->table || !L->output || !L->joint_name || !L->col_name || !L->marker_loc || !L->mslotf || !L->body_name) {
     lower_free(L);
     return NULL;
   }
@@ -355,7 +358,7 @@ lmodel *lower_model(const ir_model *ir) {
   memcpy(m->gravity, ir->gravity, sizeof m->gravity);
 
   /* bodies: 7 position and 6 velocity coordinates each, plus the modes of a
-     flexible body (computed here: they size the coordinates) */
+     flexible body (the flexible-body stage's: they size the coordinates) */
   int nq = 0, nv = 0;
   for (int b = 0; b < nb; b++) {
     const ir_body *B = &ir->bodies[b + 1];
@@ -367,16 +370,6 @@ lmodel *lower_model(const ir_model *ir) {
     d->qadr = nq;
     d->vadr = nv;
     if (B->kind == BODY_FLEXIBLE) {
-      char err[512];
-      if (flex_compute_modes(ir->path, B, &L->modes[b])) {
-        lower_free(L);
-        return NULL;
-      }
-      if (flex_build(B->flex, &L->modes[b], &L->flexd[b], err, sizeof err)) {
-        diag_error(ir->path, B->loc, "flexible body '%s': %s", B->name, err);
-        lower_free(L);
-        return NULL;
-      }
       d->kind = MB_BODY_FLEXIBLE;
       d->flex = &L->flexd[b].flex;
       d->nm = d->flex->nm;
@@ -454,16 +447,18 @@ lmodel *lower_model(const ir_model *ir) {
         const double *qb = L->q0 + L->body[b].qadr;
         double A[9], P[3], Cg[9];
         mb_euler_to_A(qb + 3, A);
-        mb_mul3(A, L->modes[b].x + 3 * node, P);
+        /* a node it does not have: add_marker reports it at the joint */
+        if (node < L->modes[b].nnodes) mb_mul3(A, L->modes[b].x + 3 * node, P);
+        else memset(P, 0, sizeof P);
         for (int i = 0; i < 3; i++) P[i] += qb[i];
         for (int i = 0; i < 9; i++) Cg[i] = A[i];
         memcpy(L->q0 + d->qadr, P, sizeof P);
         memcpy(L->q0 + d->qadr + 3, qb + 3, sizeof(double) * 4);
         int mn = add_marker(L, b, node, P, Cg,
                             xstrdup_printf("node of body '%s' under virtual body '%s'%s",
-                                           L->body[b].name, name, ""));
+                                           L->body[b].name, name, ""), J->body_loc[s]);
         int mv = add_marker(L, v, -1, P, Cg,
-                            xstrdup_printf("virtual body '%s' at its node%s%s", name, "", ""));
+                            xstrdup_printf("virtual body '%s' at its node%s%s", name, "", ""), J->loc);
         char what[64];
         for (int k = 0; k < 3; k++) {
           snprintf(what, sizeof what, "node and virtual body coincide, %s", axis_name[k]);
@@ -478,7 +473,7 @@ lmodel *lower_model(const ir_model *ir) {
       }
       mk[s] = add_marker(L, b, node, J->point[s], C[s],
                          xstrdup_printf("joint '%s', on body '%s'%s", J->name,
-                                        b >= 0 ? L->body[b].name : "ground", ""));
+                                        b >= 0 ? L->body[b].name : "ground", ""), J->body_loc[s]);
     }
     jm0[j] = mk[0];
     jm1[j] = mk[1];
@@ -892,13 +887,12 @@ void lower_free(lmodel *L) {
   free(L->profile_driver); free(L->profile_force); free(L->spline); free(L->table);
   free(L->output); free(L->q0); free(L->v0); free(L->col_name); free(L->joint_name);
   free(L->Kp); free(L->Ki);
+  free(L->marker_loc);
   for (int b = 0; b < L->m.nbody; b++) {
-    if (L->modes) fe_modes_free(&L->modes[b]);
-    if (L->flexd) flex_data_free(&L->flexd[b]);
     if (L->mslotf) free(L->mslotf[b]);
     if (L->body_name) free(L->body_name[b]);
   }
   free(L->name);
-  free(L->modes); free(L->flexd); free(L->mslotf); free(L->body_name); free(L->modal_slot);
+  free(L->mslotf); free(L->body_name); free(L->modal_slot);
   free(L);
 }

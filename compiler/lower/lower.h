@@ -28,6 +28,7 @@ typedef struct {
   char **joint_name;
   /* provenance */
   char **marker_desc;        /* "joint 'pin' on body 'crank'" */
+  ir_loc *marker_loc;        /* the YAML element that made the marker */
   char **row_desc;           /* "joint 'pin' (revolute): spherical x" */
   ir_loc *row_loc;
   int *force_ir;             /* IR force index of each force */
@@ -35,9 +36,10 @@ typedef struct {
   int *profile_force;
   double **spline;           /* owned spline and table arrays of table profiles */
   double **table;
-  /* flexible bodies: per mb body (NULL / unused for others) */
-  fe_modes *modes;           /* m.nbody entries */
-  flex_data *flexd;
+  /* flexible bodies: per mb body (unused for others); they point into the
+   * flexible-body stage's product (flex_reduce), which must outlive L */
+  const fe_modes *modes;
+  const flex_data *flexd;
   int **mslotf;
   int *modal_slot;           /* slots of constraint rows' modal columns */
   int nmodal_slot;
@@ -47,7 +49,6 @@ typedef struct {
   int bad;                   /* an error was reported while lowering */
   int nredundant;            /* rows removed at assembly */
   int dof;
-  int real_float;            /* emit for single precision (mbcc compile --real float) */
 } lmodel;
 
 /* For the lowering hooks of the elements (compiler/elements/): the marker
@@ -59,9 +60,10 @@ double *lower_force_prm(lmodel *L, mb_forcedef *d, int n);
 mb_law *lower_force_laws(lmodel *L, mb_forcedef *d, int n);
 int lower_add_profile(lmodel *L, const ir_profile *p, int driver, int force);
 
-/* Build the tables and pattern from the IR (positions as given).  Returns
- * NULL and reports on error. */
-lmodel *lower_model(const ir_model *ir);
+/* Build the tables and pattern from the IR (positions as given) and the
+ * flexible bodies' reduction (flex_reduce of the same IR).  Returns NULL and
+ * reports on error. */
+lmodel *lower_model(const ir_model *ir, const flex_product *flex);
 /* (Re)build the CSC pattern and every slot from the current rows. */
 int lower_pattern(lmodel *L);
 /* Remove constraint rows whose keep[r] is 0, then rebuild the pattern. */
@@ -76,16 +78,5 @@ int lower_node_rotates(const mb_body *B, int node);
  * constraints, redundant rows removed (warnings), consistent velocities,
  * singularity check.  Returns 0, or 2 after reporting an error. */
 int assemble_model(lmodel *L, int verbose);
-
-/* Emit generated/<name>/ (emit.c).  Returns 0 or reports and returns 2. */
-int emit_model(const lmodel *L, const char *dir);
-/* Fill templates/<name> (model name, simulation settings, solver) into the
- * file 'out' (emit.c).  Returns 0 or reports and returns 2. */
-int emit_template(const lmodel *L, const char *name, const char *out);
-/* where the templates and runtime sources are: $MBCC_ROOT, else the build's checkout */
-const char *emit_root_dir(void);
-/* mbcc compile --target embedded: the package of compiler/back/emit_embedded.c;
- * integrator MB_RK4 or MB_GENALPHA, step the suggested fixed step */
-int emit_embedded(const lmodel *L, const char *dir, int integrator, double step);
 
 #endif

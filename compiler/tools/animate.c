@@ -22,6 +22,7 @@
 #include "diag.h"
 #include "flex.h"
 #include "lower.h"
+#include "unit.h"
 
 #ifndef MBCC_ROOT
 #define MBCC_ROOT "."
@@ -404,18 +405,22 @@ int animate_write(const char *csv, const char *model, const char *scene, const c
     csv_free(&t);
     return 2;
   }
-  ir_model *ir = NULL;
-  lmodel *L = NULL;
+  /* the model's stages up to lowering (no assembly: the drawing needs the
+     bodies, markers and modes, not the state at t = 0) */
+  mbc_unit u;
+  memset(&u, 0, sizeof u);
   if (model) {
-    ir = ir_read(model, scene);
-    if (ir) L = lower_model(ir);
-    if (!L) {
-      if (ir && !diag_errors()) fprintf(stderr, "mbcc: error: out of memory while lowering\n");
-      ir_free(ir);
+    if (!mbc_unit_read(&u, model, scene) && !flex_reduce(u.ir, &u.flex))
+      u.lowered = lower_model(u.ir, &u.flex);
+    if (!u.lowered) {
+      if (u.ir && !diag_errors()) fprintf(stderr, "mbcc: error: out of memory while lowering\n");
+      mbc_unit_free(&u);
       csv_free(&t);
       return 2;
     }
   }
+  const ir_model *ir = u.ir;
+  const lmodel *L = u.lowered;
   sbuf b = {0};
   int rc = 0, tcol = 0;
   sb_add(&b, "{\"model\":");
@@ -493,8 +498,7 @@ int animate_write(const char *csv, const char *model, const char *scene, const c
   if (!rc && b.bad) { fprintf(stderr, "mbcc: error: out of memory\n"); rc = 2; }
   if (!rc) rc = write_page(html, model ? L->name : csv, &b, quiet);
   free(b.s);
-  if (L) lower_free(L);
-  ir_free(ir);
+  mbc_unit_free(&u);
   csv_free(&t);
   return rc;
 }

@@ -21,7 +21,8 @@
 #include <unistd.h>
 
 #include "diag.h"
-#include "lower.h"
+#include "emit.h"
+#include "unit.h"
 #include "trade.h"
 #include "trade_metric.h"
 
@@ -443,14 +444,16 @@ static void build_variant(const trade_options *o, const char *workdir, variant *
   textf(v->why, sizeof v->why, "the model does not build with these settings (see %s)", log);
   int saved = redirect_stderr(log);
   diag_reset();
-  ir_model *ir = ir_read(o->model, o->scene);
-  lmodel *L = NULL;
-  if (ir) {
-    apply_variant(ir, v);
-    L = lower_model(ir);
+  mbc_unit u;
+  int st = mbc_unit_read(&u, o->model, o->scene);
+  if (!st) {
+    apply_variant(u.ir, v);
+    st = mbc_unit_finish(&u, 0);
   }
-  if (L) L->real_float = v->real_float;
-  if (L && !assemble_model(L, 0) && !emit_model(L, dir)) {
+  u.real_float = v->real_float;
+  const ir_model *ir = u.ir;
+  const lmodel *L = u.lowered;
+  if (!st && !emit_model(&u, dir)) {
     v->nmodes = 0;
     int coup = -1, virt = 0;
     for (int b = 1; b < ir->nbodies; b++)
@@ -471,8 +474,7 @@ static void build_variant(const trade_options *o, const char *workdir, variant *
   }
   restore_stderr(saved);
   if (!v->ok) last_error_line(log, v->why, sizeof v->why);
-  if (L) lower_free(L);
-  if (ir) ir_free(ir);
+  mbc_unit_free(&u);
   diag_reset();
 }
 
@@ -711,14 +713,13 @@ int cmd_trade(int argc, char **argv) {
   if (parse_trade_options(argc, argv, &o)) return 2;
 
   /* the model as written: errors in it (or an unknown scene) are reported here */
-  ir_model *ir = ir_read(o.model, o.scene);
-  if (!ir) return 2;
-  lmodel *L = lower_model(ir);
-  if (!L || assemble_model(L, 0)) {
-    if (L) lower_free(L);
-    ir_free(ir);
+  mbc_unit u;
+  if (mbc_unit_build(&u, o.model, o.scene, 0)) {
+    mbc_unit_free(&u);
     return 2;
   }
+  const ir_model *ir = u.ir;
+  const lmodel *L = u.lowered;
   char name[256];
   snprintf(name, sizeof name, "%s", L->m.name);
   /* the chosen outputs */
@@ -735,8 +736,7 @@ int cmd_trade(int argc, char **argv) {
         fprintf(stderr, "mbcc: error: --outputs: '%s' is not an output column of %s (columns:", tok, name);
         for (int c = 0; c < L->m.ncols; c++) fprintf(stderr, " %s", L->m.col_name[c]);
         fprintf(stderr, ")\n");
-        lower_free(L);
-        ir_free(ir);
+        mbc_unit_free(&u);
         return 2;
       }
       if (nsel < MAXCOL) snprintf(selnames[nsel++], sizeof selnames[0], "%s", tok);
@@ -744,7 +744,7 @@ int cmd_trade(int argc, char **argv) {
   } else {
     for (int c = 0; c < L->m.ncols && nsel < MAXCOL; c++) snprintf(selnames[nsel++], sizeof selnames[0], "%s", L->m.col_name[c]);
   }
-  if (!nsel) { fprintf(stderr, "mbcc: error: the model has no outputs to compare\n"); lower_free(L); ir_free(ir); return 2; }
+  if (!nsel) { fprintf(stderr, "mbcc: error: the model has no outputs to compare\n"); mbc_unit_free(&u); return 2; }
   /* what the model has: flexible bodies and their mode selection */
   int nflex = 0, model_count = -1, model_coupling = -1, model_virtual = 0;
   for (int b = 1; b < ir->nbodies; b++) {
@@ -756,8 +756,7 @@ int cmd_trade(int argc, char **argv) {
   }
   for (int j = 0; j < ir->njoints; j++) model_virtual |= ir->joints[j].via_virtual;
   double output_step = o.output_step > 0 ? o.output_step : ir->sim.output_step;
-  lower_free(L);
-  ir_free(ir);
+  mbc_unit_free(&u);
 
   /* the integrator settings: rk4 at a quarter and a sixteenth of the output
      step, dopri5 and genalpha at three tolerances */

@@ -1,0 +1,35 @@
+/* unit.h: one compilation unit, the products of every stage of the pipeline
+ *   read -> scene -> flexible bodies -> lower -> pattern -> assembly analysis -> plan
+ * each built once (compiler/pipeline.c) and then only read: by `mbcc check`,
+ * by the emitters (every output file from the same plan), by the tools. */
+#ifndef MBCC_UNIT_H
+#define MBCC_UNIT_H
+
+#include "flex.h"
+#include "ir.h"
+#include "lower.h"
+#include "order.h"
+
+typedef struct mbc_unit {
+  const char *path, *scene; /* as given on the command line */
+  ir_model *ir;             /* read, the scene applied (ir_read) */
+  flex_product flex;        /* the flexible bodies' modes and invariants (flex_reduce) */
+  lmodel *lowered;          /* coordinates, rows, pattern, assembled (lower_model, assemble_model) */
+  ldl_plan plan;            /* the emitted LDL^T's ordering and symbolic factorization */
+  int have_plan;            /* 0: the ordering failed (the model then has no emitted LDL^T) */
+  int real_float;           /* emit for single precision (--real float) */
+} mbc_unit;
+
+/* The first stage alone: read the model and apply the scene, so that a tool
+ * can change the IR before the rest (mbcc trade's variants).  0, or 2 after
+ * reporting. */
+int mbc_unit_read(mbc_unit *u, const char *path, const char *scene);
+/* The stages after reading: flexible bodies, lowering and pattern, assembly
+ * analysis (verbose: its report on stdout), the LDL^T plan.  0, or 2 after
+ * reporting. */
+int mbc_unit_finish(mbc_unit *u, int verbose);
+/* Both: the whole pipeline */
+int mbc_unit_build(mbc_unit *u, const char *path, const char *scene, int verbose);
+void mbc_unit_free(mbc_unit *u);
+
+#endif
