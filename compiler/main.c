@@ -16,13 +16,12 @@
 #include "diag.h"
 #include "emit.h"
 #include "fe.h"
-#include "emit.h"
-#include "fe.h"
 #include "flex.h"
 #include "help.h"
 #include "lower.h"
 #include "mb_driver.h"
 #include "order.h"
+#include "outfile.h"
 #include "paths.h"
 #include "plot.h"
 #include "proc.h"
@@ -211,13 +210,11 @@ static int cmd_modes(const options *o) {
   printf("\n");
   int st = 0;
   if (o->shapes) {
-    char tmp[4200];
-    snprintf(tmp, sizeof tmp, "%s.part", o->shapes);
-    FILE *f = fopen(tmp, "w");
-    if (!f) {
-      fprintf(stderr, "mbcc: error: cannot write '%s'\n", tmp);
+    out_file out;
+    if (out_file_open(&out, o->shapes)) {
       st = 2;
     } else {
+      FILE *f = out.f;
       fprintf(f, "node,x,y,z");
       for (int j = 0; j < fm.nmodes; j++)
         fprintf(f, ",m%d_ux,m%d_uy,m%d_uz,m%d_rx,m%d_ry,m%d_rz", j + 1, j + 1, j + 1, j + 1, j + 1, j + 1);
@@ -229,7 +226,7 @@ static int cmd_modes(const options *o) {
             fprintf(f, ",%.17g", fm.shapes[(size_t)j * 6 * (size_t)fm.nnodes + 6 * (size_t)k + (size_t)i]);
         fputc('\n', f);
       }
-      if (fclose(f) || rename(tmp, o->shapes)) { remove(tmp); st = 2; }
+      if (out_file_commit(&out)) st = 2;
       else printf("wrote %s\n", o->shapes);
     }
   }

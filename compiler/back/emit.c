@@ -21,56 +21,10 @@
 #include "emit_force.h"
 #include "emit_rows.h"
 #include "element.h"
+#include "emit_util.h"
+#include "outfile.h"
 #include "flex.h"
 #include "lower.h"
-
-/* out = a/b; nonzero if it does not fit */
-static int join(char *out, size_t n, const char *a, const char *b) {
-  int k = snprintf(out, n, "%s/%s", a, b);
-  return k < 0 || (size_t)k >= n;
-}
-
-static void num(FILE *f, double x) {
-  if (x == 0) x = 0; /* no "-0" */
-  fprintf(f, "%.17g", x);
-}
-
-static void vec(FILE *f, const double *x, int n) {
-  fputc('{', f);
-  for (int i = 0; i < n; i++) {
-    if (i) fputs(", ", f);
-    num(f, x[i]);
-  }
-  fputc('}', f);
-}
-
-static void ivec(FILE *f, const int *x, int n) {
-  fputc('{', f);
-  for (int i = 0; i < n; i++) fprintf(f, "%s%d", i ? ", " : "", x[i]);
-  fputc('}', f);
-}
-
-/* a long int array, 16 per line */
-static void int_array(FILE *f, const char *name, const int *x, int n) {
-  fprintf(f, "static const int %s[%d] = {", name, n);
-  for (int i = 0; i < n; i++) fprintf(f, "%s%d", i % 16 ? ", " : (i ? ",\n  " : "\n  "), x[i]);
-  fprintf(f, "\n};\n");
-}
-
-static void real_array(FILE *f, const char *name, const double *x, int n) {
-  fprintf(f, "static const mb_real %s[%d] = {", name, n);
-  for (int i = 0; i < n; i++) {
-    fputs(i % 4 ? ", " : (i ? ",\n  " : "\n  "), f);
-    num(f, x[i]);
-  }
-  fprintf(f, "\n};\n");
-}
-
-static void upper(char *dst, const char *src, size_t n) {
-  size_t i = 0;
-  for (; src[i] && i + 1 < n; i++) dst[i] = (char)toupper((unsigned char)src[i]);
-  dst[i] = 0;
-}
 
 /* Free text (a file path, a scene name) made safe inside a C comment: no
  * comment end or start, no line break or control character, no trigraph.
@@ -93,8 +47,8 @@ static void loc_comment(FILE *f, const lmodel *L, ir_loc loc) {
   fprintf(f, "%s:%d:%d", comment_text(L->ir->path), loc.line, loc.col);
 }
 
-static void emit_flex_tables(FILE *f, const lmodel *L, int b);
-static void emit_flex_contract(FILE *f, const lmodel *L, int b);
+static void emit_flex_tables(emit_ctx *cx, int b);
+static void emit_flex_contract(emit_ctx *cx, int b);
 
 /* entry (i, l) of a flexible body's mass matrix from the moving blocks of
  * mb_flex_assemble (runtime/core/mb_flex.h): AS = A S~, AS1 = A S1, cs.J, cs.Gw */
@@ -236,13 +190,15 @@ static void emit_force_tables(FILE *f, const lmodel *L) {
 }
 
 /* the tables: bodies, markers, rows, forces, profiles, outputs */
-static void emit_tables(FILE *f, const lmodel *L) {
+static void emit_tables(emit_ctx *cx) {
+  FILE *f = cx->f;
+  const lmodel *L = cx->L;
   const mb_model *m = &L->m;
   fprintf(f, "/* --- element tables (also used for outputs and energy) --- */\n");
   for (int b = 0; b < m->nbody; b++)
     if (L->body[b].kind == MB_BODY_FLEXIBLE) {
-      emit_flex_tables(f, L, b);
-      emit_flex_contract(f, L, b);
+      emit_flex_tables(cx, b);
+      emit_flex_contract(cx, b);
     }
   if (L->nmodal_slot) int_array(f, "modal_slot", L->modal_slot, L->nmodal_slot);
   for (int k = 0; k < m->nprofile; k++) {
@@ -409,7 +365,9 @@ void emit_add_cols(FILE *f, int vadr, int n) { add_cols(f, vadr, n); }
 void emit_num(FILE *f, double x) { num(f, x); }
 
 /* a flexible body's constant data: invariants, node shapes, mass-block slots */
-static void emit_flex_tables(FILE *f, const lmodel *L, int b) {
+static void emit_flex_tables(emit_ctx *cx, int b) {
+  FILE *f = cx->f;
+  const lmodel *L = cx->L;
   const mb_body *B = &L->body[b];
   const mb_flex *x = B->flex;
   int nm = x->nm, nn = x->nnode;
@@ -469,14 +427,16 @@ static void emit_sum(FILE *f, const char *lhs, double c0, const double *coef, co
  * runtime/core/mb_flex.h) straight-line: the invariants' nonzero entries as
  * literal constants, zeros skipped (the tables are cleaned of rounding
  * residue in compiler/flex/flex.c, so the generic path sums the same terms) */
-static void emit_flex_contract(FILE *f, const lmodel *L, int b) {
+static void emit_flex_contract(emit_ctx *cx, int b) {
+  FILE *f = cx->f;
+  const lmodel *L = cx->L;
   const mb_body *B = &L->body[b];
   const mb_flex *x = B->flex;
   int nm = x->nm;
   int lin = x->coupling != MB_COUPLING_CONSTANT, quad = x->coupling == MB_COUPLING_FULL;
   double *coef = malloc(sizeof(double) * (size_t)(nm + 1));
   int *idx = malloc(sizeof(int) * (size_t)(nm + 1));
-  if (!coef || !idx) { free(coef); free(idx); return; }
+  if (!coef || !idx) { free(coef); free(idx); cx->failed = 1; return; }
   long nterm = 0;
   char lhs[64];
   fprintf(f, "\n/* flexible body '%s': the per-step contractions of its inertia invariants with\n"
@@ -560,7 +520,10 @@ static void emit_flex_contract(FILE *f, const lmodel *L, int b) {
   free(idx);
 }
 
-static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
+static void emit_eval(emit_ctx *cx) {
+  FILE *f = cx->f;
+  const lmodel *L = cx->L;
+  const char *nm = cx->nm;
   const mb_model *m = &L->m;
   fprintf(f,
           "\n/* Fill the varying entries of K, rhs = [f; gamma], phi and phid = D v - nu at (t, q, v). */\n"
@@ -586,7 +549,7 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
      its body's frame: then it is not stored); 2 forces or other rows pass it
      to kernels by address */
   char *use = calloc(m->nmarker ? (size_t)m->nmarker : 1, 1);
-  if (!use) { fputs("out of memory\n", stderr); exit(1); }
+  if (!use) { cx->failed = 1; return; }
   for (int i = 0; i < m->nforce; i++) {
     use[L->force[i].m0] = 2;
     if (L->force[i].m1 >= 0) use[L->force[i].m1] = 2;
@@ -711,7 +674,10 @@ static void emit_eval(FILE *f, const lmodel *L, const char *nm) {
   fputs("}\n", f);
 }
 
-static void emit_init(FILE *f, const lmodel *L, const char *nm) {
+static void emit_init(emit_ctx *cx) {
+  FILE *f = cx->f;
+  const lmodel *L = cx->L;
+  const char *nm = cx->nm;
   const mb_model *m = &L->m;
   fprintf(f, "\n/* The constant entries of K (mass matrix, constant Jacobian entries); all else 0. */\n"
              "void %s_init(const mb_model *m, mb_real *Kx) {\n  (void)m;\n"
@@ -753,24 +719,11 @@ static void emit_init(FILE *f, const lmodel *L, const char *nm) {
   fputs("}\n", f);
 }
 
-static int write_file(const char *dir, const char *name, const mbc_unit *u,
-                      void (*body)(FILE *, const mbc_unit *, const char *), char *final_paths,
-                      size_t cap) {
-  char path[4096];
-  if (join(path, sizeof path, dir, name)) return -1;
-  FILE *f = fopen(path, "w");
-  if (!f) return -1;
-  body(f, u, u->lowered->m.name);
-  int bad = ferror(f);
-  if (fclose(f) || bad) return -1;
-  (void)final_paths; (void)cap;
-  return 0;
-}
-
-static void emit_header(FILE *f, const mbc_unit *u, const char *nm) {
-  const lmodel *L = u->lowered;
-  char U[256];
-  upper(U, nm, sizeof U);
+static void emit_header(emit_ctx *cx) {
+  FILE *f = cx->f;
+  const mbc_unit *u = cx->u;
+  const lmodel *L = cx->L;
+  const char *nm = cx->nm, *U = cx->NM;
   const mb_model *m = &L->m;
   fprintf(f, "/* %s.h: generated by mbcc from %s%s%s. Do not edit. */\n", nm, comment_text(L->ir->path),
           L->ir->scene ? ", scene " : "", L->ir->scene ? comment_text(L->ir->scene) : "");
@@ -788,14 +741,14 @@ static void emit_header(FILE *f, const mbc_unit *u, const char *nm) {
   fprintf(f, "extern const mb_model %s_model;\n", nm);
   fprintf(f, "void %s_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,\n"
              "    mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *phid, void *work);\n", nm);
-  emit_ldl_header(f, u, nm);
+  emit_ldl_header(cx);
   fprintf(f, "void %s_init(const mb_model *m, mb_real *Kx);\n\n#endif\n", nm);
 }
 
-static void emit_source(FILE *f, const mbc_unit *u, const char *nm) {
-  const lmodel *L = u->lowered;
-  char U[256];
-  upper(U, nm, sizeof U);
+static void emit_source(emit_ctx *cx) {
+  FILE *f = cx->f;
+  const lmodel *L = cx->L;
+  const char *nm = cx->nm, *U = cx->NM;
   const mb_model *m = &L->m;
   fprintf(f, "/* %s.c: generated by mbcc from %s%s%s. Do not edit.\n", nm, comment_text(L->ir->path),
           L->ir->scene ? ", scene " : "", L->ir->scene ? comment_text(L->ir->scene) : "");
@@ -810,10 +763,10 @@ static void emit_source(FILE *f, const mbc_unit *u, const char *nm) {
   if (m->nq) real_array(f, "q0", L->q0, m->nq);
   if (m->nv) real_array(f, "v0", L->v0, m->nv);
   fputc('\n', f);
-  emit_tables(f, L);
-  emit_init(f, L, nm);
-  emit_eval(f, L, nm);
-  int ldl = emit_ldl(f, u, nm);
+  emit_tables(cx);
+  emit_init(cx);
+  emit_eval(cx);
+  int ldl = emit_ldl(cx);
   fprintf(f, "\nconst mb_model %s_model = {\n", nm);
   fprintf(f, "  .name = \"%s\",\n  .nbody = %d, .nmarker = %d, .nrow = %d, .nforce = %d,\n"
              "  .nprofile = %d, .noutput = %d, .njoint = %d,\n"
@@ -833,7 +786,7 @@ static void emit_source(FILE *f, const mbc_unit *u, const char *nm) {
   fprintf(f, ",\n  .Kp = Kp, .Ki = %s, .q0 = %s, .v0 = %s, .modal_slot = %s,\n", m->nnz ? "Ki" : "0",
           m->nq ? "q0" : "0", m->nv ? "v0" : "0", L->nmodal_slot ? "modal_slot" : "0");
   if (L->noutput_coef) fputs("  .output_coef = output_coef,\n", f);
-  emit_ldl_fields(f, nm, ldl);
+  emit_ldl_fields(cx, ldl);
   fprintf(f, "  .ncols = %s_NCOLS, .col_name = %s,\n  .eval = %s_eval, .init = %s_init,\n};\n", U,
           m->ncols ? "col_names" : "0", nm, nm);
 }
@@ -867,20 +820,15 @@ const char *emit_root_dir(void) {
 #endif
 }
 
-/* Fill templates/<name> (@MODEL@, @SETTINGS@, @SOLVER@) into out; 0 or 2 */
-int emit_template(const mbc_unit *u, const char *name, const char *out) {
+/* templates/<name> with @MODEL@, @SETTINGS@ and @SOLVER@ filled in, written
+ * to f; 0, or 2 after reporting */
+static int fill_template(FILE *f, const mbc_unit *u, const char *name) {
   const lmodel *L = u->lowered;
   char path[4200];
   snprintf(path, sizeof path, "%s/%s", mbcc_templates_dir(), name);
   FILE *in = fopen(path, "r");
   if (!in) {
     diag_error(NULL, (ir_loc){0, 0}, "cannot read the template '%s' (set MBCC_ROOT?)", path);
-    return 2;
-  }
-  FILE *f = fopen(out, "w");
-  if (!f) {
-    fclose(in);
-    diag_error(NULL, (ir_loc){0, 0}, "cannot write '%s'", out);
     return 2;
   }
   char line[1024];
@@ -900,65 +848,64 @@ int emit_template(const mbc_unit *u, const char *name, const char *out) {
     }
   }
   fclose(in);
-  int bad = ferror(f);
-  if (fclose(f) || bad) {
-    diag_error(NULL, (ir_loc){0, 0}, "cannot write '%s'", out);
-    return 2;
-  }
   return 0;
 }
 
+int emit_template(const mbc_unit *u, const char *name, const char *out) {
+  out_file o;
+  if (out_file_open(&o, out)) return 2;
+  if (fill_template(o.f, u, name)) {
+    out_file_abort(&o);
+    return 2;
+  }
+  return out_file_commit(&o);
+}
+
+/* the files of the generated directory and what writes each */
+enum { OUT_HEADER, OUT_SOURCE, OUT_MAIN, NOUT };
+
 int emit_model(const mbc_unit *u, const char *dir) {
-  const lmodel *L = u->lowered;
-  const char *nm = L->m.name;
-  char tmp[4096], hname[300], cname[300];
-  snprintf(hname, sizeof hname, "%s.h", nm);
-  snprintf(cname, sizeof cname, "%s.c", nm);
-  /* write everything into a directory of this process's own (two mbcc at once
-     never share it), then move each file in: nothing half-written */
-  snprintf(tmp, sizeof tmp, "%s.tmp.XXXXXX", dir);
-  if (!mkdtemp(tmp)) {
-    diag_error(NULL, (ir_loc){0, 0}, "cannot create directory '%s': %s", tmp, strerror(errno));
+  const char *nm = u->lowered->m.name;
+  if (mkdir(dir, 0777) && errno != EEXIST) {
+    diag_error(NULL, (ir_loc){0, 0}, "cannot create directory '%s': %s", dir, strerror(errno));
     return 2;
   }
-  char main_path[4200];
-  snprintf(main_path, sizeof main_path, "%s/main.c", tmp);
-  if (emit_template(u, "main.c.in", main_path)) return 2;
-  if (write_file(tmp, hname, u, emit_header, NULL, 0) ||
-      write_file(tmp, cname, u, emit_source, NULL, 0)) {
-    diag_error(NULL, (ir_loc){0, 0}, "cannot write generated code in '%s'", tmp);
-    for (int i = 0; i < 3; i++) {
-      char path[4096];
-      const char *names[3] = {hname, cname, "main.c"};
-      if (!join(path, sizeof path, tmp, names[i])) remove(path);
+  /* every file is written as .part; renamed only when all of them are complete */
+  out_file out[NOUT];
+  memset(out, 0, sizeof out);
+  int st = 0;
+  for (int i = 0; i < NOUT && !st; i++) {
+    char path[4096];
+    int k = snprintf(path, sizeof path, i == OUT_MAIN ? "%s/main.c" : i == OUT_HEADER ? "%s/%s.h" : "%s/%s.c",
+                     dir, nm);
+    if (k < 0 || (size_t)k >= sizeof path) {
+      diag_error(NULL, (ir_loc){0, 0}, "output directory name too long: '%s'", dir);
+      st = 2;
+      break;
     }
-    rmdir(tmp);
-    return 2;
-  }
-  if (u->real_float) { /* float literals and float math in the model (not the hosted main.c) */
-    char hpath[4400], cpath[4400];
-    snprintf(hpath, sizeof hpath, "%s/%s", tmp, hname);
-    snprintf(cpath, sizeof cpath, "%s/%s", tmp, cname);
-    if (emit_float_dialect(hpath) || emit_float_dialect(cpath)) {
-      diag_error(NULL, (ir_loc){0, 0}, "cannot rewrite the generated code in '%s' for single precision", tmp);
-      return 2;
-    }
-  }
-  /* replace the old directory's files */
-  mkdir(dir, 0777);
-  const char *files[3] = {hname, cname, "main.c"};
-  for (int i = 0; i < 3; i++) {
-    char from[4096], to[4096];
-    if (join(from, sizeof from, tmp, files[i])) return -1;
-    if (join(to, sizeof to, dir, files[i])) return -1;
-    if (rename(from, to)) {
-      diag_error(NULL, (ir_loc){0, 0}, "cannot move '%s' to '%s': %s", from, to, strerror(errno));
-      for (int j = i; j < 3; j++)
-        if (!join(from, sizeof from, tmp, files[j])) remove(from);
-      rmdir(tmp);
-      return 2;
+    if (out_file_open(&out[i], path)) { st = 2; break; }
+    emit_ctx cx;
+    emit_ctx_init(&cx, out[i].f, u);
+    if (i == OUT_HEADER) emit_header(&cx);
+    else if (i == OUT_SOURCE) emit_source(&cx);
+    else st = fill_template(out[i].f, u, "main.c.in");
+    if (cx.failed) {
+      diag_error(NULL, (ir_loc){0, 0}, "out of memory while writing '%s'", path);
+      st = 2;
     }
   }
-  rmdir(tmp);
-  return 0;
+  /* single precision: float literals and float math in the model's .h and
+     .c (not in the hosted main.c), rewritten in the .part files */
+  for (int i = 0; !st && u->real_float && i < NOUT; i++) {
+    if (i == OUT_MAIN) continue;
+    if (fflush(out[i].f) || ferror(out[i].f) || emit_float_dialect(out[i].part)) {
+      diag_error(NULL, (ir_loc){0, 0}, "cannot rewrite '%s' for single precision", out[i].part);
+      st = 2;
+    }
+  }
+  for (int i = 0; i < NOUT; i++) {
+    if (st) out_file_abort(&out[i]);
+    else st = out_file_commit(&out[i]);
+  }
+  return st;
 }

@@ -35,35 +35,8 @@
 #include <string.h>
 
 #include "emit_ldl.h"
+#include "emit_util.h"
 #include "order.h"
-
-static void upper(char *dst, const char *src, size_t n) {
-  size_t i = 0;
-  for (; src[i] && i + 1 < n; i++) dst[i] = (char)toupper((unsigned char)src[i]);
-  dst[i] = 0;
-}
-
-static void num(FILE *f, double x) {
-  if (x == 0) x = 0;
-  fprintf(f, "%.17g", x);
-}
-
-static void int_array(FILE *f, const char *name, const int *x, long n) {
-  fprintf(f, "static const int %s[%ld] = {", name, n > 0 ? n : 1);
-  if (n <= 0) fputs("0", f);
-  for (long i = 0; i < n; i++) fprintf(f, "%s%d", i % 16 ? ", " : (i ? ",\n  " : "\n  "), x[i]);
-  fprintf(f, "\n};\n");
-}
-
-static void real_array(FILE *f, const char *name, const double *x, long n) {
-  fprintf(f, "static const mb_real %s[%ld] = {", name, n > 0 ? n : 1);
-  if (n <= 0) fputs("0", f);
-  for (long i = 0; i < n; i++) {
-    fputs(i % 4 ? ", " : (i ? ",\n  " : "\n  "), f);
-    num(f, x[i]);
-  }
-  fprintf(f, "\n};\n");
-}
 
 /* the comment above ldl_block_rhs (both forms) */
 #define BLOCK_RHS_COMMENT                                                                      \
@@ -116,11 +89,11 @@ static long work_size(const ldl_plan *p) {
   return w;
 }
 
-void emit_ldl_header(FILE *f, const mbc_unit *u, const char *nm) {
-  if (!u->have_plan) return;
-  const ldl_plan *p = &u->plan;
-  char U[256];
-  upper(U, nm, sizeof U);
+void emit_ldl_header(emit_ctx *cx) {
+  FILE *f = cx->f;
+  const char *nm = cx->nm, *U = cx->NM;
+  if (!cx->u->have_plan) return;
+  const ldl_plan *p = &cx->u->plan;
   fprintf(f, "/* emitted LDL^T of K (solver \"ldl\"), see %s.c */\n", nm);
   fprintf(f, "#define %s_LDL_NNZL %ld      /* nonzeros of L (strictly lower) */\n", U, p->nnzL);
   fprintf(f, "#define %s_LDL_FLOPS %.0f.0  /* flops of one numeric factorization */\n", U, p->flops);
@@ -133,11 +106,10 @@ void emit_ldl_header(FILE *f, const mbc_unit *u, const char *nm) {
   fprintf(f, "int %s_ldl_solve(const mb_real *Kx, mb_real *work, mb_real *b, mb_real *residual);\n", nm);
 }
 
-void emit_ldl_fields(FILE *f, const char *nm, int emitted) {
+void emit_ldl_fields(emit_ctx *cx, int emitted) {
   if (!emitted) return;
-  char U[256];
-  upper(U, nm, sizeof U);
-  fprintf(f, "  .ldl_factor = ldl_factor_m, .ldl_solve = ldl_solve_m, .ldl_worksize = %s_LDL_WORK,\n"
+  const char *U = cx->NM;
+  fprintf(cx->f, "  .ldl_factor = ldl_factor_m, .ldl_solve = ldl_solve_m, .ldl_worksize = %s_LDL_WORK,\n"
              "  .ldl_nnzL = %s_LDL_NNZL, .ldl_flops = %s_LDL_FLOPS, .ldl_straight = %s_LDL_STRAIGHT,\n"
              "  .ldl_exact = %s_LDL_EXACT,\n",
           U, U, U, U, U);
@@ -145,42 +117,14 @@ void emit_ldl_fields(FILE *f, const char *nm, int emitted) {
 
 /* ---------------------------------------------------------------- helpers */
 
-/* Where the straight-line code reads the entry at position q of K' (the
- * plan's slots): with block pivots, the entries they change (and the
- * decoupled diagonals) are in Kc (the block pivots' output, kc_of[q] >= 0),
- * all others straight from Kx (slot Krmap[q]); without, K' = K.  (The looped
- * code gathers all of K' into Kc instead: kc_of[q] = q.) */
-static const int *kc_of, *kc_map;
-/* with massless bodies (straight-line code): the K1 gather's sources (a Kx
- * slot, or -1: 0, -2: 1, -3: -1, -4: computed), to write K1's constants as
- * literals */
-static const int *k1_map;
-/* straight-line code: the entries of Kx that init sets once and eval never
- * writes (+1 or -1: a rigid body's translational columns in a point row), 0
- * for the others; they become literals too */
-static const signed char *kx_cst;
-/* the space of the slots kput prints: 1 the block pivots' (K1 with massless
- * bodies, else Kx), 0 Kx itself (the massless bodies' code) */
-static int kput_k1;
-/* straight-line code with massless bodies: K1 is not gathered; a read of its
- * slot q goes to Kx at the slot it was gathered from (k1_map[q] >= 0), to the
- * K1 array only for the entries the massless bodies' elimination computes
- * (-4), and constants are literals */
-static int k1_direct;
-/* straight-line block pivots: the entries of Kc known at compile time (a
- * weld's translational rows: unit D_u and unit rows on both sides), kc_cst[k]
- * set and the value in kc_val[k]; those are not stored, their readers get the
- * literal */
-static char *kc_cst;
-static double *kc_val;
 
-static int kconst(int q, double *v);
+static int kconst(const emit_ctx *cx, int q, double *v);
 
 /* 1 if the slot of the block pivots' space (k1) or of Kx holds a compile-time
  * constant (K1's constants, init's entries of Kx), its value in *v */
-static int slot_const(int slot, int k1, double *v) {
-  if (k1 && k1_map) {
-    int s = k1_map[slot];
+static int slot_const(const emit_ctx *cx, int slot, int k1, double *v) {
+  if (k1 && cx->ldl.k1_map) {
+    int s = cx->ldl.k1_map[slot];
     if (s == -4) return 0;
     if (s < 0) {
       *v = s == -2 ? 1 : s == -3 ? -1 : 0;
@@ -188,38 +132,40 @@ static int slot_const(int slot, int k1, double *v) {
     }
     slot = s;
   }
-  if (!kx_cst || !kx_cst[slot]) return 0;
-  *v = kx_cst[slot];
+  if (!cx->ldl.kx_cst || !cx->ldl.kx_cst[slot]) return 0;
+  *v = cx->ldl.kx_cst[slot];
   return 1;
 }
 
 /* where the straight-line code reads slot q, into buf: of Kx (k1 = 0), or of
  * the block pivots' space (k1 = 1: K1 with massless bodies, else Kx) */
-static void kname_buf(char *buf, size_t n, int q, int k1) {
-  int s = k1 && k1_direct && k1_map ? k1_map[q] : q;
-  if (!k1 || !k1_direct || !k1_map || s >= 0) snprintf(buf, n, "Kx[%d]", s);
+static void kname_buf(const emit_ctx *cx, char *buf, size_t n, int q, int k1) {
+  int s = k1 && cx->ldl.k1_direct && cx->ldl.k1_map ? cx->ldl.k1_map[q] : q;
+  if (!k1 || !cx->ldl.k1_direct || !cx->ldl.k1_map || s >= 0) snprintf(buf, n, "Kx[%d]", s);
   else if (s == -4) snprintf(buf, n, "K1[%d]", q);
   else snprintf(buf, n, "%s", s == -2 ? "1" : s == -3 ? "-1" : "0");
 }
 
-static void kname(FILE *f, int q) {
+static void kname(emit_ctx *cx, int q) {
+  FILE *f = cx->f;
   char b[32];
-  kname_buf(b, sizeof b, q, 1);
+  kname_buf(cx, b, sizeof b, q, 1);
   fputs(b, f);
 }
 
 /* into buf: kname_buf's name of the slot (space k1), or its value when it is
  * a compile-time constant */
-static void kput_buf(char *buf, size_t n, int slot, int k1) {
+static void kput_buf(const emit_ctx *cx, char *buf, size_t n, int slot, int k1) {
   double c;
-  if (slot_const(slot, k1, &c)) snprintf(buf, n, "%.17g", c == 0 ? 0 : c);
-  else kname_buf(buf, n, slot, k1);
+  if (slot_const(cx, slot, k1, &c)) snprintf(buf, n, "%.17g", c == 0 ? 0 : c);
+  else kname_buf(cx, buf, n, slot, k1);
 }
 
 /* kput_buf of the slot in the space kput_k1, written to f */
-static void kput(FILE *f, int slot) {
+static void kput(emit_ctx *cx, int slot) {
+  FILE *f = cx->f;
   char b[32];
-  kput_buf(b, sizeof b, slot, kput_k1);
+  kput_buf(cx, b, sizeof b, slot, cx->ldl.kput_k1);
   fputs(b, f);
 }
 
@@ -227,7 +173,8 @@ static void kput(FILE *f, int slot) {
  * c, a factor 1 then dropped and a zero term left out; 'any': a term came
  * before (then " + " or " - ").  The same products in the same order: a
  * product with +-1 is exact, so the numbers do not change. */
-static void put_term(FILE *f, int *any, int known, double c, const char *coef, const char *v) {
+static void put_term(emit_ctx *cx, int *any, int known, double c, const char *coef, const char *v) {
+  FILE *f = cx->f;
   if (known) {
     if (c == 0) return;
     fputs(*any ? (c < 0 ? " - " : " + ") : (c < 0 ? "-" : ""), f);
@@ -243,40 +190,41 @@ static void put_term(FILE *f, int *any, int known, double c, const char *coef, c
 }
 
 /* put_term with the slot's entry (space kput_k1) as the coefficient */
-static void put_kterm(FILE *f, int *any, int slot, const char *v) {
+static void put_kterm(emit_ctx *cx, int *any, int slot, const char *v) {
   double c;
   char coef[32];
-  int known = slot_const(slot, kput_k1, &c);
-  kname_buf(coef, sizeof coef, slot, kput_k1);
-  put_term(f, any, known, c, coef, v);
+  int known = slot_const(cx, slot, cx->ldl.kput_k1, &c);
+  kname_buf(cx, coef, sizeof coef, slot, cx->ldl.kput_k1);
+  put_term(cx, any, known, c, coef, v);
 }
 
-static void kval(FILE *f, int q) {
+static void kval(emit_ctx *cx, int q) {
+  FILE *f = cx->f;
   double c;
-  if (kconst(q, &c)) num(f, c);
-  else if (!kc_of) kname(f, q);
-  else if (kc_of[q] >= 0) fprintf(f, "Kc[%d]", kc_of[q]);
-  else if (kc_map[q] >= 0) kname(f, kc_map[q]);
-  else fputs(kc_map[q] == -2 ? "1" : kc_map[q] == -3 ? "-1" : "0", f); /* a constant of K' */
+  if (kconst(cx, q, &c)) num(f, c);
+  else if (!cx->ldl.kc_of) kname(cx, q);
+  else if (cx->ldl.kc_of[q] >= 0) fprintf(f, "Kc[%d]", cx->ldl.kc_of[q]);
+  else if (cx->ldl.kc_map[q] >= 0) kname(cx, cx->ldl.kc_map[q]);
+  else fputs(cx->ldl.kc_map[q] == -2 ? "1" : cx->ldl.kc_map[q] == -3 ? "-1" : "0", f); /* a constant of K' */
 }
 
 /* 1 if kval(q) writes a constant of K' (the decoupled diagonals of the block
  * pivots' unknowns and rows), its value in *v */
-static int kconst(int q, double *v) {
+static int kconst(const emit_ctx *cx, int q, double *v) {
   int src = q;
-  if (kc_of) {
-    if (kc_of[q] >= 0) {
-      if (!kc_cst || !kc_cst[kc_of[q]]) return 0;
-      *v = kc_val[kc_of[q]];
+  if (cx->ldl.kc_of) {
+    if (cx->ldl.kc_of[q] >= 0) {
+      if (!cx->ldl.kc_cst || !cx->ldl.kc_cst[cx->ldl.kc_of[q]]) return 0;
+      *v = cx->ldl.kc_val[cx->ldl.kc_of[q]];
       return 1;
     }
-    src = kc_map[q];
+    src = cx->ldl.kc_map[q];
     if (src < 0) {
       *v = src == -2 ? 1 : src == -3 ? -1 : 0;
       return 1;
     }
   }
-  return slot_const(src, 1, v);
+  return slot_const(cx, src, 1, v);
 }
 
 /* pivot k of K_aug is a decoupled unknown whose value the block pivots or the
@@ -284,18 +232,18 @@ static int kconst(int q, double *v) {
  * row and column of L, a constant diagonal +-1.  The solve leaves it out. */
 /* pivot k's value when it is a compile-time constant +-1: an empty row of L
  * and a constant diagonal of K_aug (no weighted terms); else 0 */
-static int ldl_const_pivot(const ldl_plan *p, int k) {
+static int ldl_const_pivot(const emit_ctx *cx, const ldl_plan *p, int k) {
   if (p->Rp[k + 1] != p->Rp[k]) return 0;
   int diag = -1;
   for (int e = p->Up[k]; e < p->Up[k + 1]; e++)
     if (p->Ui[e] == k) diag = e;
   double c;
-  if (diag < 0 || p->Us[diag] < 0 || p->Tp[diag] != p->Tp[diag + 1] || !kconst(p->Us[diag], &c)) return 0;
+  if (diag < 0 || p->Us[diag] < 0 || p->Tp[diag] != p->Tp[diag + 1] || !kconst(cx, p->Us[diag], &c)) return 0;
   return c == 1 ? 1 : c == -1 ? -1 : 0;
 }
 
-static int ldl_decoupled(const ldl_plan *p, int k) {
-  if (!p->straight || p->Lp[k + 1] != p->Lp[k] || !ldl_const_pivot(p, k)) return 0;
+static int ldl_decoupled(const emit_ctx *cx, const ldl_plan *p, int k) {
+  if (!p->straight || p->Lp[k + 1] != p->Lp[k] || !ldl_const_pivot(cx, p, k)) return 0;
   int u = p->perm[k];
   for (int e = 0; e < p->nelim; e++)
     for (int i = 0; i < 6; i++)
@@ -310,23 +258,25 @@ static int ldl_decoupled(const ldl_plan *p, int k) {
 }
 
 /* the value of K_aug entry e (upper triangle, permuted) as a C expression */
-static void aug_value(FILE *f, const ldl_plan *p, int e) {
+static void aug_value(emit_ctx *cx, const ldl_plan *p, int e) {
+  FILE *f = cx->f;
   int any = 0;
-  if (p->Us[e] >= 0) { kval(f, p->Us[e]); any = 1; }
+  if (p->Us[e] >= 0) { kval(cx, p->Us[e]); any = 1; }
   for (int t = p->Tp[e]; t < p->Tp[e + 1]; t++) {
     fputs(any ? " + " : "", f);
     num(f, p->w[p->Tw[t]]);
     fputs(" * ", f);
-    kval(f, p->Ta[t]);
+    kval(cx, p->Ta[t]);
     fputs(" * ", f);
-    kval(f, p->Tb[t]);
+    kval(cx, p->Tb[t]);
     any = 1;
   }
   if (!any) fputs("0", f);
 }
 
 /* row sums of |K| (the same straight-line / looped choice as the factorization) */
-static void emit_knorm(FILE *f, const lmodel *L, const ldl_plan *p) {
+static void emit_knorm(emit_ctx *cx, const lmodel *L, const ldl_plan *p) {
+  FILE *f = cx->f;
   const mb_model *m = &L->m;
   fputs("/* ||K||_inf: the largest row sum of |K| (for the relative residual); 'work' from\n"
         " * LDL_R on is scratch */\n"
@@ -344,7 +294,7 @@ static void emit_knorm(FILE *f, const lmodel *L, const ldl_plan *p) {
   int n = m->n;
   int *cnt = calloc((size_t)n + 1, sizeof(int)), *rp = calloc((size_t)n + 1, sizeof(int));
   int *rs = malloc(sizeof(int) * (size_t)(m->nnz + 1));
-  if (!cnt || !rp || !rs) { free(cnt); free(rp); free(rs); return; }
+  if (!cnt || !rp || !rs) { free(cnt); free(rp); free(rs); cx->failed = 1; return; }
   fputs("  {\n    mb_real a = 0, c;\n", f);
   for (int q = 0; q < m->nnz; q++) rp[m->Ki[q] + 1]++;
   for (int i = 0; i < n; i++) rp[i + 1] += rp[i];
@@ -363,7 +313,8 @@ static void emit_knorm(FILE *f, const lmodel *L, const ldl_plan *p) {
 /* sum over k of the terms 'fmt' (two %d: a[k], b[k], e.g. "Lx[%d] * t[%d]"), as up
  * to four interleaved partial sums: one long chain of dependent multiply-adds
  * would leave the straight-line code waiting on latency */
-static void emit_sum(FILE *f, const char *fmt, const int *a, const int *b, int len) {
+static void emit_sum(emit_ctx *cx, const char *fmt, const int *a, const int *b, int len) {
+  FILE *f = cx->f;
   int ways = len >= 8 ? 4 : len >= 4 ? 2 : 1;
   if (ways > 1) fputc('(', f);
   for (int w = 0; w < ways; w++) {
@@ -385,7 +336,8 @@ static void emit_sum(FILE *f, const char *fmt, const int *a, const int *b, int l
  * forwarding then work on small functions, and its time stays linear */
 #define LDL_CHUNK_FLOPS 600
 
-static void emit_factor_straight(FILE *f, const lmodel *L, const ldl_plan *p, const char *nm) {
+static void emit_factor_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *p, const char *nm) {
+  FILE *f = cx->f;
   int n = p->n;
   char name[512];
   /* row k of L is formed in dot-product form: for j in the row (ascending)
@@ -396,7 +348,7 @@ static void emit_factor_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
    * column (axpy) form */
   int *inrow = malloc(sizeof(int) * (size_t)(n + 1)); /* column j in row k: 1 */
   int *kent = malloc(sizeof(int) * (size_t)(n + 1));  /* row i of column k of K_aug: entry e */
-  if (!inrow || !kent) { free(inrow); free(kent); return; }
+  if (!inrow || !kent) { free(inrow); free(kent); cx->failed = 1; return; }
   for (int j = 0; j < n; j++) inrow[j] = 0, kent[j] = -1;
   int nchunk = 0;
   double chunk_flops = 0;
@@ -405,8 +357,8 @@ static void emit_factor_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
       if (k) fputs("  return 0;\n}\n\n", f);
       fprintf(f, "static LDL_NOINLINE int ldl_factor_part%d(const mb_real *restrict Kx,%s%s mb_real *restrict Lx, "
                  "mb_real *restrict Dinv) {\n",
-              nchunk++, p->nelim ? " const mb_real *restrict Kc," : "", k1_direct ? " const mb_real *restrict K1," : "");
-      fprintf(f, "  (void)Kx;\n%s%s  (void)Lx;\n", p->nelim ? "  (void)Kc;\n" : "", k1_direct ? "  (void)K1;\n" : "");
+              nchunk++, p->nelim ? " const mb_real *restrict Kc," : "", cx->ldl.k1_direct ? " const mb_real *restrict K1," : "");
+      fprintf(f, "  (void)Kx;\n%s%s  (void)Lx;\n", p->nelim ? "  (void)Kc;\n" : "", cx->ldl.k1_direct ? "  (void)K1;\n" : "");
       chunk_flops = 0;
     }
     int u = p->perm[k];
@@ -419,7 +371,7 @@ static void emit_factor_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
       if (p->Ui[e] == k) diag = e;
       else kent[p->Ui[e]] = e;
     }
-    int dc = ldl_const_pivot(p, k);
+    int dc = ldl_const_pivot(cx, p, k);
     if (dc) {
       /* a decoupled unknown: no entries in its row of L, a constant pivot */
       fprintf(f, "  Dinv[%d] = %s;\n", k, dc > 0 ? "1" : "-1");
@@ -437,7 +389,7 @@ static void emit_factor_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
     for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) {
       int j = p->Rj[r], any = 0;
       fprintf(f, "    y%d = ", j);
-      if (kent[j] >= 0) { aug_value(f, p, kent[j]); any = 1; }
+      if (kent[j] >= 0) { aug_value(cx, p, kent[j]); any = 1; }
       for (int rr = p->Rp[j]; rr < p->Rp[j + 1]; rr++)
         if (inrow[p->Rj[rr]]) {
           fprintf(f, "%sLx[%d] * y%d", any ? " - " : "-", p->Rpos[rr], p->Rj[rr]);
@@ -448,7 +400,7 @@ static void emit_factor_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
       chunk_flops += 2.0 * (p->Rpos[r] - p->Lp[j]) + 3;
     }
     fputs("    d = ", f);
-    if (diag >= 0) aug_value(f, p, diag);
+    if (diag >= 0) aug_value(cx, p, diag);
     else fputs("0", f);
     fputs(";\n    s = fabs(d);\n", f);
     for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) {
@@ -471,11 +423,12 @@ static void emit_factor_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
   fputs("  /* the pivots in order, in parts */\n", f);
   for (int c = 0; c < nchunk; c++)
     fprintf(f, "  if ((rc = ldl_factor_part%d(Kx,%s%s Lx, Dinv)) != 0) return rc;\n", c, p->nelim ? " Kc," : "",
-            k1_direct ? " work + LDL_K1," : "");
+            cx->ldl.k1_direct ? " work + LDL_K1," : "");
   fputs("  (void)Lx;\n  (void)Dinv;\n  (void)rc;\n  return 0;\n}\n\n", f);
 }
 
-static void emit_factor_looped(FILE *f, const lmodel *L, const ldl_plan *p, const char *nm) {
+static void emit_factor_looped(emit_ctx *cx, const lmodel *L, const ldl_plan *p, const char *nm) {
+  FILE *f = cx->f;
   (void)L;
   (void)nm;
   fputs("/* L D L^T of K_aug, whose entries come from Kx (K, or K' after the block pivots) */\n", f);
@@ -504,10 +457,10 @@ static void emit_factor_looped(FILE *f, const lmodel *L, const ldl_plan *p, cons
 /* ----------------------------------------------------------- block pivots */
 
 /* ldl_invn and ldl_inv6 of the generated code (once per file) */
-static int inv6_emitted;
-static void emit_inv6(FILE *f) {
-  if (inv6_emitted) return;
-  inv6_emitted = 1;
+static void emit_inv6(emit_ctx *cx) {
+  FILE *f = cx->f;
+  if (cx->ldl.inv6_emitted) return;
+  cx->ldl.inv6_emitted = 1;
   fputs("\n/* X = A^-1 for an n x n A (row-major, n <= 6; A is overwritten), Gauss-Jordan\n"
         " * with partial pivoting; 1 if a pivot is below 1e-12 amax.  The 6 x 6 are a\n"
         " * body's D_u: a rotation and the identity up to signs, so the explicit inverse\n"
@@ -546,7 +499,8 @@ static void emit_inv6(FILE *f) {
 static int blk_nz(const int *nz, int n, int i, int j) { return nz[n * i + j]; }
 
 /* "+ a_ij a_kl - a_il a_kj" with the structural zeros dropped; 0 if both vanish */
-static int emit_minor(FILE *f, const int *nz, int n, int i, int k, int j, int l) {
+static int emit_minor(emit_ctx *cx, const int *nz, int n, int i, int k, int j, int l) {
+  FILE *f = cx->f;
   int t1 = blk_nz(nz, n, i, j) && blk_nz(nz, n, k, l), t2 = blk_nz(nz, n, i, l) && blk_nz(nz, n, k, j);
   if (t1) fprintf(f, "a%d%d * a%d%d", i, j, k, l);
   if (t2) fprintf(f, "%sa%d%d * a%d%d", t1 ? " - " : "-", i, l, k, j);
@@ -559,8 +513,9 @@ static int emit_minor(FILE *f, const int *nz, int n, int i, int k, int j, int l)
  * identity up to signs), larger by ldl_invn.  The emitted code has 'amax' (A's
  * largest entry) in scope; a determinant below 1e-12 amax^n or a Gauss-Jordan
  * pivot below 1e-12 amax runs 'fail'. */
-static void emit_inv_small(FILE *f, const int *slot, const int *mem, int n, const char *X, const char *fail,
+static void emit_inv_small(emit_ctx *cx, const int *slot, const int *mem, int n, const char *X, const char *fail,
                            int adjugate) {
+  FILE *f = cx->f;
   int bnz[36];
   for (int i = 0; i < n; i++)
     for (int j = 0; j < n; j++) bnz[n * i + j] = slot[6 * mem[i] + mem[j]] >= 0;
@@ -571,7 +526,7 @@ static void emit_inv_small(FILE *f, const int *slot, const int *mem, int n, cons
       for (int j = 0; j < n; j++) {
         int sl = slot[6 * mem[i] + mem[j]];
         fprintf(f, "      a[%d] = ", n * i + j);
-        if (sl >= 0) kput(f, sl);
+        if (sl >= 0) kput(cx, sl);
         else fputc('0', f);
         fputs(";\n", f);
       }
@@ -585,7 +540,7 @@ static void emit_inv_small(FILE *f, const int *slot, const int *mem, int n, cons
     for (int j = 0; j < n; j++)
       if (bnz[n * i + j]) {
         fprintf(f, "      const mb_real a%d%d = ", i, j);
-        kput(f, slot[6 * mem[i] + mem[j]]);
+        kput(cx, slot[6 * mem[i] + mem[j]]);
         fputs(";\n", f);
       }
   /* cij: the cofactor of a_ij (structural zeros not declared) */
@@ -602,7 +557,7 @@ static void emit_inv_small(FILE *f, const int *slot, const int *mem, int n, cons
       cnz[n * i + j] = (bnz[n * i1 + j1] && bnz[n * i2 + j2]) || (bnz[n * i1 + j2] && bnz[n * i2 + j1]);
       if (!cnz[n * i + j]) continue;
       fprintf(f, "      const mb_real c%d%d = ", i, j);
-      emit_minor(f, bnz, n, i1, i2, j1, j2);
+      emit_minor(cx, bnz, n, i1, i2, j1, j2);
       fputs(";\n", f);
     }
   fputs("      const mb_real det = ", f);
@@ -639,32 +594,34 @@ static void emit_inv_small(FILE *f, const int *slot, const int *mem, int n, cons
 /* A 1 x 1 block whose entry is a compile-time constant c != 0 (kput_k1's
  * space) is X = 1 / c with no test (a unit pivot beside a rotation's entries);
  * xk/xc (when not NULL) then get X's entry as known. */
-static int emit_inv_component(FILE *f, const int *slot, const int *comp, int c, const char *X,
+static int emit_inv_component(emit_ctx *cx, const int *slot, const int *comp, int c, const char *X,
                               const char *fail, int adjugate, char *xk, double *xc) {
+  FILE *f = cx->f;
   int mem[6], n = 0;
   for (int i = 0; i < 6; i++)
     if (comp[i] == c) mem[n++] = i;
   if (n == 1) {
     int d = 7 * mem[0];
     double v;
-    if (slot_const(slot[d], kput_k1, &v) && v != 0) {
+    if (slot_const(cx, slot[d], cx->ldl.kput_k1, &v) && v != 0) {
       fprintf(f, "    %s[%d] = ", X, d);
       num(f, 1 / v);
       fputs("; /* a constant pivot */\n", f);
       if (xk) { xk[d] = 1; xc[d] = 1 / v; }
     } else {
       char a[32];
-      kname_buf(a, sizeof a, slot[d], kput_k1);
+      kname_buf(cx, a, sizeof a, slot[d], cx->ldl.kput_k1);
       fprintf(f, "    if (!(fabs(%s) > 1e-12 * amax)) %s;\n    %s[%d] = 1 / %s;\n", a, fail, X, d, a);
     }
   } else {
-    emit_inv_small(f, slot, mem, n, X, fail, adjugate);
+    emit_inv_small(cx, slot, mem, n, X, fail, adjugate);
   }
   return n;
 }
 
-static void emit_inv_blocked(FILE *f, const int *slot, const char *X, const char *fail, char *xk,
+static void emit_inv_blocked(emit_ctx *cx, const int *slot, const char *X, const char *fail, char *xk,
                              double *xc) {
+  FILE *f = cx->f;
   int nz[36], comp[6];
   for (int i = 0; i < 36; i++) nz[i] = slot[i] >= 0;
   int nb = ldl_inv_blocks(nz, comp);
@@ -672,7 +629,7 @@ static void emit_inv_blocked(FILE *f, const int *slot, const char *X, const char
     fputs("  {\n    mb_real A[36];\n", f);
     for (int i = 0; i < 36; i++) {
       fprintf(f, "    A[%d] = ", i);
-      if (slot[i] >= 0) kput(f, slot[i]);
+      if (slot[i] >= 0) kput(cx, slot[i]);
       else fputc('0', f);
       fputs(";\n", f);
     }
@@ -682,17 +639,17 @@ static void emit_inv_blocked(FILE *f, const int *slot, const char *X, const char
   /* amax: the largest |entry|, the constants' part at compile time */
   double cmax = 0, v;
   for (int k = 0; k < 36; k++)
-    if (nz[k] && slot_const(slot[k], kput_k1, &v) && fabs(v) > cmax) cmax = fabs(v);
+    if (nz[k] && slot_const(cx, slot[k], cx->ldl.kput_k1, &v) && fabs(v) > cmax) cmax = fabs(v);
   fprintf(f, "  { /* block-diagonal: %d blocks inverted apart */\n    mb_real amax = ", nb);
   num(f, cmax);
   fputs(";\n", f);
   for (int k = 0; k < 36; k++)
-    if (nz[k] && !slot_const(slot[k], kput_k1, &v)) {
+    if (nz[k] && !slot_const(cx, slot[k], cx->ldl.kput_k1, &v)) {
       char a[32];
-      kname_buf(a, sizeof a, slot[k], kput_k1);
+      kname_buf(cx, a, sizeof a, slot[k], cx->ldl.kput_k1);
       fprintf(f, "    if (fabs(%s) > amax) amax = fabs(%s);\n", a, a);
     }
-  for (int c = 0; c < nb; c++) emit_inv_component(f, slot, comp, c, X, fail, 1, xk, xc);
+  for (int c = 0; c < nb; c++) emit_inv_component(cx, slot, comp, c, X, fail, 1, xk, xc);
   fputs("    (void)amax;\n  }\n", f);
 }
 
@@ -744,21 +701,22 @@ static int tri_structure(const int *slot, int comp[6], int blk[6], int xnz[36]) 
  * X_kj = -X_kk T_kj with T_kj = sum over the later blocks l of A_kl X_lj.
  * Only the structural nonzeros (xnz) of X are written.  'fail' runs when a
  * block's pivot or determinant is below 1e-12 of A's largest entry (^n). */
-static void emit_inv_triangular(FILE *f, const int *slot, const char *X, const char *fail) {
+static void emit_inv_triangular(emit_ctx *cx, const int *slot, const char *X, const char *fail) {
+  FILE *f = cx->f;
   int comp[6], blk[6], xnz[36];
   int nb = tri_structure(slot, comp, blk, xnz);
   double cmax = 0, v;
   for (int k = 0; k < 36; k++)
-    if (slot[k] >= 0 && slot_const(slot[k], kput_k1, &v) && fabs(v) > cmax) cmax = fabs(v);
+    if (slot[k] >= 0 && slot_const(cx, slot[k], cx->ldl.kput_k1, &v) && fabs(v) > cmax) cmax = fabs(v);
   fprintf(f, "  { /* block upper triangular in %d blocks: the diagonal ones inverted, the rest\n"
              "       by substitution */\n    mb_real amax = ", nb);
   num(f, cmax);
   fputs(";\n", f);
   for (int k = 0; k < 36; k++)
-    if (slot[k] >= 0 && !slot_const(slot[k], kput_k1, &v))
+    if (slot[k] >= 0 && !slot_const(cx, slot[k], cx->ldl.kput_k1, &v))
       fprintf(f, "    if (fabs(Kx[%d]) > amax) amax = fabs(Kx[%d]);\n", slot[k], slot[k]);
   for (int bi = nb - 1; bi >= 0; bi--) {
-    int c = blk[bi], mem[6], n = emit_inv_component(f, slot, comp, c, X, fail, 0, NULL, NULL);
+    int c = blk[bi], mem[6], n = emit_inv_component(cx, slot, comp, c, X, fail, 0, NULL, NULL);
     for (int i = 0, k = 0; i < 6; i++)
       if (comp[i] == c) mem[k++] = i;
     /* column j of a later block: T(p, j) = sum_q A(p, q) X(q, j) over q outside
@@ -776,7 +734,7 @@ static void emit_inv_triangular(FILE *f, const int *slot, const char *X, const c
             char xv[32];
             if (!any) fprintf(f, "    const mb_real t%d_%d = ", p, j);
             snprintf(xv, sizeof xv, "%s[%d]", X, 6 * q + j);
-            put_kterm(f, &any, slot[6 * p + q], xv);
+            put_kterm(cx, &any, slot[6 * p + q], xv);
           }
         if (any) fputs(";\n", f);
         tnz[pi] = any;
@@ -801,14 +759,15 @@ static void emit_inv_triangular(FILE *f, const int *slot, const char *X, const c
  * constant, structural zeros of Du, Dx and Eu skipped */
 /* "  v[i] = r[row] - Kx[slot] * d[col] ...;": row of a block's right side less
  * the known unknowns cols[0..n) through the Kx slots slots[6 k + i] (-1: none) */
-static void emit_reduced_rhs(FILE *f, const char *v, int i, int row, const int *slots,
+static void emit_reduced_rhs(emit_ctx *cx, const char *v, int i, int row, const int *slots,
                              const int *cols, int n) {
+  FILE *f = cx->f;
   fprintf(f, "  %s[%d] = r[%d]", v, i, row);
   for (int k = 0; k < n; k++) {
     double c;
     int sl = slots[6 * k + i];
     if (sl < 0) continue;
-    if (!slot_const(sl, kput_k1, &c)) { fputs(" - ", f); kname(f, sl); fprintf(f, " * d[%d]", cols[k]); }
+    if (!slot_const(cx, sl, cx->ldl.kput_k1, &c)) { fputs(" - ", f); kname(cx, sl); fprintf(f, " * d[%d]", cols[k]); }
     else if (c == 1 || c == -1) fprintf(f, " %c d[%d]", c == 1 ? '-' : '+', cols[k]);
     else if (c != 0) { fputs(" - ", f); num(f, c); fprintf(f, " * d[%d]", cols[k]); }
   }
@@ -822,15 +781,16 @@ typedef struct {
   double c[36]; /* their values */
 } blk_known;
 
-static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, const long *woff) {
+static void emit_blocks_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *p, const long *woff) {
+  FILE *f = cx->f;
   char name[512], ex[48], vx[48];
   int nkc = 0;
   for (int q = 0; q < p->nnzR; q++)
-    if (kc_of[q] >= 0 && kc_of[q] + 1 > nkc) nkc = kc_of[q] + 1;
+    if (cx->ldl.kc_of[q] >= 0 && cx->ldl.kc_of[q] + 1 > nkc) nkc = cx->ldl.kc_of[q] + 1;
   int *src = malloc(sizeof(int) * (size_t)(nkc + 1));
-  if (!src) return;
+  if (!src) { cx->failed = 1; return; }
   for (int q = 0; q < p->nnzR; q++)
-    if (kc_of[q] >= 0) src[kc_of[q]] = p->Krmap[q];
+    if (cx->ldl.kc_of[q] >= 0) src[cx->ldl.kc_of[q]] = p->Krmap[q];
   /* the blocks' D_u structure, and with it which entries of D_u^-1 can be nonzero */
   int (*dinz)[36] = calloc((size_t)p->nelim + 1, sizeof *dinz);
   blk_known *dk = calloc((size_t)p->nelim + 1, sizeof *dk);
@@ -838,13 +798,13 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
   for (int e = 0; e < p->nelim; e++) nw += 6 * (p->esp[e + 1] - p->esp[e]);
   char *wk = calloc((size_t)nw + 1, 1); /* W's entries known at compile time, per block at 6 esp[e] */
   double *wc = calloc((size_t)nw + 1, sizeof(double));
-  kc_cst = calloc((size_t)nkc + 1, 1);
-  kc_val = calloc((size_t)nkc + 1, sizeof(double));
-  if (!dinz || !dk || !wk || !wc || !kc_cst || !kc_val) { free(src); free(dinz); free(dk); free(wk); free(wc); return; }
+  cx->ldl.kc_cst = calloc((size_t)nkc + 1, 1);
+  cx->ldl.kc_val = calloc((size_t)nkc + 1, sizeof(double));
+  if (!dinz || !dk || !wk || !wc || !cx->ldl.kc_cst || !cx->ldl.kc_val) { free(src); free(dinz); free(dk); free(wk); free(wc); cx->failed = 1; return; }
   for (int e = 0; e < p->nelim; e++) ldl_block_dinz(p, e, dinz[e]);
   /* the entries of Kc that a block's update reaches (their first update sets them) */
   char *updated = calloc((size_t)nkc + 1, 1);
-  if (!updated) { free(src); free(dinz); free(dk); free(wk); free(wc); return; }
+  if (!updated) { free(src); free(dinz); free(dk); free(wk); free(wc); cx->failed = 1; return; }
   for (int e = 0; e < p->nelim; e++) {
     int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss, k = p->ekrp[e];
     for (int si = 0; si < ns; si++)
@@ -852,27 +812,27 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
         const int *dx = p->edx + 6 * (xs + xi);
         for (int i = 0; i < 6; i++)
           if (dx[i] >= 0 && ldl_w_nonzero(p->eeu + 6 * (ss + si), dinz[e], i))
-            updated[kc_of[p->ekr[2 * k]]] = updated[kc_of[p->ekr[2 * k + 1]]] = 1;
+            updated[cx->ldl.kc_of[p->ekr[2 * k]]] = updated[cx->ldl.kc_of[p->ekr[2 * k + 1]]] = 1;
       }
   }
-  kput_k1 = 1;
+  cx->ldl.kput_k1 = 1;
   fputs("/* Kc (the entries of K' the block pivots set) from Kx; returns 0, or 1 + a column\n"
         " * of a virtual body whose Du is singular.  Entries known at compile time (a\n"
         " * weld's unit translational rows) are literals where they are read, not stored */\n"
         "static int ldl_block_pivots(const mb_real *Kx, mb_real *work) {\n"
         "  mb_real *Kc = work + LDL_KR, *Di, *W, v;\n", f);
-  if (k1_direct) fputs("  const mb_real *K1 = work + LDL_K1; /* the massless bodies' computed entries */\n  (void)K1;\n", f);
+  if (cx->ldl.k1_direct) fputs("  const mb_real *K1 = work + LDL_K1; /* the massless bodies' computed entries */\n  (void)K1;\n", f);
   fputs("  /* the entries of K' that no block changes (the others: at their first change) */\n", f);
   for (int k = 0; k < nkc; k++) {
     double c;
     if (updated[k]) continue;
-    if (src[k] < 0 || slot_const(src[k], 1, &c)) { /* a constant of K' */
-      kc_cst[k] = 1;
-      kc_val[k] = src[k] >= 0 ? c : src[k] == -2 ? 1 : src[k] == -3 ? -1 : 0;
+    if (src[k] < 0 || slot_const(cx, src[k], 1, &c)) { /* a constant of K' */
+      cx->ldl.kc_cst[k] = 1;
+      cx->ldl.kc_val[k] = src[k] >= 0 ? c : src[k] == -2 ? 1 : src[k] == -3 ? -1 : 0;
       continue;
     }
     fprintf(f, "  Kc[%d] = ", k);
-    kname(f, src[k]);
+    kname(cx, src[k]);
     fputs(";\n", f);
   }
   for (int e = 0, w0 = 0; e < p->nelim; e++) {
@@ -882,7 +842,7 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
     {
       char fail[32];
       snprintf(fail, sizeof fail, "return %d", 1 + p->eu[e][0]);
-      emit_inv_blocked(f, p->edu[e], "Di", fail, dk[e].k, dk[e].c);
+      emit_inv_blocked(cx, p->edu[e], "Di", fail, dk[e].k, dk[e].c);
     }
     int k = p->ekrp[e];
     for (int si = 0; si < ns; si++) {
@@ -897,7 +857,7 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
         for (int c6 = 0; c6 < 6; c6++)
           if (eu[c6] >= 0 && dinz[e][6 * c6 + i]) {
             any = 1;
-            if (slot_const(eu[c6], 1, &c) && dk[e].k[6 * c6 + i]) sum += c * dk[e].c[6 * c6 + i];
+            if (slot_const(cx, eu[c6], 1, &c) && dk[e].k[6 * c6 + i]) sum += c * dk[e].c[6 * c6 + i];
             else known = 0;
           }
         if (!any) continue;
@@ -909,10 +869,10 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
             int kn = dk[e].k[6 * c6 + i];
             snprintf(vx, sizeof vx, "Di[%d]", 6 * c6 + i);
             if (kn) { /* Di known: the term is Kx * constant, written constant * Kx */
-              kput_buf(ex, sizeof ex, eu[c6], 1);
-              put_term(f, &any, 1, dk[e].c[6 * c6 + i], "", ex);
+              kput_buf(cx, ex, sizeof ex, eu[c6], 1);
+              put_term(cx, &any, 1, dk[e].c[6 * c6 + i], "", ex);
             } else {
-              put_kterm(f, &any, eu[c6], vx);
+              put_kterm(cx, &any, eu[c6], vx);
             }
           }
         fputs(";\n", f);
@@ -924,7 +884,7 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
         for (int i = 0; i < 6; i++)
           if (dx[i] >= 0 && ldl_w_nonzero(eu, dinz[e], i)) {
             any = 1;
-            if (wki[i] && slot_const(dx[i], 1, &c)) vsum += wci[i] * c;
+            if (wki[i] && slot_const(cx, dx[i], 1, &c)) vsum += wci[i] * c;
             else known = 0;
           }
         if (!any) continue;
@@ -935,23 +895,23 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
             if (dx[i] >= 0 && ldl_w_nonzero(eu, dinz[e], i)) {
               snprintf(ex, sizeof ex, "W[%d]", 6 * si + i);
               if (wki[i]) { /* W known: constant * Kx */
-                kput_buf(vx, sizeof vx, dx[i], 1);
-                put_term(f, &any, 1, wci[i], "", vx);
+                kput_buf(cx, vx, sizeof vx, dx[i], 1);
+                put_term(cx, &any, 1, wci[i], "", vx);
               } else {
-                put_kterm(f, &any, dx[i], ex);
+                put_kterm(cx, &any, dx[i], ex);
               }
             }
           fputs(any ? ";\n" : "0;\n", f);
         }
         for (int h = 0; h < 2; h++) {
-          int kc = kc_of[p->ekr[2 * k + h]];
+          int kc = cx->ldl.kc_of[p->ekr[2 * k + h]];
           if (updated[kc] == 2) { /* a later change */
-            if (kc_cst[kc] && known) { kc_val[kc] -= vsum; continue; }
-            if (kc_cst[kc]) {
+            if (cx->ldl.kc_cst[kc] && known) { cx->ldl.kc_val[kc] -= vsum; continue; }
+            if (cx->ldl.kc_cst[kc]) {
               fprintf(f, "  Kc[%d] = ", kc);
-              num(f, kc_val[kc]);
+              num(f, cx->ldl.kc_val[kc]);
               fputs(" - v;\n", f);
-              kc_cst[kc] = 0;
+              cx->ldl.kc_cst[kc] = 0;
             } else if (known) {
               fprintf(f, "  Kc[%d] -= ", kc);
               num(f, vsum);
@@ -963,11 +923,11 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
           }
           updated[kc] = 2; /* its first change: K'(s, x) = K(s, x) - v */
           double base;
-          int bknown = src[kc] < 0 || slot_const(src[kc], 1, &base);
+          int bknown = src[kc] < 0 || slot_const(cx, src[kc], 1, &base);
           if (src[kc] < 0) base = src[kc] == -2 ? 1 : src[kc] == -3 ? -1 : 0;
-          if (bknown && known) { kc_cst[kc] = 1; kc_val[kc] = base - vsum; continue; }
+          if (bknown && known) { cx->ldl.kc_cst[kc] = 1; cx->ldl.kc_val[kc] = base - vsum; continue; }
           fprintf(f, "  Kc[%d] = ", kc);
-          if (!bknown) { kname(f, src[kc]); fputs(" - ", f); }
+          if (!bknown) { kname(cx, src[kc]); fputs(" - ", f); }
           else if (base != 0) { num(f, base); fputs(" - ", f); }
           else fputc('-', f);
           if (known) num(f, vsum);
@@ -985,7 +945,7 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
   fputs(BLOCK_RHS_COMMENT
         "static void ldl_block_rhs(const mb_real *Kx, const mb_real *work, mb_real *r) {\n"
         "  const mb_real *Di, *W;\n  mb_real z[6];\n", f);
-  if (k1_direct) fputs("  const mb_real *K1 = work + LDL_K1;\n  (void)K1;\n", f);
+  if (cx->ldl.k1_direct) fputs("  const mb_real *K1 = work + LDL_K1;\n  (void)K1;\n", f);
   for (int e = 0, w0 = 0; e < p->nelim; e++) {
     int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
     fprintf(f, "  /* block %d */\n  Di = work + %ld;\n  W = Di + 42;\n", e, woff[e]);
@@ -997,7 +957,7 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
           if (!any) fprintf(f, "  r[%d] -= ", p->es[ss + si]);
           snprintf(ex, sizeof ex, "W[%d]", 6 * si + c);
           snprintf(vx, sizeof vx, "r[%d]", p->er[e][c]);
-          put_term(f, &any, wk[w0 + 6 * si + c], wc[w0 + 6 * si + c], ex, vx);
+          put_term(cx, &any, wk[w0 + 6 * si + c], wc[w0 + 6 * si + c], ex, vx);
         }
       if (any) fputs(";\n", f);
     }
@@ -1008,7 +968,7 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
         if (dinz[e][6 * c + i]) {
           snprintf(ex, sizeof ex, "Di[%d]", 6 * c + i);
           snprintf(vx, sizeof vx, "r[%d]", p->eu[e][c]);
-          put_term(f, &any, dk[e].k[6 * c + i], dk[e].c[6 * c + i], ex, vx);
+          put_term(cx, &any, dk[e].k[6 * c + i], dk[e].c[6 * c + i], ex, vx);
         }
       fputs(any ? ";\n" : "0;\n", f);
     }
@@ -1019,7 +979,7 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
         if (dx[i] >= 0) {
           if (!any) fprintf(f, "  r[%d] -= ", p->ex[xs + xi]);
           snprintf(vx, sizeof vx, "z[%d]", i);
-          put_kterm(f, &any, dx[i], vx);
+          put_kterm(cx, &any, dx[i], vx);
         }
       if (any) fputs(";\n", f);
     }
@@ -1031,12 +991,12 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
         " * lambda_r = Du^-T (f_u - Eu^T lambda_s) */\n"
         "static void ldl_block_back(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *d) {\n"
         "  const mb_real *Di;\n  mb_real y[6], z[6];\n", f);
-  if (k1_direct) fputs("  const mb_real *K1 = work + LDL_K1;\n  (void)K1;\n", f);
+  if (cx->ldl.k1_direct) fputs("  const mb_real *K1 = work + LDL_K1;\n  (void)K1;\n", f);
   for (int e = 0; e < p->nelim; e++) {
     int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
     fprintf(f, "  /* block %d */\n  Di = work + %ld;\n", e, woff[e]);
-    for (int i = 0; i < 6; i++) emit_reduced_rhs(f, "y", i, p->er[e][i], p->edx + 6 * xs, p->ex + xs, nx);
-    for (int c = 0; c < 6; c++) emit_reduced_rhs(f, "z", c, p->eu[e][c], p->eeu + 6 * ss, p->es + ss, ns);
+    for (int i = 0; i < 6; i++) emit_reduced_rhs(cx, "y", i, p->er[e][i], p->edx + 6 * xs, p->ex + xs, nx);
+    for (int c = 0; c < 6; c++) emit_reduced_rhs(cx, "z", c, p->eu[e][c], p->eeu + 6 * ss, p->es + ss, ns);
     for (int c = 0; c < 6; c++) {
       int any = 0;
       fprintf(f, "  d[%d] = ", p->eu[e][c]);
@@ -1044,7 +1004,7 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
         if (dinz[e][6 * c + i]) {
           snprintf(ex, sizeof ex, "Di[%d]", 6 * c + i);
           snprintf(vx, sizeof vx, "y[%d]", i);
-          put_term(f, &any, dk[e].k[6 * c + i], dk[e].c[6 * c + i], ex, vx);
+          put_term(cx, &any, dk[e].k[6 * c + i], dk[e].c[6 * c + i], ex, vx);
         }
       fprintf(f, "%s;\n  d[%d] = ", any ? "" : "0", p->er[e][c]);
       any = 0;
@@ -1052,20 +1012,21 @@ static void emit_blocks_straight(FILE *f, const lmodel *L, const ldl_plan *p, co
         if (dinz[e][6 * i + c]) {
           snprintf(ex, sizeof ex, "Di[%d]", 6 * i + c);
           snprintf(vx, sizeof vx, "z[%d]", i);
-          put_term(f, &any, dk[e].k[6 * i + c], dk[e].c[6 * i + c], ex, vx);
+          put_term(cx, &any, dk[e].k[6 * i + c], dk[e].c[6 * i + c], ex, vx);
         }
       fputs(any ? ";\n" : "0;\n", f);
     }
   }
   fputs("  (void)Kx;\n  (void)Di;\n}\n\n", f);
-  kput_k1 = 0;
+  cx->ldl.kput_k1 = 0;
   free(dinz);
   free(dk);
   free(wk);
   free(wc);
 }
 
-static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
+static void emit_blocks(emit_ctx *cx, const lmodel *L, const ldl_plan *p) {
+  FILE *f = cx->f;
   const mb_model *m = &L->m;
   char name[512];
   fputs("/* block pivots: each virtual body welded to a massive body is eliminated with\n"
@@ -1081,7 +1042,7 @@ static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
         "} ldl_block;\n", f);
   long w = block_base(p);
   long *woff = malloc(sizeof(long) * (size_t)(p->nelim + 1));
-  if (!woff) return;
+  if (!woff) { cx->failed = 1; return; }
   for (int e = 0; e < p->nelim; e++) {
     const mb_body *B = &m->body[p->eb[e]];
     int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
@@ -1107,9 +1068,9 @@ static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
     snprintf(nmx, sizeof nmx, "ldl_b%d_dx", e); int_array(f, nmx, p->edx + 6 * xs, 6L * nx);
     snprintf(nmx, sizeof nmx, "ldl_b%d_eu", e); int_array(f, nmx, p->eeu + 6 * ss, 6L * ns);
   }
-  emit_inv6(f);
+  emit_inv6(cx);
   if (p->straight) {
-    emit_blocks_straight(f, L, p, woff);
+    emit_blocks_straight(cx, L, p, woff);
     free(woff);
     return;
   }
@@ -1124,10 +1085,10 @@ static void emit_blocks(FILE *f, const lmodel *L, const ldl_plan *p) {
      others are read from Kx), or all of K' (looped code) */
   int nkc = 0, npair = p->ekrp[p->nelim];
   int *src = malloc(sizeof(int) * (size_t)(p->nnzR + 1)), *ekc = malloc(sizeof(int) * (size_t)(2 * npair + 1));
-  if (!src || !ekc) { free(src); free(ekc); return; }
+  if (!src || !ekc) { free(src); free(ekc); cx->failed = 1; return; }
   for (int q = 0; q < p->nnzR; q++)
-    if (kc_of[q] >= 0) src[kc_of[q]] = p->Krmap[q], nkc = kc_of[q] + 1 > nkc ? kc_of[q] + 1 : nkc;
-  for (int k = 0; k < 2 * npair; k++) ekc[k] = p->ekr[k] >= 0 ? kc_of[p->ekr[k]] : -1;
+    if (cx->ldl.kc_of[q] >= 0) src[cx->ldl.kc_of[q]] = p->Krmap[q], nkc = cx->ldl.kc_of[q] + 1 > nkc ? cx->ldl.kc_of[q] + 1 : nkc;
+  for (int k = 0; k < 2 * npair; k++) ekc[k] = p->ekr[k] >= 0 ? cx->ldl.kc_of[p->ekr[k]] : -1;
   fputs("/* Kc entries of the corrected pairs (s, x), (x, s), block by block, s-major\n"
         " * (-1: a pair whose correction is structurally zero) */\n", f);
   int_array(f, "ldl_ekc", ekc, 2L * npair);
@@ -1263,7 +1224,8 @@ static int ml_fixed_du(const ldl_plan *p, int e, int slot[36], int xnz[36]) {
  * order, the structural zeros of Du^-1 skipped here and in the solves); it declines (returns 0) when those rows no
  * longer suit: Du singular, or |W| above LDL_ML_WMAX (the other rows, in
  * terms of the chosen ones, grow) */
-static void emit_ml_fixed_factor(FILE *f, const ldl_plan *p) {
+static void emit_ml_fixed_factor(emit_ctx *cx, const ldl_plan *p) {
+  FILE *f = cx->f;
   fputs("#define LDL_ML_WMAX 4 /* see ldl_mlN_fixed */\n", f);
   for (int e = 0; e < p->nml; e++) {
     ml_view b = ml_body(p, e);
@@ -1277,7 +1239,7 @@ static void emit_ml_fixed_factor(FILE *f, const ldl_plan *p) {
                "  (void)K1;\n", e, b.w, r);
     int slot[36], xnz[36];
     if (ml_fixed_du(p, e, slot, xnz)) {
-      emit_inv_triangular(f, slot, "Di", "return 0");
+      emit_inv_triangular(cx, slot, "Di", "return 0");
     } else {
       fputs("  const mb_real Du[36] = {", f);
       for (int i = 0; i < 36; i++) {
@@ -1321,8 +1283,9 @@ static void emit_ml_fixed_factor(FILE *f, const ldl_plan *p) {
 /* "    <lhs> = sum Di[..] * <v>[..];" over the structural nonzeros xnz of Du^-1:
  * row k of Du^-1 (by_row: Di[6 k + c] * v[c]) or column c (Di[6 k + c] * v[k]);
  * vi maps the summation index to v's (NULL: itself) */
-static void emit_di_sum(FILE *f, const char *lhs, const int *xnz, int by_row, int kc, const char *v,
+static void emit_di_sum(emit_ctx *cx, const char *lhs, const int *xnz, int by_row, int kc, const char *v,
                         const int *vi) {
+  FILE *f = cx->f;
   int any = 0;
   fprintf(f, "    %s = ", lhs);
   for (int j = 0; j < 6; j++) {
@@ -1335,7 +1298,8 @@ static void emit_di_sum(FILE *f, const char *lhs, const int *xnz, int by_row, in
 }
 
 /* ldl_ml_rhs_pivoting of body e with its rows at t = 0, when the factorization used them */
-static void emit_ml_fixed_rhs(FILE *f, const ldl_plan *p, int e) {
+static void emit_ml_fixed_rhs(emit_ctx *cx, const ldl_plan *p, int e) {
+  FILE *f = cx->f;
   ml_view b = ml_body(p, e);
   int r = b.r, ny = b.ny;
   const int *pi = b.pi, *R = b.R, *T = b.T, *u = b.u, *Y = b.Y;
@@ -1353,7 +1317,7 @@ static void emit_ml_fixed_rhs(FILE *f, const ldl_plan *p, int e) {
   for (int c = 0; c < 6; c++) {
     char lhs[16];
     snprintf(lhs, sizeof lhs, "z[%d]", c);
-    emit_di_sum(f, lhs, xnz, 0, c, "r", u);
+    emit_di_sum(cx, lhs, xnz, 0, c, "r", u);
   }
   for (int y = 0; y < ny; y++) {
     int any = 0;
@@ -1372,7 +1336,8 @@ static void emit_ml_fixed_rhs(FILE *f, const ldl_plan *p, int e) {
 }
 
 /* ldl_ml_back_pivoting of body e with its rows at t = 0, when the factorization used them */
-static void emit_ml_fixed_back(FILE *f, const ldl_plan *p, int e) {
+static void emit_ml_fixed_back(emit_ctx *cx, const ldl_plan *p, int e) {
+  FILE *f = cx->f;
   ml_view b = ml_body(p, e);
   int r = b.r, ny = b.ny;
   const int *pi = b.pi, *R = b.R, *T = b.T, *u = b.u, *Y = b.Y;
@@ -1402,11 +1367,11 @@ static void emit_ml_fixed_back(FILE *f, const ldl_plan *p, int e) {
   char lhs[32];
   for (int k = 0; k < 6; k++) {
     snprintf(lhs, sizeof lhs, "d[%d]", u[k]);
-    emit_di_sum(f, lhs, xnz, 1, k, "y", NULL);
+    emit_di_sum(cx, lhs, xnz, 1, k, "y", NULL);
   }
   for (int c = 0; c < 6; c++) {
     snprintf(lhs, sizeof lhs, "d[%d]", R[pi[c]]);
-    emit_di_sum(f, lhs, xnz, 0, c, "z", NULL);
+    emit_di_sum(cx, lhs, xnz, 0, c, "z", NULL);
   }
   for (int i = 0; i < r - 6; i++) fprintf(f, "    d[%d] = mu[%d];\n", R[pi[6 + i]], i);
   fprintf(f, "  } else {\n    ldl_ml_back_pivoting(&ldl_ml[%d], Kx, work, r, d);\n  }\n", e);
@@ -1414,7 +1379,8 @@ static void emit_ml_fixed_back(FILE *f, const ldl_plan *p, int e) {
 
 /* stage 1: the massless bodies that are not welded (see order.h): tables,
  * the elimination, its right side and the recovery of their unknowns */
-static void emit_massless(FILE *f, const lmodel *L, const ldl_plan *p) {
+static void emit_massless(emit_ctx *cx, const lmodel *L, const ldl_plan *p) {
+  FILE *f = cx->f;
   const mb_model *m = &L->m;
   char nmx[64], name[512];
   int rmax;
@@ -1457,7 +1423,7 @@ static void emit_massless(FILE *f, const lmodel *L, const ldl_plan *p) {
     snprintf(nmx, sizeof nmx, "ldl_ml%d_k1", e);
     int_array(f, nmx, p->mlk + 2 * p->mlkp[e], 2L * (p->mlkp[e + 1] - p->mlkp[e]));
     int *hy = calloc((size_t)r + 1, sizeof(int));
-    if (!hy) return;
+    if (!hy) { cx->failed = 1; return; }
     for (int k = 0; k < r; k++)
       for (int y = 0; y < ny; y++) hy[k] |= p->mldy[p->mldyp[e] + (long)k * ny + y] >= 0;
     snprintf(nmx, sizeof nmx, "ldl_ml%d_hy", e); int_array(f, nmx, hy, r);
@@ -1475,7 +1441,7 @@ static void emit_massless(FILE *f, const lmodel *L, const ldl_plan *p) {
         " * -4: computed below */\n", f);
   fprintf(f, "#define LDL_NK1 %d\n", p->nnz1);
   if (!p->straight) int_array(f, "ldl_K1src", p->K1map, p->nnz1);
-  emit_inv6(f);
+  emit_inv6(cx);
   fputs("/* where a body's factors came from: 1 its compile-time rows (ldl_mlN_static), 0 pivoting */\n"
         "#define LDL_ML_FIXED(B, ws) ws[(B)->r + 36 + 6 * ((B)->r - 6)]\n\n", f);
   fputs("/* body B by partial pivoting on D_RU (any configuration): Du^-1, W and the slot\n"
@@ -1525,7 +1491,7 @@ static void emit_massless(FILE *f, const lmodel *L, const ldl_plan *p) {
         "      const mb_real w = W[6 * i + c], *dp = D + ny * pi[c];\n"
         "      for (int y = 0; y < ny; y++) K1[k1[2 * y]] -= w * dp[y];\n    }\n"
         "    for (int y = 0; y < ny; y++) K1[k1[2 * y + 1]] = K1[k1[2 * y]];\n  }\n  return 0;\n}\n\n", f);
-  if (p->straight) emit_ml_fixed_factor(f, p);
+  if (p->straight) emit_ml_fixed_factor(cx, p);
   fputs(p->straight ? "/* the entries of K1 (work + LDL_K1) the massless bodies' elimination computes (its\n"
                      " * other entries are read from Kx or are literals); returns 0, or 1 + a column of a\n"
                      " * massless body whose rows have lost rank 6 on it */\n"
@@ -1574,7 +1540,7 @@ static void emit_massless(FILE *f, const lmodel *L, const ldl_plan *p) {
         "static void ldl_ml_rhs(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *r1) {\n"
         "  for (int i = 0; i < LDL_N; i++) r1[i] = r[i];\n", f);
   if (p->straight)
-    for (int e = 0; e < p->nml; e++) emit_ml_fixed_rhs(f, p, e);
+    for (int e = 0; e < p->nml; e++) emit_ml_fixed_rhs(cx, p, e);
   else
     fputs("  for (int e = 0; e < LDL_NML; e++) ldl_ml_rhs_pivoting(&ldl_ml[e], Kx, work, r, r1);\n", f);
   fputs("}\n\n", f);
@@ -1611,20 +1577,21 @@ static void emit_massless(FILE *f, const lmodel *L, const ldl_plan *p) {
   fputs("/* d (the solution of K1) into the solution of K */\n"
         "static void ldl_ml_back(const mb_real *Kx, const mb_real *work, const mb_real *r, mb_real *d) {\n", f);
   if (p->straight)
-    for (int e = 0; e < p->nml; e++) emit_ml_fixed_back(f, p, e);
+    for (int e = 0; e < p->nml; e++) emit_ml_fixed_back(cx, p, e);
   else
     fputs("  for (int e = 0; e < LDL_NML; e++) ldl_ml_back_pivoting(&ldl_ml[e], Kx, work, r, d);\n", f);
   fputs("}\n\n", f);
 }
 
 /* the public factorization: ||K||, the block pivots, then L D L^T of K_aug */
-static void emit_factor_entry(FILE *f, const lmodel *L, const ldl_plan *p, const char *nm) {
-  emit_knorm(f, L, p);
+static void emit_factor_entry(emit_ctx *cx, const lmodel *L, const ldl_plan *p, const char *nm) {
+  FILE *f = cx->f;
+  emit_knorm(cx, L, p);
   fprintf(f, "int %s_ldl_factor(const mb_real *Kx, mb_real *work) {\n", nm);
   /* Kp: the matrix the rest works on (K, or K1 after the massless bodies) */
   if (p->nml)
     fprintf(f, "  int rc1 = ldl_massless(Kx, work);\n  if (rc1) return rc1;\n"
-               "  const mb_real *Kp = %s;\n", k1_direct ? "Kx; /* K1's gathered entries are read from Kx */" : "work + LDL_K1");
+               "  const mb_real *Kp = %s;\n", cx->ldl.k1_direct ? "Kx; /* K1's gathered entries are read from Kx */" : "work + LDL_K1");
   else
     fputs("  const mb_real *Kp = Kx;\n", f);
   if (p->nelim) {
@@ -1641,7 +1608,8 @@ static void emit_factor_entry(FILE *f, const lmodel *L, const ldl_plan *p, const
 
 /* start part *nparts of the forward or backward solve when there is none yet or
  * the open one has passed LDL_CHUNK_FLOPS (closing it) */
-static void solve_part_open(FILE *f, const char *dir, const char *what, int *nparts, double *part_flops) {
+static void solve_part_open(emit_ctx *cx, const char *dir, const char *what, int *nparts, double *part_flops) {
+  FILE *f = cx->f;
   if (*nparts && *part_flops <= LDL_CHUNK_FLOPS) return;
   if (*nparts) fputs("}\n\n", f);
   fprintf(f, "/* %s: %s, row by row (part %d) */\n", dir, what, *nparts);
@@ -1650,18 +1618,19 @@ static void solve_part_open(FILE *f, const char *dir, const char *what, int *npa
   *part_flops = 0;
 }
 
-static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan *p) {
+static void emit_solve_helpers_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *p) {
+  FILE *f = cx->f;
   const mb_model *m = &L->m;
   int n = p->n, nv = p->nv;
   /* t = P [r_top + D^T W r_bot; r_bot] */
   fputs("/* t = P [r_top + D^T W r_bot; r_bot]: the right side of K_aug, permuted */\n", f);
   fprintf(f, "static void ldl_aug(const mb_real *Kx,%s%s const mb_real *r, mb_real *t) {\n",
-          p->nelim ? " const mb_real *Kc," : "", k1_direct ? " const mb_real *K1," : "");
+          p->nelim ? " const mb_real *Kc," : "", cx->ldl.k1_direct ? " const mb_real *K1," : "");
   if (p->nelim) fputs("  (void)Kc;\n", f);
-  if (k1_direct) fputs("  (void)K1;\n", f);
+  if (cx->ldl.k1_direct) fputs("  (void)K1;\n", f);
   for (int k = 0; k < n; k++) {
     int u = p->perm[k];
-    if (ldl_decoupled(p, k)) continue; /* recovered by ldl_block_back / ldl_ml_back */
+    if (ldl_decoupled(cx, p, k)) continue; /* recovered by ldl_block_back / ldl_ml_back */
     fprintf(f, "  t[%d] = r[%d]", k, u);
     if (u < nv)
       for (int w = 0; w < p->nw; w++)
@@ -1670,7 +1639,7 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
             fputs(" + ", f);
             num(f, p->w[w]);
             fputs(" * ", f);
-            kval(f, p->Ds[q]);
+            kval(cx, p->Ds[q]);
             fprintf(f, " * r[%d]", nv + p->wrow[w]);
           }
     fputs(";\n", f);
@@ -1685,9 +1654,9 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
   for (int i = 0; i < n; i++) {
     int len = p->Rp[i + 1] - p->Rp[i];
     if (!len) continue;
-    solve_part_open(f, "forward", "L y = t", &nfwd, &part_flops);
+    solve_part_open(cx, "forward", "L y = t", &nfwd, &part_flops);
     fprintf(f, "  t[%d] -= ", i);
-    emit_sum(f, "Lx[%d] * t[%d]", p->Rpos + p->Rp[i], p->Rj + p->Rp[i], len);
+    emit_sum(cx, "Lx[%d] * t[%d]", p->Rpos + p->Rp[i], p->Rj + p->Rp[i], len);
     fputs(";\n", f);
     part_flops += 2.0 * len;
   }
@@ -1695,12 +1664,12 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
   for (int j = n - 1; j >= 0; j--) {
     int len = p->Lp[j + 1] - p->Lp[j];
     if (!len) continue;
-    solve_part_open(f, "backward", "L^T x = z", &nbwd, &part_flops);
+    solve_part_open(cx, "backward", "L^T x = z", &nbwd, &part_flops);
     int *lq = malloc(sizeof(int) * (size_t)len);
-    if (!lq) break;
+    if (!lq) { cx->failed = 1; break; }
     for (int k = 0; k < len; k++) lq[k] = p->Lp[j] + k;
     fprintf(f, "  t[%d] -= ", j);
-    emit_sum(f, "Lx[%d] * t[%d]", lq, p->Li + p->Lp[j], len);
+    emit_sum(cx, "Lx[%d] * t[%d]", lq, p->Li + p->Lp[j], len);
     fputs(";\n", f);
     free(lq);
     part_flops += 2.0 * len;
@@ -1711,7 +1680,7 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
   for (int c = 0; c < nfwd; c++) fprintf(f, "  ldl_forward%d(Lx, t);\n", c);
   fputs("  /* diagonal: z = D^-1 y */\n", f);
   for (int k = 0; k < n; k++)
-    if (!ldl_decoupled(p, k)) fprintf(f, "  t[%d] *= Dinv[%d];\n", k, k);
+    if (!ldl_decoupled(cx, p, k)) fprintf(f, "  t[%d] *= Dinv[%d];\n", k, k);
   for (int c = 0; c < nbwd; c++) fprintf(f, "  ldl_backward%d(Lx, t);\n", c);
   if (p->nnzL == 0) fputs("  (void)Lx;\n", f);
   fputs("}\n\n", f);
@@ -1720,7 +1689,7 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
     fputs("/* x = P^T t */\n", f);
     fputs("static void ldl_scatter(const mb_real *t, mb_real *x) {\n", f);
     for (int k = 0; k < n; k++)
-      if (!ldl_decoupled(p, k)) fprintf(f, "  x[%d] = t[%d];\n", p->perm[k], k);
+      if (!ldl_decoupled(cx, p, k)) fprintf(f, "  x[%d] = t[%d];\n", p->perm[k], k);
     fputs("}\n\n", f);
   } else {
     fputs("/* x += P^T t */\n", f);
@@ -1734,6 +1703,7 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
   fputs("static void ldl_residual(const mb_real *Kx, const mb_real *x, const mb_real *b, mb_real *r) {\n", f);
   int *cnt = calloc((size_t)n + 1, sizeof(int)), *rp = calloc((size_t)n + 1, sizeof(int));
   int *rs = malloc(sizeof(int) * (size_t)(m->nnz + 1)), *rc = malloc(sizeof(int) * (size_t)(m->nnz + 1));
+  if (!(cnt && rp && rs && rc)) cx->failed = 1;
   if (cnt && rp && rs && rc) {
     for (int q = 0; q < m->nnz; q++) rp[m->Ki[q] + 1]++;
     for (int i = 0; i < n; i++) rp[i + 1] += rp[i];
@@ -1753,7 +1723,8 @@ static void emit_solve_helpers_straight(FILE *f, const lmodel *L, const ldl_plan
   fputs("}\n\n", f);
 }
 
-static void emit_solve_helpers_looped(FILE *f, const ldl_plan *p) {
+static void emit_solve_helpers_looped(emit_ctx *cx, const ldl_plan *p) {
+  FILE *f = cx->f;
   fputs("/* t = P [r_top + D^T W r_bot; r_bot]: the right side of K_aug, permuted */\n", f);
   fputs("static void ldl_aug(const mb_real *Kx, const mb_real *r, mb_real *t) {\n", f);
   fputs("  for (int k = 0; k < LDL_N; k++) t[k] = r[ldl_perm[k]];\n", f);
@@ -1789,13 +1760,14 @@ static void emit_solve_helpers_looped(FILE *f, const ldl_plan *p) {
 }
 
 /* one pass of the solve: d (or x += ...) from the factors with right side 'rhs' */
-static void emit_solve_pass(FILE *f, const ldl_plan *p, const char *rhs, const char *ind) {
+static void emit_solve_pass(emit_ctx *cx, const ldl_plan *p, const char *rhs, const char *ind) {
+  FILE *f = cx->f;
   int staged = p->nelim || p->nml;
   if (p->nml)
     fprintf(f, "%sldl_ml_rhs(Kx, work, %s, r1); /* the massless bodies' right side: K1 */\n", ind, rhs);
   else
     fprintf(f, "%sr1 = %s;\n", ind, rhs);
-  const char *kc = p->straight ? " work + LDL_KR," : "", *k1 = k1_direct ? " work + LDL_K1," : "";
+  const char *kc = p->straight ? " work + LDL_KR," : "", *k1 = cx->ldl.k1_direct ? " work + LDL_K1," : "";
   if (p->nelim) {
     fprintf(f, "%sldl_block_rhs(Kp, work, r1); /* the block pivots' right side: K' (in place) */\n", ind);
     fprintf(f, "%sldl_aug(%s,%s%s r1, t);\n", ind, p->straight ? "Kp" : "work + LDL_KR", kc, k1);
@@ -1810,24 +1782,25 @@ static void emit_solve_pass(FILE *f, const ldl_plan *p, const char *rhs, const c
   }
 }
 
-static void emit_solve(FILE *f, const ldl_plan *p, const char *nm) {
+static void emit_solve(emit_ctx *cx, const ldl_plan *p, const char *nm) {
+  FILE *f = cx->f;
   int staged = p->nelim || p->nml;
   fprintf(f, "int %s_ldl_solve(const mb_real *Kx, mb_real *work, mb_real *b, mb_real *residual) {\n", nm);
   fputs("  const mb_real *Lx = work, *Dinv = work + LDL_DINV;\n"
         "  mb_real *x = work + LDL_X, *r = work + LDL_R, *t = work + LDL_T, *xb = work + LDL_XB;\n", f);
   if (staged) fputs("  mb_real *d = work + LDL_DD;\n", f);
   if (p->nml)
-    fprintf(f, "  mb_real *r1 = work + LDL_R1;\n  const mb_real *Kp = %s;\n", k1_direct ? "Kx" : "work + LDL_K1");
+    fprintf(f, "  mb_real *r1 = work + LDL_R1;\n  const mb_real *Kp = %s;\n", cx->ldl.k1_direct ? "Kx" : "work + LDL_K1");
   else fprintf(f, "  const mb_real *Kp = Kx;\n  %smb_real *r1;\n", p->nelim ? "" : "const ");
   if (!p->nw) {
     /* no weighted rows: the factors are those of K itself, and the first
        solution is the one refinement would start from */
     fputs("  if (!residual) { /* one pass: no residual, no refinement */\n", f);
     if (staged) {
-      emit_solve_pass(f, p, "b", "    ");
+      emit_solve_pass(cx, p, "b", "    ");
     } else {
       fputs("    for (int i = 0; i < LDL_N; i++) x[i] = 0;\n", f);
-      emit_solve_pass(f, p, "b", "    ");
+      emit_solve_pass(cx, p, "b", "    ");
       fputs("    ldl_scatter_add(t, x);\n", f);
     }
     /* the copy and the finiteness test in one pass, without a branch per
@@ -1845,7 +1818,7 @@ static void emit_solve(FILE *f, const ldl_plan *p, const char *nm) {
         "  /* pass 0: the solve; pass 1: refinement; pass 2: a second one if still above 1e-12 */\n"
         "  for (int it = 0; it < 3; it++) {\n"
         "    mb_real rn = 0, xn = 0, den, rel;\n", f);
-  emit_solve_pass(f, p, "r", "    ");
+  emit_solve_pass(cx, p, "r", "    ");
   if (staged) fputs("    for (int i = 0; i < LDL_N; i++) x[i] += d[i];\n", f);
   else fputs("    ldl_scatter_add(t, x);\n", f);
   fputs("    ldl_residual(Kx, x, b, r);\n"
@@ -1867,15 +1840,16 @@ static void emit_solve(FILE *f, const ldl_plan *p, const char *nm) {
         "  return isfinite(best) ? MB_OK : MB_ERR_NONFINITE;\n}\n\n", f);
 }
 
-int emit_ldl(FILE *f, const mbc_unit *u, const char *nm) {
-  const lmodel *L = u->lowered;
+int emit_ldl(emit_ctx *cx) {
+  FILE *f = cx->f;
+  const mbc_unit *u = cx->u;
+  const lmodel *L = cx->L;
+  const char *nm = cx->nm, *U = cx->NM;
   const ldl_plan *p = &u->plan;
   if (!u->have_plan) {
     fputs("/* --- emitted LDL^T: not available (the ordering failed) --- */\n\n", f);
     return 0;
   }
-  char U[256];
-  upper(U, nm, sizeof U);
   int n = p->n;
   char ordering[256];
   if (p->tree)
@@ -1923,7 +1897,7 @@ int emit_ldl(FILE *f, const mbc_unit *u, const char *nm) {
     int nt = p->Tp[p->nnzA];
     if (nt > 0) {
       double *tw = malloc(sizeof(double) * (size_t)(nt + 1));
-      if (!tw) { return 0; }
+      if (!tw) { cx->failed = 1; return 0; }
       for (int t = 0; t < nt; t++) tw[t] = p->w[p->Tw[t]];
       int_array(f, "ldl_Tp", p->Tp, p->nnzA + 1);
       real_array(f, "ldl_Tw", tw, nt);
@@ -1942,7 +1916,7 @@ int emit_ldl(FILE *f, const mbc_unit *u, const char *nm) {
       int nd = p->Dp[p->nw];
       int *dt = malloc(sizeof(int) * (size_t)(nd + 1)), *dr = malloc(sizeof(int) * (size_t)(nd + 1));
       double *dw = malloc(sizeof(double) * (size_t)(nd + 1));
-      if (!dt || !dr || !dw) { free(dt); free(dr); free(dw); return 0; }
+      if (!dt || !dr || !dw) { free(dt); free(dr); free(dw); cx->failed = 1; return 0; }
       for (int k = 0; k < p->nw; k++)
         for (int q = p->Dp[k]; q < p->Dp[k + 1]; q++) {
           dt[q] = p->iperm[p->Dj[q]];
@@ -1962,9 +1936,10 @@ int emit_ldl(FILE *f, const mbc_unit *u, const char *nm) {
     fputc('\n', f);
   }
   /* the compile-time constants: K1's (massless bodies) and init's entries of Kx */
-  k1_map = p->nml && p->straight ? p->K1map : NULL;
-  k1_direct = p->nml && p->straight;
+  cx->ldl.k1_map = p->nml && p->straight ? p->K1map : NULL;
+  cx->ldl.k1_direct = p->nml && p->straight;
   signed char *cst = p->straight ? calloc((size_t)L->m.nnz + 1, 1) : NULL;
+  if (p->straight && !cst) cx->failed = 1;
   if (cst)
     for (int r = 0; r < L->m.nrow; r++)
       for (int s = 0; s < 2; s++)
@@ -1973,13 +1948,13 @@ int emit_ldl(FILE *f, const mbc_unit *u, const char *nm) {
           if (!R->constant[s][j] || R->slot[s][j] < 0) continue;
           cst[R->slot[s][j]] = cst[R->slotT[s][j]] = (signed char)(s ? 1 : -1); /* as init writes them */
         }
-  kx_cst = cst;
+  cx->ldl.kx_cst = cst;
   int *kc = NULL;
-  inv6_emitted = 0;
-  if (p->nml) emit_massless(f, L, p);
+  cx->ldl.inv6_emitted = 0;
+  if (p->nml) emit_massless(cx, L, p);
   if (p->nelim) {
     kc = malloc(sizeof(int) * (size_t)(p->nnzR + 1));
-    if (!kc) { free(cst); return 0; }
+    if (!kc) { free(cst); cx->failed = 1; return 0; }
     int nkc = 0;
     for (int q = 0; q < p->nnzR; q++) kc[q] = p->straight ? -1 : nkc++;
     if (p->straight) {
@@ -1989,24 +1964,24 @@ int emit_ldl(FILE *f, const mbc_unit *u, const char *nm) {
          a virtual body's decoupled diagonals) */
       for (int q = 0; q < p->nnzR; q++) kc[q] = kc[q] == 0 ? nkc++ : -1;
     }
-    kc_of = kc;
-    kc_map = p->Krmap;
-    emit_blocks(f, L, p);
+    cx->ldl.kc_of = kc;
+    cx->ldl.kc_map = p->Krmap;
+    emit_blocks(cx, L, p);
   }
-  if (p->straight) emit_factor_straight(f, L, p, nm);
-  else emit_factor_looped(f, L, p, nm);
-  emit_factor_entry(f, L, p, nm);
-  if (p->straight) emit_solve_helpers_straight(f, L, p);
-  else emit_solve_helpers_looped(f, p);
-  emit_solve(f, p, nm);
-  kc_of = kc_map = k1_map = NULL;
-  k1_direct = 0;
-  kx_cst = NULL;
+  if (p->straight) emit_factor_straight(cx, L, p, nm);
+  else emit_factor_looped(cx, L, p, nm);
+  emit_factor_entry(cx, L, p, nm);
+  if (p->straight) emit_solve_helpers_straight(cx, L, p);
+  else emit_solve_helpers_looped(cx, p);
+  emit_solve(cx, p, nm);
+  cx->ldl.kc_of = cx->ldl.kc_map = cx->ldl.k1_map = NULL;
+  cx->ldl.k1_direct = 0;
+  cx->ldl.kx_cst = NULL;
   free(cst);
-  free(kc_cst);
-  free(kc_val);
-  kc_cst = NULL;
-  kc_val = NULL;
+  free(cx->ldl.kc_cst);
+  free(cx->ldl.kc_val);
+  cx->ldl.kc_cst = NULL;
+  cx->ldl.kc_val = NULL;
   free(kc);
   fputs("static int ldl_factor_m(const mb_model *m, const mb_real *Kx, mb_real *work) {\n", f);
   fprintf(f, "  (void)m;\n  return %s_ldl_factor(Kx, work);\n}\n", nm);

@@ -5,14 +5,15 @@
 
 #include <stdio.h>
 
-#include "unit.h"
+#include "emit_util.h"
 
 /* <model>.h: the workspace-size macros and the prototypes */
-void emit_ldl_header(FILE *f, const mbc_unit *u, const char *nm);
+void emit_ldl_header(emit_ctx *cx);
 /* <model>.c: tables and functions, before the model initializer; returns 1
- * when emitted, 0 when not (no plan, or out of memory: the model then has no ldl) */
-int emit_ldl(FILE *f, const mbc_unit *u, const char *nm);
+ * when emitted, 0 when not (no plan: the model then has no ldl; or out of
+ * memory: cx->failed set) */
+int emit_ldl(emit_ctx *cx);
 /* inside the initializer: the designated initializers of the ldl fields */
-void emit_ldl_fields(FILE *f, const char *nm, int emitted);
+void emit_ldl_fields(emit_ctx *cx, int emitted);
 
 #endif

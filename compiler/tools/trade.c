@@ -22,6 +22,7 @@
 
 #include "diag.h"
 #include "emit.h"
+#include "outfile.h"
 #include "unit.h"
 #include "trade.h"
 #include "trade_metric.h"
@@ -600,10 +601,9 @@ static void run_settings(const variant *V, const integ_setting *I, const trade_r
 }
 
 static int write_csv(const char *path, const variant *V, const integ_setting *I, const trade_run *R, int nrun) {
-  char tmp[4300];
-  textf(tmp, sizeof tmp, "%s.part", path);
-  FILE *f = fopen(tmp, "w");
-  if (!f) { fprintf(stderr, "mbcc: error: cannot write '%s'\n", tmp); return 2; }
+  out_file out;
+  if (out_file_open(&out, path)) return 2;
+  FILE *f = out.f;
   fprintf(f, "run,variant,modes,coupling,joints,real,integrator,step,rtol,solver,cpu_s,max_err,rms_err,failed,pareto,note\n");
   for (int k = 0; k < nrun; k++) {
     const trade_run *r = &R[k];
@@ -621,12 +621,7 @@ static int write_csv(const char *path, const variant *V, const integ_setting *I,
     for (const char *p = r->why; *p; p++) fputc(*p == ',' || *p == '"' ? ';' : *p, f);
     fputc('\n', f);
   }
-  if (fclose(f) || rename(tmp, path)) {
-    remove(tmp);
-    fprintf(stderr, "mbcc: error: cannot write '%s'\n", path);
-    return 2;
-  }
-  return 0;
+  return out_file_commit(&out);
 }
 
 /* log-log error against CPU time: every successful run, the Pareto front as a line */
