@@ -1,15 +1,51 @@
 /* pipeline.c: the stages in order, each product built once into the unit. */
+#include <stdio.h>
 #include <string.h>
 
 #include "diag.h"
 #include "unit.h"
 
+/* FNV-1a 64 step over n bytes */
+static uint64_t fnv1a(uint64_t h, const unsigned char *b, size_t n) {
+  for (size_t i = 0; i < n; i++) {
+    h ^= b[i];
+    h *= 0x100000001b3ULL;
+  }
+  return h;
+}
+
+/* the input hash (unit.h); 0 after reporting if the file cannot be read */
+static int hash_input(mbc_unit *u) {
+  FILE *f = fopen(u->path, "rb");
+  if (!f) {
+    diag_error(u->path, (ir_loc){0, 0}, "cannot read the model file again to hash it");
+    return 2;
+  }
+  uint64_t h = 0xcbf29ce484222325ULL;
+  unsigned char buf[8192];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, f)) > 0) h = fnv1a(h, buf, n);
+  int bad = ferror(f);
+  fclose(f);
+  if (bad) {
+    diag_error(u->path, (ir_loc){0, 0}, "cannot read the model file again to hash it");
+    return 2;
+  }
+  h = fnv1a(h, (const unsigned char *)"", 1);
+  if (u->scene) h = fnv1a(h, (const unsigned char *)u->scene, strlen(u->scene));
+  u->input_hash = h;
+  return 0;
+}
+
 int mbc_unit_read(mbc_unit *u, const char *path, const char *scene) {
   memset(u, 0, sizeof *u);
   u->path = path;
   u->scene = scene;
+  const char *slash = strrchr(path, '/');
+  u->file_name = slash ? slash + 1 : path;
   u->ir = ir_read(path, scene);
-  return u->ir ? 0 : 2;
+  if (!u->ir) return 2;
+  return hash_input(u);
 }
 
 int mbc_unit_finish(mbc_unit *u, int verbose) {

@@ -5,6 +5,8 @@
 #ifndef MBCC_UNIT_H
 #define MBCC_UNIT_H
 
+#include <stdint.h>
+
 #include "flex.h"
 #include "ir.h"
 #include "lower.h"
@@ -13,6 +15,9 @@
 typedef struct mbc_unit {
   const char *path, *scene; /* as given on the command line */
   ir_model *ir;             /* read, the scene applied (ir_read) */
+  const char *file_name;    /* the model file's name in its own directory (path's basename):
+                               what the generated code quotes, however the path was typed */
+  uint64_t input_hash;      /* FNV-1a 64 of the model file's bytes, a 0 byte and the scene's name */
   flex_product flex;        /* the flexible bodies' modes and invariants (flex_reduce) */
   lmodel *lowered;          /* coordinates, rows, pattern, assembled (lower_model, assemble_model) */
   ldl_plan plan;            /* the emitted LDL^T's ordering and symbolic factorization */
