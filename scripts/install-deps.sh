@@ -27,7 +27,7 @@ present() {
     return
   fi
   case $1 in
-    build-essential)    command -v cc && command -v make && [ -e /usr/include/stdio.h ] ;;
+    build-essential)    command -v cc && command -v make && command -v g++ && [ -e /usr/include/stdio.h ] ;;
     libyaml-dev)        [ -e /usr/include/yaml.h ] && links yaml ;;
     libsuitesparse-dev) [ -e /usr/include/suitesparse/klu.h ] && links klu &&
                         [ -e /usr/include/suitesparse/cholmod.h ] && links cholmod &&

@@ -753,11 +753,13 @@ static void emit_header(emit_ctx *cx) {
   fprintf(f, "#define %s_N %d    /* dimension of K */\n", U, m->n);
   fprintf(f, "#define %s_NNZ %d  /* nonzeros of K */\n", U, m->nnz);
   fprintf(f, "#define %s_NCOLS %d /* output columns */\n\n", U, m->ncols);
+  fputs("#ifdef __cplusplus\nextern \"C\" {\n#endif\n\n", f);
   fprintf(f, "extern const mb_model %s_model;\n", nm);
   fprintf(f, "void %s_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,\n"
              "    mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *phid, void *work);\n", nm);
   emit_ldl_header(cx);
-  fprintf(f, "void %s_init(const mb_model *m, mb_real *Kx);\n\n#endif\n", nm);
+  fprintf(f, "void %s_init(const mb_model *m, mb_real *Kx);\n\n", nm);
+  fputs("#ifdef __cplusplus\n}\n#endif\n\n#endif\n", f);
 }
 
 static void emit_source(emit_ctx *cx) {
@@ -788,22 +790,25 @@ static void emit_source(emit_ctx *cx) {
              "  .nq = %s_NQ, .nv = %s_NV, .nc = %s_NC, .n = %s_N, .nnz = %s_NNZ,\n",
           nm, m->nbody, m->nmarker, m->nrow, m->nforce, m->nprofile, m->noutput, m->njoint, U, U,
           U, U, U);
-  fprintf(f, "  .body = %s, .marker = %s, .row = %s, .force = %s,\n  .profile = %s, .output = %s, .joint_name = %s,\n",
+  /* every field in the order of mb_model's, as C++ wants designated initializers */
+  fprintf(f, "  .body = %s, .marker = %s, .row = %s, .force = %s,\n",
           m->nbody ? "bodies" : "0", m->nmarker ? "markers" : "0", m->nrow ? "rows" : "0",
-          m->nforce ? "forces" : "0", m->nprofile ? "profiles" : "0",
-          m->noutput ? "outputs" : "0", m->njoint ? "joint_names" : "0");
+          m->nforce ? "forces" : "0");
   if (m->nforce_prm || m->nforce_law)
-    fprintf(f, "  .force_prm = %s, .nforce_prm = %d, .force_law = %s, .nforce_law = %d,\n",
-            m->nforce_prm ? "force_prm" : "0", m->nforce_prm, m->nforce_law ? "force_laws" : "0",
+    fprintf(f, "  .force_prm = %s, .force_law = %s, .nforce_prm = %d, .nforce_law = %d,\n",
+            m->nforce_prm ? "force_prm" : "0", m->nforce_law ? "force_laws" : "0", m->nforce_prm,
             m->nforce_law);
+  fprintf(f, "  .profile = %s, .output = %s, ", m->nprofile ? "profiles" : "0", m->noutput ? "outputs" : "0");
+  if (L->noutput_coef) fputs(".output_coef = output_coef, ", f);
+  fprintf(f, ".joint_name = %s,\n", m->njoint ? "joint_names" : "0");
   fputs("  .gravity = ", f);
   vec(f, m->gravity, 3);
-  fprintf(f, ",\n  .Kp = Kp, .Ki = %s, .q0 = %s, .v0 = %s, .modal_slot = %s,\n", m->nnz ? "Ki" : "0",
-          m->nq ? "q0" : "0", m->nv ? "v0" : "0", L->nmodal_slot ? "modal_slot" : "0");
-  if (L->noutput_coef) fputs("  .output_coef = output_coef,\n", f);
-  emit_ldl_fields(cx, ldl);
-  fprintf(f, "  .ncols = %s_NCOLS, .col_name = %s,\n  .eval = %s_eval, .init = %s_init,\n};\n", U,
+  fprintf(f, ",\n  .Kp = Kp, .Ki = %s, .modal_slot = %s, .q0 = %s, .v0 = %s,\n", m->nnz ? "Ki" : "0",
+          L->nmodal_slot ? "modal_slot" : "0", m->nq ? "q0" : "0", m->nv ? "v0" : "0");
+  fprintf(f, "  .ncols = %s_NCOLS, .col_name = %s,\n  .eval = %s_eval, .init = %s_init,\n", U,
           m->ncols ? "col_names" : "0", nm, nm);
+  emit_ldl_fields(cx, ldl);
+  fputs("};\n", f);
 }
 
 /* the model's simulation settings as C statements on an mb_settings 's' */

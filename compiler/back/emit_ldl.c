@@ -355,9 +355,9 @@ static void emit_factor_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *
   for (int k = 0; k < n; k++) {
     if (k == 0 || chunk_flops > LDL_CHUNK_FLOPS) {
       if (k) fputs("  return 0;\n}\n\n", f);
-      fprintf(f, "static LDL_NOINLINE int ldl_factor_part%d(const mb_real *restrict Kx,%s%s mb_real *restrict Lx, "
-                 "mb_real *restrict Dinv) {\n",
-              nchunk++, p->nelim ? " const mb_real *restrict Kc," : "", cx->ldl.k1_direct ? " const mb_real *restrict K1," : "");
+      fprintf(f, "static LDL_NOINLINE int ldl_factor_part%d(const mb_real *MB_RESTRICT Kx,%s%s mb_real *MB_RESTRICT Lx, "
+                 "mb_real *MB_RESTRICT Dinv) {\n",
+              nchunk++, p->nelim ? " const mb_real *MB_RESTRICT Kc," : "", cx->ldl.k1_direct ? " const mb_real *MB_RESTRICT K1," : "");
       fprintf(f, "  (void)Kx;\n%s%s  (void)Lx;\n", p->nelim ? "  (void)Kc;\n" : "", cx->ldl.k1_direct ? "  (void)K1;\n" : "");
       chunk_flops = 0;
     }
@@ -1613,7 +1613,7 @@ static void solve_part_open(emit_ctx *cx, const char *dir, const char *what, int
   if (*nparts && *part_flops <= LDL_CHUNK_FLOPS) return;
   if (*nparts) fputs("}\n\n", f);
   fprintf(f, "/* %s: %s, row by row (part %d) */\n", dir, what, *nparts);
-  fprintf(f, "static LDL_NOINLINE void ldl_%s%d(const mb_real *restrict Lx, mb_real *restrict t) {\n", dir, *nparts);
+  fprintf(f, "static LDL_NOINLINE void ldl_%s%d(const mb_real *MB_RESTRICT Lx, mb_real *MB_RESTRICT t) {\n", dir, *nparts);
   (*nparts)++;
   *part_flops = 0;
 }
@@ -1676,7 +1676,7 @@ static void emit_solve_helpers_straight(emit_ctx *cx, const lmodel *L, const ldl
   }
   if (nbwd) fputs("}\n\n", f);
   fputs("/* t <- (L D L^T)^-1 t */\n", f);
-  fputs("static void ldl_lsolve(const mb_real *restrict Lx, const mb_real *restrict Dinv, mb_real *restrict t) {\n", f);
+  fputs("static void ldl_lsolve(const mb_real *MB_RESTRICT Lx, const mb_real *MB_RESTRICT Dinv, mb_real *MB_RESTRICT t) {\n", f);
   for (int c = 0; c < nfwd; c++) fprintf(f, "  ldl_forward%d(Lx, t);\n", c);
   fputs("  /* diagonal: z = D^-1 y */\n", f);
   for (int k = 0; k < n; k++)

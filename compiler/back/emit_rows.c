@@ -13,6 +13,7 @@
  * keep the kernels' order of operations, so for finite values the numbers are
  * the kernels' own (up to the sign of a zero); test_generic and test_ldl
  * compare the two paths. */
+#include <ctype.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -22,6 +23,37 @@
 #define EXPR 640 /* longest expression kept symbolic; longer ones go to locals */
 
 typedef struct { char e[3][EXPR]; } svec;
+
+/* an element of a braced mb_real initializer, converted explicitly when it
+ * holds a floating literal (a double: where mb_real is float, C converts the
+ * value implicitly, C++ rejects the narrowing in braces); expressions of
+ * mb_real variables and integers as they are */
+static void init_elem(FILE *f, const char *e) {
+  int real_literal = 0;
+  for (const char *c = e; *c; c++) {
+    int starts = isdigit((unsigned char)*c) &&
+                 (c == e || !(isalnum((unsigned char)c[-1]) || c[-1] == '_' || c[-1] == '.' || c[-1] == '['));
+    if (!starts) continue;
+    const char *t = c;
+    while (isalnum((unsigned char)*t) || *t == '.' || ((*t == '-' || *t == '+') && (t[-1] == 'e' || t[-1] == 'E'))) {
+      real_literal |= *t == '.' || *t == 'e' || *t == 'E';
+      t++;
+    }
+    c = t - 1;
+  }
+  if (real_literal) fprintf(f, "(mb_real)(%s)", e);
+  else fputs(e, f);
+}
+
+/* "{e0, e1, e2}" with init_elem's elements */
+static void init3(FILE *f, const svec *v) {
+  fputc('{', f);
+  for (int i = 0; i < 3; i++) {
+    if (i) fputs(", ", f);
+    init_elem(f, v->e[i]);
+  }
+  fputc('}', f);
+}
 
 static int is_zero(const char *a) { return !strcmp(a, "0"); }
 static int is_one(const char *a) { return !strcmp(a, "1"); }
@@ -129,7 +161,9 @@ static void s_local(FILE *f, svec *v, const char *name, const char *indent) {
   int need = 0;
   for (int i = 0; i < 3; i++) need |= !is_atom(v->e[i]);
   if (!need) return;
-  fprintf(f, "%smb_real %s[3] = {%s, %s, %s};\n", indent, name, v->e[0], v->e[1], v->e[2]);
+  fprintf(f, "%smb_real %s[3] = ", indent, name);
+  init3(f, v);
+  fputs(";\n", f);
   for (int i = 0; i < 3; i++)
     if (!is_atom(v->e[i])) snprintf(v->e[i], EXPR, "%s[%d]", name, i);
 }
@@ -187,7 +221,9 @@ int emit_marker_special(FILE *f, const lmodel *L, int k) {
   }
   int moving = !(is_zero(u.e[0]) && is_zero(u.e[1]) && is_zero(u.e[2]));
   if (moving) {
-    fprintf(f, "  {\n    mb_real u[3] = {%s, %s, %s}, wu[3];\n", u.e[0], u.e[1], u.e[2]);
+    fputs("  {\n    mb_real u[3] = ", f);
+    init3(f, &u);
+    fputs(", wu[3];\n", f);
     fprintf(f, "    mb_cross3(f%d.w, u, wu);\n    mb_cross3(f%d.w, wu, k%d.aP);\n", b, b, k);
     for (int i = 0; i < 3; i++)
       fprintf(f, "    k%d.P[%d] = f%d.r[%d] + u[%d];\n    k%d.V[%d] = f%d.rd[%d] + wu[%d];\n", k, i, b,
@@ -407,8 +443,11 @@ static void emit_row_common(FILE *f, const lmodel *L, int r, const smark mk[2], 
     } else {
       /* a flexible node: its modal columns too */
       svec v = dV[s], w = dW[s];
-      fprintf(f, "    mb_real dV%d[3] = {%s, %s, %s}, dW%d[3] = {%s, %s, %s};\n", s, v.e[0], v.e[1], v.e[2],
-              s, w.e[0], w.e[1], w.e[2]);
+      fprintf(f, "    mb_real dV%d[3] = ", s);
+      init3(f, &v);
+      fprintf(f, ", dW%d[3] = ", s);
+      init3(f, &w);
+      fputs(";\n", f);
       char nv[16], nw[16];
       snprintf(nv, sizeof nv, "dV%d", s);
       snprintf(nw, sizeof nw, "dW%d", s);

@@ -19,6 +19,10 @@
 #include "elements/mb_force_point.h"
 #include "elements/mb_spring.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef enum { MB_BODY_RIGID = 1, MB_BODY_VIRTUAL = 2, MB_BODY_FLEXIBLE = 3 } mb_body_kind;
 
 typedef struct {
@@ -205,5 +209,9 @@ double mb_model_angle_step(const struct mb_model *m, const mb_real *q, const mb_
 /* kinetic and potential energy (gravity and force elements) */
 void mb_model_energy(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
                      mb_real *kinetic, mb_real *potential, void *work);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

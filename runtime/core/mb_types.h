@@ -3,6 +3,24 @@
 #ifndef MB_TYPES_H
 #define MB_TYPES_H
 
+/* restrict in C99 and later, the compilers' __restrict in C++ (the generated
+ * code also compiles as C++), nothing elsewhere */
+#if defined(__cplusplus)
+#if defined(__GNUC__) || defined(__clang__) || defined(_MSC_VER)
+#define MB_RESTRICT __restrict
+#else
+#define MB_RESTRICT
+#endif
+#elif defined(__STDC_VERSION__) && __STDC_VERSION__ >= 199901L
+#define MB_RESTRICT restrict
+#else
+#define MB_RESTRICT
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #ifdef MB_REAL_FLOAT
 typedef float mb_real;
 #else
@@ -25,5 +43,9 @@ typedef enum {
 #define MB_PI 3.14159265358979323846
 
 const char *mb_status_text(int status);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif
