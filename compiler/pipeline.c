@@ -45,7 +45,11 @@ int mbc_unit_read(mbc_unit *u, const char *path, const char *scene) {
   u->file_name = slash ? slash + 1 : path;
   u->ir = ir_read(path, scene);
   if (!u->ir) return 2;
-  return hash_input(u);
+  if (hash_input(u)) {
+    mbc_unit_free(u);
+    return 2;
+  }
+  return 0;
 }
 
 int mbc_unit_finish(mbc_unit *u, int verbose) {

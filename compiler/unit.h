@@ -27,7 +27,8 @@ typedef struct mbc_unit {
 
 /* The first stage alone: read the model and apply the scene, so that a tool
  * can change the IR before the rest (mbcc trade's variants).  0, or 2 after
- * reporting. */
+ * reporting (nothing is then held).  Every function here leaves u ready for
+ * mbc_unit_free, also after a failure. */
 int mbc_unit_read(mbc_unit *u, const char *path, const char *scene);
 /* The stages after reading: flexible bodies, lowering and pattern, assembly
  * analysis (verbose: its report on stdout), the LDL^T plan.  0, or 2 after
