@@ -1,7 +1,8 @@
 /* fuzz_front.c: the libFuzzer harness of the front end (make fuzz): a YAML
- * model -> IR (reader and its checks) -> lowering (coordinates, rows, the
- * sparse pattern, FE modes) -> assembly analysis (Newton on the constraints,
- * redundancy).  Every input must end in a result or located errors, within
+ * model -> IR (reader and its checks) -> flexible bodies (FE modes) ->
+ * lowering (coordinates, rows, the sparse pattern) -> assembly analysis
+ * (Newton on the constraints, redundancy) -> the LDL^T plan: the whole
+ * pipeline of compiler/pipeline.c.  Every input must end in a result or located errors, within
  * the time and memory libFuzzer allows, with no sanitizer report.  The limits
  * are set low here (bodies, FE size) so that every run stays fast. */
 #define _GNU_SOURCE
@@ -11,7 +12,7 @@
 #include <unistd.h>
 
 #include "diag.h"
-#include "lower.h"
+#include "unit.h"
 
 static char model_path[64];
 static void remove_model(void) { unlink(model_path); }
@@ -33,14 +34,9 @@ int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size) {
   if (!f) return 0;
   fwrite(data, 1, size, f);
   fclose(f);
-  ir_model *ir = ir_read(model_path, NULL);
-  if (ir) {
-    lmodel *L = lower_model(ir);
-    if (L) {
-      assemble_model(L, 0);
-      lower_free(L);
-    }
-    ir_free(ir);
-  }
+  mbc_unit u;
+  memset(&u, 0, sizeof u);
+  mbc_unit_build(&u, model_path, NULL, 0);
+  mbc_unit_free(&u);
   return 0;
 }
