@@ -33,6 +33,13 @@ done
 python3 -c "import sys; sys.stdout.write('a: ' + '[' * 1000000 + ']' * 1000000 + '\n')" > brackets.yaml
 check brackets.yaml 'nested more than 64 deep'
 check /dev/zero 'larger than the limit'
+# a results CSV that streams forever: plot and animate refuse it at once
+for cmd in plot animate; do
+  timeout 10 "$MBCC" $cmd /dev/zero -o zero.out > zero.log 2>&1
+  rc=$?
+  [ $rc = 2 ] && grep -q "not a regular file" zero.log && [ ! -e zero.out ] ||
+    err "mbcc $cmd /dev/zero: exit $rc: $(head -2 zero.log)"
+done
 awk 'BEGIN { print "name: chain\nbodies:"; for (i = 1; i <= 10001; i++) printf "  b%d: {type: rigid, mass: 1, inertia: [1, 1, 1], position: [%d, 0, 0]}\n", i, i
              print "joints:"; for (i = 1; i <= 10001; i++) printf "  j%d: {type: revolute, bodies: [%s, b%d], point: [%d, 0, 0], axis: [0, 0, 1]}\n", i, i == 1 ? "ground" : "b" i - 1, i, i - 1 }' > chain.yaml
 check chain.yaml 'more than the limit 10000'

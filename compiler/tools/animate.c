@@ -19,6 +19,7 @@
 
 #include "paths.h"
 #include "animate.h"
+#include "plot.h"
 #include "diag.h"
 #include "flex.h"
 #include "lower.h"
@@ -133,6 +134,7 @@ static void csv_free(csv_table *t) {
 static int csv_read(const char *path, csv_table *t) {
   memset(t, 0, sizeof *t);
   size_t len;
+  if (csv_file_check(path)) return 2;
   char *text = read_all(path, &len);
   if (!text) { fprintf(stderr, "mbcc: error: cannot read '%s': %s\n", path, strerror(errno)); return 2; }
   char *line = text, *eol = strchr(line, '\n');

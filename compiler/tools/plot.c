@@ -12,6 +12,7 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include "bounds.h"
 #include "plot.h"
 #include "proc.h"
 
@@ -40,10 +41,27 @@ static void csv_free(csvfile *f) {
   free(f->text);
 }
 
+int csv_file_check(const char *path) {
+  struct stat st;
+  if (stat(path, &st)) { fprintf(stderr, "mbcc: error: cannot read '%s': %s\n", path, strerror(errno)); return 2; }
+  if (!S_ISREG(st.st_mode)) {
+    fprintf(stderr, "mbcc: error: '%s' is not a regular file (a results CSV is read whole)\n", path);
+    return 2;
+  }
+  double limit = limit_value("MBCC_MAX_CSV", 1024.0 * 1024 * 1024);
+  if ((double)st.st_size > limit) {
+    fprintf(stderr, "mbcc: error: '%s' has %.0f bytes, more than the limit %.0f (MBCC_MAX_CSV=BYTES lifts it)\n",
+            path, (double)st.st_size, limit);
+    return 2;
+  }
+  return 0;
+}
+
 /* the header, the units file and the range of every column; 0 or 2 */
 static int csv_read(const char *path, csvfile *f) {
   memset(f, 0, sizeof *f);
   f->path = path;
+  if (csv_file_check(path)) return 2;
   FILE *in = fopen(path, "r");
   if (!in) { fprintf(stderr, "mbcc: error: cannot read '%s'\n", path); return 2; }
   size_t cap = 0;
