@@ -65,44 +65,52 @@ static void lit(char *o, double x) {
   snprintf(o, EXPR, "%.17g", x);
 }
 
+/* an expression that did not fit its buffer becomes a token that no C
+ * compiler accepts: the build fails loudly instead of compiling a cut
+ * (and possibly still valid) expression */
+#define EXPR_TOO_LONG "@mbcc_internal_error_expression_longer_than_EXPR@"
+static void checked(char *t, int written) {
+  if (written < 0 || written >= EXPR) memcpy(t, EXPR_TOO_LONG, sizeof EXPR_TOO_LONG);
+}
+
 static void s_neg(char *o, const char *a) {
   char t[EXPR];
-  if (is_zero(a)) snprintf(t, sizeof t, "0");
-  else if (is_atom(a) && a[0] == '-') snprintf(t, sizeof t, "%s", a + 1);
-  else if (is_atom(a)) snprintf(t, sizeof t, "-%s", a);
-  else snprintf(t, sizeof t, "-(%s)", a);
+  if (is_zero(a)) checked(t, snprintf(t, sizeof t, "0"));
+  else if (is_atom(a) && a[0] == '-') checked(t, snprintf(t, sizeof t, "%s", a + 1));
+  else if (is_atom(a)) checked(t, snprintf(t, sizeof t, "-%s", a));
+  else checked(t, snprintf(t, sizeof t, "-(%s)", a));
   memcpy(o, t, EXPR);
 }
 
 /* o = a * b */
 static void s_mul(char *o, const char *a, const char *b) {
   char t[EXPR];
-  if (is_zero(a) || is_zero(b)) snprintf(t, sizeof t, "0");
-  else if (is_one(a)) snprintf(t, sizeof t, "%s", b);
-  else if (is_one(b)) snprintf(t, sizeof t, "%s", a);
+  if (is_zero(a) || is_zero(b)) checked(t, snprintf(t, sizeof t, "0"));
+  else if (is_one(a)) checked(t, snprintf(t, sizeof t, "%s", b));
+  else if (is_one(b)) checked(t, snprintf(t, sizeof t, "%s", a));
   else if (is_mone(a)) s_neg(t, b);
   else if (is_mone(b)) s_neg(t, a);
   else
-    snprintf(t, sizeof t, "%s%s%s * %s%s%s", is_atom(a) ? "" : "(", a, is_atom(a) ? "" : ")",
-             is_atom(b) ? "" : "(", b, is_atom(b) ? "" : ")");
+    checked(t, snprintf(t, sizeof t, "%s%s%s * %s%s%s", is_atom(a) ? "" : "(", a, is_atom(a) ? "" : ")",
+             is_atom(b) ? "" : "(", b, is_atom(b) ? "" : ")"));
   memcpy(o, t, EXPR);
 }
 
 /* o = a + b (a's own sum is left-associative: no parentheses needed) */
 static void s_add(char *o, const char *a, const char *b) {
   char t[EXPR];
-  if (is_zero(b)) snprintf(t, sizeof t, "%s", a);
-  else if (is_zero(a)) snprintf(t, sizeof t, "%s", b);
-  else snprintf(t, sizeof t, "%s + %s%s%s", a, is_atom(b) ? "" : "(", b, is_atom(b) ? "" : ")");
+  if (is_zero(b)) checked(t, snprintf(t, sizeof t, "%s", a));
+  else if (is_zero(a)) checked(t, snprintf(t, sizeof t, "%s", b));
+  else checked(t, snprintf(t, sizeof t, "%s + %s%s%s", a, is_atom(b) ? "" : "(", b, is_atom(b) ? "" : ")"));
   memcpy(o, t, EXPR);
 }
 
 /* o = a - b */
 static void s_sub(char *o, const char *a, const char *b) {
   char t[EXPR];
-  if (is_zero(b)) snprintf(t, sizeof t, "%s", a);
+  if (is_zero(b)) checked(t, snprintf(t, sizeof t, "%s", a));
   else if (is_zero(a)) s_neg(t, b);
-  else snprintf(t, sizeof t, "%s - %s%s%s", a, is_atom(b) ? "" : "(", b, is_atom(b) ? "" : ")");
+  else checked(t, snprintf(t, sizeof t, "%s - %s%s%s", a, is_atom(b) ? "" : "(", b, is_atom(b) ? "" : ")"));
   memcpy(o, t, EXPR);
 }
 
@@ -254,19 +262,24 @@ void emit_marker_node(FILE *f, const lmodel *L, int k) {
     int qa = (s == 0 || s == 1) ? B->qadr + 7 : B->vadr + 6;
     const char *arr = (s == 0 || s == 1) ? "q" : "v";
     for (int i = 0; i < 3; i++) {
-      char e[EXPR], c[EXPR], x[EXPR];
-      snprintf(e, sizeof e, "0");
-      for (int j = 0; j < nm; j++) {
-        lit(c, T[3 * j + i]);
-        snprintf(x, sizeof x, "%s[%d]", arr, qa + j);
-        s_mul(c, c, x);
-        s_add(e, e, c);
+      /* written term by term (as s_add would join them): a sum over
+         hundreds of modes does not fit an expression buffer */
+      fprintf(f, "    %s[%d] = ", nmv[s], i);
+      int any = 0;
+      for (int j = 0; j <= nm; j++) {
+        char c[EXPR], x[EXPR];
+        if (j < nm) {
+          lit(c, T[3 * j + i]);
+          snprintf(x, sizeof x, "%s[%d]", arr, qa + j);
+          s_mul(c, c, x);
+        } else if (s == 0) lit(c, fx->node_x[3 * node + i]);
+        else break;
+        if (is_zero(c)) continue;
+        if (!any) fputs(c, f);
+        else fprintf(f, " + %s%s%s", is_atom(c) ? "" : "(", c, is_atom(c) ? "" : ")");
+        any = 1;
       }
-      if (s == 0) {
-        lit(c, fx->node_x[3 * node + i]);
-        s_add(e, e, c);
-      }
-      fprintf(f, "    %s[%d] = %s;\n", nmv[s], i, e);
+      fprintf(f, "%s;\n", any ? "" : "0");
     }
   }
   fprintf(f, "    mb_marker_node_sums(&f%d, b, th, thd, Xwd, (const mb_real[9]){", d->body);
