@@ -22,6 +22,7 @@
 #include "mb_driver.h"
 #include "order.h"
 #include "outfile.h"
+#include "params.h"
 #include "paths.h"
 #include "plot.h"
 #include "proc.h"
@@ -44,6 +45,10 @@ typedef struct {
   int nsim;
   int quiet;
   int animate;      /* run --animate: pose outputs added, and the HTML animation written */
+  char set_names[64][128];   /* run --set NAME=VALUE: run-time parameters */
+  double set_values[64];
+  const char *set_args[64];  /* as given, for the simulator */
+  int nset;
 } options;
 
 static int parse_options(int argc, char **argv, options *o) {
@@ -60,6 +65,20 @@ static int parse_options(int argc, char **argv, options *o) {
     if (!strcmp(a, "--animate")) { o->animate = 1; continue; }
     if (!v) { fprintf(stderr, "mbcc: error: option '%s' needs a value\n", a); return 2; }
     i++;
+    if (!strcmp(a, "--set")) {
+      const char *eq = strchr(v, '=');
+      char *end = NULL;
+      double value = eq ? strtod(eq + 1, &end) : 0;
+      if (!eq || eq == v || end == eq + 1 || *end || !isfinite(value)) {
+        fprintf(stderr, "mbcc: error: --set needs NAME=VALUE with a finite number, got '%s'\n", v);
+        return 2;
+      }
+      if (o->nset == 64) { fprintf(stderr, "mbcc: error: more than 64 --set options\n"); return 2; }
+      snprintf(o->set_names[o->nset], sizeof o->set_names[0], "%.*s", (int)(eq - v), v);
+      o->set_values[o->nset] = value;
+      o->set_args[o->nset++] = v;
+      continue;
+    }
     if (!strcmp(a, "--scene")) o->scene = v;
     else if (!strcmp(a, "--body")) o->body = v;
     else if (!strcmp(a, "--shapes")) o->shapes = v;
@@ -115,15 +134,59 @@ static int refuse_input_as_output(const options *o, const char *out, const char 
 
 /* the whole pipeline into *u, --animate's pose outputs added to the IR
  * between reading and the rest; 0, or 2 after reporting (u is then freed) */
-static int build(const options *o, mbc_unit *u, int verbose) {
+static int build_read(const options *o, mbc_unit *u, int verbose, int overridden) {
   mb_lapack_context = o->model; /* a LAPACK argument error names the model */
   if (mbc_unit_read(u, o->model, o->scene) || (o->animate && animate_add_pose_outputs(u->ir)) ||
-      mbc_unit_finish(u, verbose)) {
+      ((u->overridden = overridden), mbc_unit_finish(u, verbose))) {
     mbc_unit_free(u);
     return 2;
   }
   u->real_float = o->real_float;
   return 0;
+}
+
+static int build(const options *o, mbc_unit *u, int verbose) { return build_read(o, u, verbose, 0); }
+
+/* run --set: each a run-time parameter of the model (read into ir) with a
+ * value in its range; 0, or 2 after reporting */
+static int check_sets(const options *o, const ir_model *ir) {
+  for (int i = 0; i < o->nset; i++) {
+    char suggest[128];
+    int k = params_find(ir, o->set_names[i], suggest, sizeof suggest);
+    const ir_param *P = k >= 0 ? &ir->params[k] : NULL;
+    if (!P) {
+      fprintf(stderr, "mbcc: error: --set %s: the model has no parameter '%s'", o->set_args[i], o->set_names[i]);
+      if (suggest[0]) fprintf(stderr, " (did you mean '%s'?)", suggest);
+      fputc('\n', stderr);
+      return 2;
+    }
+    if (!P->runtime) {
+      diag_error(ir->path, P->loc, "--set %s: parameter '%s' is compile-time (give it 'runtime: true' to "
+                 "set it without recompiling, or edit its value)", o->set_args[i], P->name);
+      return 2;
+    }
+    if (!(o->set_values[i] >= P->min && o->set_values[i] <= P->max)) {
+      diag_error(ir->path, P->loc, "--set %s: outside the range [%g, %g] of parameter '%s'", o->set_args[i],
+                 P->min, P->max, P->name);
+      return 2;
+    }
+  }
+  return 0;
+}
+
+/* the generic path with --set: the model read again with the values (every
+ * field that names them follows, and the model is assembled with them) */
+static int build_with_sets(const options *o, mbc_unit *u) {
+  if (build(o, u, 0)) return 2;
+  if (check_sets(o, u->ir)) { mbc_unit_free(u); return 2; }
+  if (!o->nset) return 0;
+  mbc_unit_free(u);
+  const char *names[64];
+  for (int i = 0; i < o->nset; i++) names[i] = o->set_names[i];
+  params_set_overrides(names, o->set_values, o->nset);
+  int rc = build_read(o, u, 0, 1);
+  params_set_overrides(NULL, NULL, 0);
+  return rc;
 }
 
 static int cmd_check(const options *o) {
@@ -166,6 +229,23 @@ static int cmd_check(const options *o) {
     printf("\n    mass %.6g kg, damping ratios:", m->body[b].flex->mass);
     for (int j = 0; j < m->body[b].nm; j++)
       printf(" %.3g", m->body[b].flex->damping[j] / (2 * 2 * MB_PI * fm->freq_hz[j] * sqrt(m->body[b].flex->Mff[j * m->body[b].nm + j])));
+    printf("\n");
+  }
+  if (ir->nparams) printf("  parameters        %d\n", ir->nparams);
+  for (int k = 0; k < ir->nparams; k++) {
+    const ir_param *P = &ir->params[k];
+    printf("    %-16s %.15g%s%s %s", P->name, P->value, P->unit ? " " : "", P->unit ? P->unit : "",
+           P->runtime ? "run-time" : P->uses_runtime ? "compile-time (follows a run-time parameter)" : "compile-time");
+    if (P->runtime && (isfinite(P->min) || isfinite(P->max))) printf(" [%g, %g]", P->min, P->max);
+    int nused = 0;
+    for (int i = 0; i < ir->nuses; i++) {
+      if (!expr_names(ir->uses[i].expr, k)) continue;
+      printf("%s%d:%d", nused++ ? ", " : ", used at ", ir->uses[i].loc.line, ir->uses[i].loc.col);
+    }
+    for (int j = 0; j < ir->nparams; j++)
+      if (ir->params[j].expr && expr_names(ir->params[j].expr, k))
+        printf("%s'%s'", nused++ ? ", " : ", used at ", ir->params[j].name);
+    if (!nused) printf(", unused");
     printf("\n");
   }
   mbc_unit_free(&u);
@@ -531,7 +611,7 @@ static int cmd_run(const options *o) {
     /* in-process, without code generation: the generic path */
     options o2 = *o;
     o2.outdir = NULL;
-    if (build(&o2, &u, 0)) return 2;
+    if (build_with_sets(&o2, &u)) return 2;
     const lmodel *Lg = u.lowered;
     if (!o->csv) default_csv(o, Lg->m.name, csv, sizeof csv);
     const ir_sim *s = &u.ir->sim;
@@ -555,6 +635,7 @@ static int cmd_run(const options *o) {
     o2.outdir = NULL;
     memset(&u, 0, sizeof u);
     rc = cmd_compile(&o2, dir, sizeof dir, &u);
+    if (!rc) rc = check_sets(o, u.ir);
     if (rc) { mbc_unit_free(&u); return rc; }
     const lmodel *L = u.lowered;
     if (!o->csv) default_csv(o, L->m.name, csv, sizeof csv);
@@ -580,11 +661,15 @@ static int cmd_run(const options *o) {
       mbc_unit_free(&u);
       return 2;
     }
-    char *args[40];
+    char *args[40 + 2 * 64];
     int na = 0;
     args[na++] = exe_final;
     args[na++] = "-o";
     args[na++] = csv;
+    for (int i = 0; i < o->nset; i++) { /* the simulator sets them: nothing recompiled */
+      args[na++] = "--set";
+      args[na++] = (char *)o->set_args[i];
+    }
     for (int i = 0; i < o->nsim; i++)
       if (strcmp(o->sim_args[i], "--columns")) args[na++] = (char *)o->sim_args[i];
       else i++;
@@ -721,6 +806,10 @@ int main(int argc, char **argv) {
     return 2;
   }
   if (parse_options(argc, argv, &o)) return 2;
+  if (o.nset && strcmp(cmd, "run")) {
+    fprintf(stderr, "mbcc: error: --set is an option of mbcc run (and of the generated simulator)\n");
+    return 2;
+  }
   if (refuse_input_as_output(&o, o.plot, "the plot") || refuse_input_as_output(&o, o.shapes, "the shapes file") ||
       refuse_input_as_output(&o, o.modal_out, "the modal file") ||
       (strcmp(cmd, "compile") && refuse_input_as_output(&o, o.csv, "the output")))

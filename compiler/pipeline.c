@@ -1,8 +1,11 @@
 /* pipeline.c: the stages in order, each product built once into the unit. */
+#include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "diag.h"
+#include "params.h"
 #include "unit.h"
 
 /* FNV-1a 64 step over n bytes */
@@ -52,6 +55,132 @@ int mbc_unit_read(mbc_unit *u, const char *path, const char *scene) {
   return 0;
 }
 
+/* the first run-time parameter that use i depends on (for messages) */
+static const char *runtime_name(const ir_model *ir, const ir_expr *e) {
+  for (int k = 0; k < ir->nparams; k++)
+    if (ir->params[k].uses_runtime && expr_names(e, k)) {
+      const ir_param *P = &ir->params[k];
+      if (P->runtime || !P->expr) return P->name;
+      return runtime_name(ir, P->expr);
+    }
+  return "?";
+}
+
+static bool same(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
+
+/* Which pool entries of the lowered model the run-time parameters set.  The
+ * model is read and lowered a second time with every run-time parameter
+ * moved a little (by a different fraction each); an entry of the force pools
+ * that moves must equal, in both readings, a field written as an expression
+ * over run-time parameters: it is then bound to that expression.  A moved
+ * expression that lands nowhere in the pools (a mass, a point, a table), a
+ * pool entry derived from one, or any other change of the lowered model is
+ * an error: the generated code fixes those at compile time. */
+static int bind_runtime(mbc_unit *u) {
+  const ir_model *A = u->ir;
+  const lmodel *LA = u->lowered;
+  int nrt = 0;
+  for (int k = 0; k < A->nparams; k++) nrt += A->params[k].runtime;
+  if (!nrt) return 0;
+  const char **names = calloc((size_t)nrt, sizeof *names);
+  double *values = calloc((size_t)nrt, sizeof *values);
+  bool *bound = calloc((size_t)A->nuses + 1, sizeof *bound);
+  u->bind = calloc((size_t)(LA->m.nforce_prm + 2 * LA->m.nforce_law) + 1, sizeof *u->bind);
+  u->lowered->prm_runtime = calloc((size_t)LA->m.nforce_prm + 1, 1);
+  if (!names || !values || !bound || !u->bind || !u->lowered->prm_runtime) {
+    free(names); free(values); free(bound);
+    diag_error(u->path, (ir_loc){0, 0}, "out of memory while binding run-time parameters");
+    return 2;
+  }
+  const ir_param *first = NULL;
+  for (int k = 0, j = 0; k < A->nparams; k++) {
+    const ir_param *P = &A->params[k];
+    if (!P->runtime) continue;
+    if (!first) first = P;
+    double step = (P->value != 0 ? fabs(P->value) : 1) * ldexp(1 + 0.37 * j, -12);
+    names[j] = P->name;
+    values[j] = P->value + step <= P->max ? P->value + step : P->value - step;
+    j++;
+  }
+  int errors = diag_errors();
+  params_set_overrides(names, values, nrt);
+  diag_mute(1);
+  ir_model *B = ir_read(u->path, u->scene);
+  flex_product flexB;
+  memset(&flexB, 0, sizeof flexB);
+  lmodel *LB = B && !flex_reduce(B, &flexB) ? lower_model(B, &flexB) : NULL;
+  diag_mute(0);
+  params_set_overrides(NULL, NULL, 0);
+  int rc = 0;
+  if (!LB || diag_errors() > errors || B->nuses != A->nuses || LB->m.nforce_prm != LA->m.nforce_prm ||
+      LB->m.nforce_law != LA->m.nforce_law || LB->m.nbody != LA->m.nbody || LB->m.nmarker != LA->m.nmarker ||
+      LB->m.nrow != LA->m.nrow || LB->m.nforce != LA->m.nforce) {
+    diag_error(u->path, first->loc,
+               "moving run-time parameter '%s' a little changes the model's structure or makes it invalid: "
+               "it must be compile-time (drop 'runtime: true')", first->name);
+    rc = 2;
+    goto done;
+  }
+  /* the pools: force_prm, then each law's coefficient and exponent */
+  for (int s = 0; s < LA->m.nforce_prm + 2 * LA->m.nforce_law; s++) {
+    runtime_pool pool = s < LA->m.nforce_prm ? BIND_PRM : (s - LA->m.nforce_prm) % 2 ? BIND_LAW_EXPONENT : BIND_LAW_COEF;
+    int index = pool == BIND_PRM ? s : (s - LA->m.nforce_prm) / 2;
+    double a = pool == BIND_PRM ? LA->force_prm[index] : pool == BIND_LAW_COEF ? LA->force_law[index].coef : LA->force_law[index].exponent;
+    double b = pool == BIND_PRM ? LB->force_prm[index] : pool == BIND_LAW_COEF ? LB->force_law[index].coef : LB->force_law[index].exponent;
+    if (same(a, b)) continue;
+    int force = 0;
+    for (int k = 0; k < LA->m.nforce; k++) {
+      const mb_forcedef *d = &LA->force[k];
+      if (pool == BIND_PRM ? index >= d->padr && index < d->padr + d->pnum : index >= d->ladr && index < d->ladr + d->lnum)
+        force = k;
+    }
+    int use = -1;
+    for (int i = 0; i < A->nuses && use < 0; i++)
+      if (A->uses[i].uses_runtime && same(A->uses[i].value, a) && same(B->uses[i].value, b)) use = i;
+    const ir_force *F = &A->forces[LA->force_ir[force]];
+    if (use < 0) {
+      diag_error(u->path, F->loc, "force '%s' uses a value derived from run-time parameter '%s' (only values written "
+                 "in its fields can be run-time: stiffness, damping, preload, free length, force and torque "
+                 "values); make the parameter compile-time (drop 'runtime: true')", F->name, first->name);
+      rc = 2;
+      continue;
+    }
+    bound[use] = true;
+    u->bind[u->nbind++] = (runtime_binding){pool, index, use, force};
+    if (pool == BIND_PRM) u->lowered->prm_runtime[index] = 1;
+  }
+  for (int i = 0; i < A->nuses; i++)
+    if (A->uses[i].uses_runtime && !bound[i] && !same(A->uses[i].value, B->uses[i].value)) {
+      diag_error(u->path, A->uses[i].loc,
+                 "this value depends on run-time parameter '%s', but the generated code fixes it at compile "
+                 "time (run-time parameters can set force-element constants: stiffness, damping, preload, free "
+                 "length, force and torque values); make the parameter compile-time (drop 'runtime: true')",
+                 runtime_name(A, A->uses[i].expr));
+      rc = 2;
+    }
+  /* anything else that moved: the bodies, the markers, the rows, gravity */
+  bool moved = memcmp(LA->m.gravity, LB->m.gravity, sizeof LA->m.gravity) != 0;
+  for (int b = 0; b < LA->m.nbody && !moved; b++)
+    moved = !same(LA->body[b].mass, LB->body[b].mass) || memcmp(LA->body[b].J, LB->body[b].J, sizeof LA->body[b].J);
+  for (int k = 0; k < LA->m.nmarker && !moved; k++)
+    moved = memcmp(LA->marker[k].s, LB->marker[k].s, sizeof LA->marker[k].s) ||
+            memcmp(LA->marker[k].C, LB->marker[k].C, sizeof LA->marker[k].C);
+  for (int k = 0; k < LA->m.nrow && !moved; k++) moved = !same(LA->row[k].L, LB->row[k].L);
+  if (moved && !rc) {
+    diag_error(u->path, first->loc, "run-time parameter '%s' changes the model's masses, geometry or gravity, which "
+               "the generated code fixes at compile time: make it compile-time (drop 'runtime: true')", first->name);
+    rc = 2;
+  }
+done:
+  if (LB) lower_free(LB);
+  flex_product_free(&flexB);
+  ir_free(B);
+  free(names);
+  free(values);
+  free(bound);
+  return rc;
+}
+
 int mbc_unit_finish(mbc_unit *u, int verbose) {
   if (flex_reduce(u->ir, &u->flex)) return 2;
   u->lowered = lower_model(u->ir, &u->flex);
@@ -59,6 +188,7 @@ int mbc_unit_finish(mbc_unit *u, int verbose) {
     if (!diag_errors()) diag_error(u->path, (ir_loc){0, 0}, "out of memory while lowering");
     return 2;
   }
+  if (!u->overridden && bind_runtime(u)) return 2;
   if (assemble_model(u->lowered, verbose)) return 2;
   /* the plan reads the assembled model: removed rows and the values at t = 0 */
   u->have_plan = !ldl_plan_build(u->lowered, &u->plan);
@@ -72,7 +202,11 @@ int mbc_unit_build(mbc_unit *u, const char *path, const char *scene, int verbose
 
 void mbc_unit_free(mbc_unit *u) {
   if (u->have_plan) ldl_plan_free(&u->plan);
-  if (u->lowered) lower_free(u->lowered);
+  free(u->bind);
+  if (u->lowered) {
+    free(u->lowered->prm_runtime);
+    lower_free(u->lowered);
+  }
   flex_product_free(&u->flex);
   if (u->ir) ir_free(u->ir);
   memset(u, 0, sizeof *u);

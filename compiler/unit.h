@@ -23,7 +23,22 @@ typedef struct mbc_unit {
   ldl_plan plan;            /* the emitted LDL^T's ordering and symbolic factorization */
   int have_plan;            /* 0: the ordering failed (the model then has no emitted LDL^T) */
   int real_float;           /* emit for single precision (--real float) */
+  /* run-time parameters (ir->params with runtime): the pool entries each sets
+   * (pipeline.c, bind_runtime); none when the model has no run-time parameter */
+  struct runtime_binding *bind;
+  int nbind;
+  int overridden;           /* read with --set values (the generic path): nothing to bind */
 } mbc_unit;
+
+/* one pool entry of the lowered model set by an expression over run-time
+ * parameters: force_prm[index], or force_law[index].coef / .exponent */
+typedef enum { BIND_PRM, BIND_LAW_COEF, BIND_LAW_EXPONENT } runtime_pool;
+typedef struct runtime_binding {
+  runtime_pool pool;
+  int index;
+  int use;      /* ir->uses[use]: its expression and location */
+  int force;    /* the force element (lowered index) */
+} runtime_binding;
 
 /* The first stage alone: read the model and apply the scene, so that a tool
  * can change the IR before the rest (mbcc trade's variants).  0, or 2 after

@@ -14,6 +14,8 @@
 #include <unistd.h>
 
 #include "paths.h"
+#include "params.h"
+#include "unit.h"
 #include "diag.h"
 #include "emit.h"
 #include "emit_float.h"
@@ -137,9 +139,63 @@ static const char *law_kind_name(mb_law_kind kind) {
   return "0";
 }
 
+static int runtime_count(const ir_model *ir) {
+  int n = 0;
+  for (int k = 0; k < ir->nparams; k++) n += ir->params[k].runtime;
+  return n;
+}
+
+static void limit_literal(FILE *f, double x) {
+  if (isinf(x)) fputs(x < 0 ? "-HUGE_VAL" : "HUGE_VAL", f);
+  else num(f, x);
+}
+
+/* the run-time parameters: names, defaults, bounds, and set_params, which
+ * writes the pool entries they set (pipeline.c, bind_runtime) */
+static void emit_runtime_params(emit_ctx *cx) {
+  const mbc_unit *u = cx->u;
+  const ir_model *ir = u->ir;
+  const lmodel *L = cx->L;
+  FILE *f = cx->f;
+  int n = runtime_count(ir);
+  if (!n) return;
+  fputs("\n/* --- run-time parameters: the simulator's --set NAME=VALUE --- */\n", f);
+  fprintf(f, "static const char *const param_names[%d] = {", n);
+  for (int k = 0, j = 0; k < ir->nparams; k++)
+    if (ir->params[k].runtime) fprintf(f, "%s\"%s\"", j++ ? ", " : "", ir->params[k].name);
+  fputs("};\n", f);
+  const char *what[3] = {"param_values", "param_min", "param_max"};
+  for (int w = 0; w < 3; w++) {
+    fprintf(f, "static const mb_real %s[%d] = {", what[w], n);
+    for (int k = 0, j = 0; k < ir->nparams; k++) {
+      const ir_param *P = &ir->params[k];
+      if (!P->runtime) continue;
+      if (j++) fputs(", ", f);
+      limit_literal(f, w == 0 ? P->value : w == 1 ? P->min : P->max);
+    }
+    fputs("};\n", f);
+  }
+  fputs("static void set_params(const mb_model *m, const mb_real *p) {\n  (void)m;\n", f);
+  for (int i = 0; i < u->nbind; i++) {
+    const runtime_binding *b = &u->bind[i];
+    const ir_force *F = &ir->forces[L->force_ir[b->force]];
+    const ir_expr_use *use = &ir->uses[b->use];
+    fprintf(f, "  /* force '%s', %s:%d:%d */\n  ", F->name, u->file_name, use->loc.line, use->loc.col);
+    if (b->pool == BIND_PRM) fprintf(f, "force_prm[%d] = (mb_real)", b->index);
+    else fprintf(f, "force_laws[%d].%s = (mb_real)", b->index, b->pool == BIND_LAW_COEF ? "coef" : "exponent");
+    expr_print_c(f, ir, use->expr, "(double)p");
+    fputs(";\n", f);
+  }
+  fputs("}\n", f);
+}
+
 /* the force records (kind and addresses) and their pools: force_prm, force_laws */
-static void emit_force_tables(FILE *f, const lmodel *L) {
+static void emit_force_tables(emit_ctx *cx) {
+  FILE *f = cx->f;
+  const lmodel *L = cx->L;
   const mb_model *m = &L->m;
+  /* run-time parameters write the pools (set_params): then not const */
+  const char *pool_const = runtime_count(cx->u->ir) ? "" : "const ";
   fprintf(f, "static const mb_forcedef forces[%d] = {\n", m->nforce);
   for (int k = 0; k < m->nforce; k++) {
     const mb_forcedef *d = &L->force[k];
@@ -157,7 +213,7 @@ static void emit_force_tables(FILE *f, const lmodel *L) {
   }
   fputs("};\n", f);
   if (m->nforce_prm) {
-    fprintf(f, "static const mb_real force_prm[%d] = {\n", m->nforce_prm);
+    fprintf(f, "static %smb_real force_prm[%d] = {\n", pool_const, m->nforce_prm);
     for (int k = 0; k < m->nforce; k++) {
       const mb_forcedef *d = &L->force[k];
       if (!d->pnum) continue;
@@ -174,7 +230,7 @@ static void emit_force_tables(FILE *f, const lmodel *L) {
     fputs("};\n", f);
   }
   if (m->nforce_law) {
-    fprintf(f, "static const mb_law force_laws[%d] = {\n", m->nforce_law);
+    fprintf(f, "static %smb_law force_laws[%d] = {\n", pool_const, m->nforce_law);
     for (int k = 0; k < m->nforce; k++) {
       const mb_forcedef *d = &L->force[k];
       for (int l = 0; l < d->lnum; l++) {
@@ -191,6 +247,7 @@ static void emit_force_tables(FILE *f, const lmodel *L) {
     }
     fputs("};\n", f);
   }
+  emit_runtime_params(cx);
 }
 
 /* the tables: bodies, markers, rows, forces, profiles, outputs */
@@ -289,7 +346,7 @@ static void emit_tables(emit_ctx *cx) {
     }
     fputs("};\n", f);
   }
-  if (m->nforce) emit_force_tables(f, L);
+  if (m->nforce) emit_force_tables(cx);
   if (m->nprofile) {
     fprintf(f, "static const mb_profile profiles[%d] = {\n", m->nprofile);
     for (int k = 0; k < m->nprofile; k++) {
@@ -808,6 +865,11 @@ static void emit_source(emit_ctx *cx) {
   fprintf(f, "  .ncols = %s_NCOLS, .col_name = %s,\n  .eval = %s_eval, .init = %s_init,\n", U,
           m->ncols ? "col_names" : "0", nm, nm);
   emit_ldl_fields(cx, ldl);
+  if (runtime_count(L->ir)) {
+    int n = runtime_count(L->ir);
+    fprintf(f, "  .nparam = %d, .param_name = param_names, .param_value = param_values,\n"
+               "  .param_min = param_min, .param_max = param_max, .set_params = set_params,\n", n);
+  }
   fputs("};\n", f);
 }
 

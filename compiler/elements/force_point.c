@@ -50,7 +50,9 @@ static void emit_point_load(FILE *f, const lmodel *L, int k) {
   if (d->profile >= 0) fprintf(f, "    mb_profile_eval(&profiles[%d], t, x);\n    s = x[0];\n", d->profile);
   for (int j = 0; j < 3; j++) {
     fprintf(f, "    val[%d] = s * ", j);
-    emit_num(f, L->force_prm[d->padr + MB_POINT_VEC + j]);
+    int slot = d->padr + MB_POINT_VEC + j;
+    if (L->prm_runtime && L->prm_runtime[slot]) fprintf(f, "force_prm[%d]", slot); /* a run-time parameter */
+    else emit_num(f, L->force_prm[slot]);
     fputs(";\n", f);
   }
   if (d->local) fprintf(f, "    mb_mul3(f%d.A, val, val);\n", b0);

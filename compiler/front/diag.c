@@ -22,8 +22,12 @@ static unsigned long long line_hash(const char *s) {
   return h;
 }
 
+static bool muted;
+void diag_mute(int on) { muted = on != 0; }
+
 static void print(const char *file, ir_loc loc, const char *severity,
                   const char *fmt, va_list ap) {
+  if (muted) return;
   char line[2048];
   int n = snprintf(line, sizeof line, "%s", file == NULL ? "mbcc" : file);
   if (loc.line > 0 && n >= 0 && (size_t)n < sizeof line)

@@ -31,6 +31,9 @@ void diag_vnote(const char *file, ir_loc loc, const char *fmt, va_list ap) DIAG_
 
 int diag_errors(void);   /* errors reported so far (shown or not) */
 int diag_warnings(void); /* warnings reported so far */
-void diag_reset(void);   /* zero both counters (e.g. between test cases) */
+void diag_reset(void);
+/* 1: count but print nothing (a second reading of the model that only probes
+ * it, compiler/pipeline.c), 0: print again */
+void diag_mute(int on);   /* zero both counters (e.g. between test cases) */
 
 #endif

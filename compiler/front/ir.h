@@ -313,6 +313,46 @@ typedef struct {
   ir_jof joints_on_flexible; /* default direct */
 } ir_sim;
 
+/* --- parameters and expressions (compiler/front/params.c) ------------------------------ */
+/* An arithmetic expression over parameters, as a small tree of nodes (index
+ * 'root'); 'pos' is each node's byte offset in the scalar, for messages. */
+typedef enum {
+  EXPR_NUMBER, EXPR_PARAM, EXPR_NEG, EXPR_ADD, EXPR_SUB, EXPR_MUL, EXPR_DIV, EXPR_POW, EXPR_CALL
+} ir_expr_op;
+
+typedef struct {
+  ir_expr_op op;
+  double number;  /* NUMBER */
+  int param;      /* PARAM: index into ir_model.params; CALL: the function (params.c) */
+  int a, b;       /* operands (b: -1 when unary) */
+  int pos;
+} ir_expr_node;
+
+typedef struct {
+  ir_expr_node *node;
+  int count, root;
+} ir_expr;
+
+typedef struct {
+  char *name;
+  ir_loc loc;         /* its key in 'parameters:' */
+  double value;       /* the default (or the --set override) */
+  bool runtime;       /* an input of the generated code (mbcc run --set) */
+  double min, max;    /* bounds of a run-time value (-inf, inf when not given) */
+  char *unit;         /* documentation only, or NULL */
+  ir_expr *expr;      /* its definition when not a plain number, else NULL */
+  bool uses_runtime;  /* runtime, or defined through a run-time parameter */
+  int state;          /* while reading: 0 not evaluated, 1 being evaluated, 2 done, 3 failed */
+} ir_param;
+
+/* A numeric field of the model written as an expression that names parameters. */
+typedef struct {
+  ir_loc loc;
+  ir_expr *expr;
+  double value;
+  bool uses_runtime;
+} ir_expr_use;
+
 /* --- the model ------------------------------------------------------------------------- */
 typedef struct {
   char *path;        /* the file read */
@@ -330,6 +370,10 @@ typedef struct {
   ir_output *outputs;
   int noutputs;
   ir_sim sim;
+  ir_param *params;     /* 'parameters:' in file order */
+  int nparams;
+  ir_expr_use *uses;    /* fields given by expressions over parameters, in reading order */
+  int nuses, cap_uses;
 } ir_model;
 
 /* Read and validate a model, applying scene 'scene' (NULL: the base model).

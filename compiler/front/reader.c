@@ -24,6 +24,7 @@
 #include "diag.h"
 #include "bounds.h"
 #include "names.h"
+#include "params.h"
 #include "quantities.h"
 #include "reader.h"
 #include "scene.h"
@@ -1429,8 +1430,10 @@ static void parse_model(reader *r, yaml_node_t *root, const char *chosen_scene_n
   mapping top;
   map_open(&top, r, root, file_start, "the model");
   static const char *const keys[] = {"name",    "gravity", "bodies",     "joints", "drivers",
-                                     "forces",  "outputs", "simulation", "scenes", NULL};
+                                     "forces",  "outputs", "simulation", "scenes", "parameters", NULL};
   map_check_keys(&top, keys);
+  /* first: every numeric field may name parameters */
+  parse_parameters(r, map_get(&top, "parameters"));
 
   yaml_node_t *name = map_require(&top, "name", true, "a C identifier");
   if (name != NULL && name->type != YAML_SCALAR_NODE)
@@ -1644,6 +1647,7 @@ static ir_model *read_model(const char *path, const char *scene) {
       parse_model(&r, root, scene);
       table_free(&r.names);
       free_chosen_scene(&r.scene, model->nbodies);
+      free(r.param_nodes);
     }
     yaml_document_delete(&doc);
   }
@@ -1715,6 +1719,7 @@ void ir_free(ir_model *m) {
   }
   free(m->forces);
   free_outputs(m->outputs, m->noutputs);
+  params_free(m);
   free(m);
 }
 

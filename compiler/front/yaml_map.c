@@ -5,6 +5,7 @@
  * parsers of compiler/elements/ and fe.c. */
 #include "yaml_map.h"
 #include "bounds.h"
+#include "params.h"
 
 #include <errno.h>
 #include <setjmp.h>
@@ -312,6 +313,10 @@ bool to_number(reader *r, yaml_node_t *n, const char *label, double *out) {
       }
       error_at(r, loc_of(n), "%s must be a finite number (got %s)", label, show_node(r, n));
       return false;
+    }
+    if (!blank_start) { /* an expression over parameters (params.c) */
+      int as_expression = expr_number(r, n, label, out);
+      if (as_expression != 0) return as_expression > 0;
     }
   }
   error_at(r, loc_of(n), "%s must be a number (got %s)", label, show_node(r, n));

@@ -51,6 +51,9 @@ typedef struct reader {
   ir_model *model;
   name_table names;
   chosen_scene scene;
+  /* 'parameters:' (params.c): the value node of each, evaluated on first use */
+  yaml_node_t **param_nodes;
+  bool params_block;  /* the model has a 'parameters:' block */
   /* show_*() format user text into these, so a message can quote a few */
   char shown[SHOWN_BUFFERS][SHOWN_SIZE];
   int next_shown;

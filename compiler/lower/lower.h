@@ -49,6 +49,10 @@ typedef struct {
   int bad;                   /* an error was reported while lowering */
   int nredundant;            /* rows removed at assembly */
   int dof;
+  /* per force_prm entry: 1 when a run-time parameter sets it (the emitted code
+   * then reads the pool instead of a literal); NULL when none does.  Owned by
+   * the compilation unit (pipeline.c). */
+  unsigned char *prm_runtime;
 } lmodel;
 
 /* For the lowering hooks of the elements (compiler/elements/): the marker

@@ -157,6 +157,15 @@ typedef struct mb_model {
   int ldl_straight;            /* 1: straight-line code, 0: loops over static tables */
   int ldl_exact;               /* 1: no weighted rows, so ldl_solve with residual NULL is
                                   one pass without refinement (the factors are K's) */
+  /* run-time parameters ('runtime: true' in the model's 'parameters:'): inputs
+   * of the generated code, changed without recompiling (the simulator's --set
+   * NAME=VALUE).  set_params(m, p) writes the force pools from the vector p of
+   * nparam values (defaults param_value, bounds param_min..param_max) before a
+   * run; not safe while another thread evaluates the model.  0 / NULL: none. */
+  int nparam;
+  const char *const *param_name;
+  const mb_real *param_value, *param_min, *param_max;
+  void (*set_params)(const struct mb_model *m, const mb_real *p);
 } mb_model;
 
 /* triplets (row, column, value) of K from the general generic path */

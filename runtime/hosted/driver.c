@@ -212,8 +212,59 @@ static void usage(const char *prog) {
           "usage: %s [-o results.csv] [--solver ldl|klu|dense] [--integrator rk4|dopri5|genalpha|auto]\n"
           "          [--end T] [--output-step H] [--step H] [--max-step H] [--rtol R] [--atol A]\n"
           "          [--rho-inf R] [--max-steps N]\n"
-          "          [--stabilization projection|baumgarte|none] [--precision N] [--quiet]\n",
+          "          [--stabilization projection|baumgarte|none] [--precision N] [--set NAME=VALUE]... [--quiet]\n",
           prog);
+}
+
+/* --set NAME=VALUE (each item of 'sets'): the model's run-time parameters
+ * from their defaults, then set (m->set_params); 0, or 2 after reporting */
+static int apply_sets(const mb_model *m, const char *prog, int nsets, const char *const *sets) {
+  if (!nsets) return 0;
+  if (!m->nparam) {
+    fprintf(stderr, "%s: error: --set %s: the model has no run-time parameters ('runtime: true' in its "
+            "'parameters:' makes one)\n", prog, sets[0]);
+    return 2;
+  }
+  mb_real *p = malloc((size_t)m->nparam * sizeof *p);
+  if (!p) { fprintf(stderr, "%s: error: out of memory\n", prog); return 2; }
+  memcpy(p, m->param_value, (size_t)m->nparam * sizeof *p);
+  for (int i = 0; i < nsets; i++) {
+    const char *eq = strchr(sets[i], '=');
+    size_t length = eq ? (size_t)(eq - sets[i]) : strlen(sets[i]);
+    int k = -1;
+    for (int j = 0; j < m->nparam && k < 0; j++)
+      if (strlen(m->param_name[j]) == length && !strncmp(m->param_name[j], sets[i], length)) k = j;
+    if (k < 0 || !eq) {
+      if (!eq)
+        fprintf(stderr, "%s: error: --set needs NAME=VALUE, got '%s'\n", prog, sets[i]);
+      else {
+        fprintf(stderr, "%s: error: --set %s: no run-time parameter '%.*s' (the model's are:", prog, sets[i],
+                (int)length, sets[i]);
+        for (int j = 0; j < m->nparam; j++) fprintf(stderr, " %s", m->param_name[j]);
+        fputs(")\n", stderr);
+      }
+      free(p);
+      return 2;
+    }
+    char *end;
+    errno = 0;
+    double v = strtod(eq + 1, &end);
+    if (end == eq + 1 || *end || !isfinite(v)) {
+      fprintf(stderr, "%s: error: --set %s: the value must be a finite number\n", prog, sets[i]);
+      free(p);
+      return 2;
+    }
+    if (!(v >= (double)m->param_min[k] && v <= (double)m->param_max[k])) {
+      fprintf(stderr, "%s: error: --set %s: outside the parameter's range [%g, %g]\n", prog, sets[i],
+              (double)m->param_min[k], (double)m->param_max[k]);
+      free(p);
+      return 2;
+    }
+    p[k] = (mb_real)v;
+  }
+  m->set_params(m, p);
+  free(p);
+  return 0;
 }
 
 static mode_t current_umask(void) {
@@ -228,6 +279,8 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
   const char *csv_path = "results.csv";
   int output_given = 0, max_given = 0;
   int quiet = 0, digits = 12;
+  const char *sets[64];
+  int nsets = 0;
   for (int i = 1; i < argc; i++) {
     const char *a = argv[i], *val = (i + 1 < argc) ? argv[i + 1] : NULL;
     int takes = 1;
@@ -235,6 +288,10 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
     else if (!val) { usage(argv[0]); return 2; }
     else if (!strcmp(a, "-o")) csv_path = val;
     else if (!strcmp(a, "--solver")) solver = val;
+    else if (!strcmp(a, "--set")) {
+      if (nsets == 64) { fprintf(stderr, "%s: error: more than 64 --set options\n", argv[0]); return 2; }
+      sets[nsets++] = val;
+    }
     else if (!strcmp(a, "--precision")) {
       char *end;
       long d = strtol(val, &end, 10);
@@ -292,6 +349,7 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
     return 2;
   }
 
+  if (apply_sets(m, argv[0], nsets, sets)) return 2;
   mb_solver *ls = mb_solver_new(solver, m);
   if (!ls) {
     if (!strcmp(solver, "ldl"))

@@ -1,0 +1,40 @@
+/* params.h: the model's 'parameters:' block and arithmetic expressions over
+ * parameters in numeric fields (params.c).  docs/model-format.md, Parameters. */
+#ifndef MBCC_PARAMS_H
+#define MBCC_PARAMS_H
+
+#include <stdio.h>
+
+#include "ir.h"
+#include "yaml_map.h"
+
+/* Reads 'parameters:' (n may be NULL) into r->model->params; values are
+ * evaluated on first use and all of them at the end of this call. */
+void parse_parameters(reader *r, yaml_node_t *n);
+
+/* A scalar that is not a plain number, as an expression: 1 with *out set,
+ * -1 after reporting at the offending character ('label' names the field),
+ * 0 when it is no expression and nothing was reported (without a
+ * 'parameters:' block a syntax error or unknown name is left to the caller,
+ * which says "must be a number"). */
+int expr_number(reader *r, yaml_node_t *n, const char *label, double *out);
+
+/* --set NAME=VALUE for the next ir_read: run-time parameters take these
+ * values instead of their defaults (the arrays must outlive the reads). */
+void params_set_overrides(const char *const *names, const double *values, int count);
+
+/* The index of parameter 'name', or -1; 'suggest' (may be NULL) gets a
+ * close name for "did you mean", or "". */
+int params_find(const ir_model *m, const char *name, char *suggest, size_t size);
+
+/* the expression as C over the run-time parameter vector 'vector' (p[i] for
+ * run-time parameter i, in the order of run-time parameters among params) */
+void expr_print_c(FILE *f, const ir_model *m, const ir_expr *e, const char *vector);
+/* index among run-time parameters of params[k], or -1 */
+int params_runtime_index(const ir_model *m, int k);
+/* whether e names params[k] directly */
+bool expr_names(const ir_expr *e, int k);
+
+void params_free(ir_model *m);
+
+#endif
