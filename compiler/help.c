@@ -62,6 +62,8 @@ static const help_command commands[] = {
       {"--plot FILE.png|none", "the plot (default: beside the CSV)"},
       {"--columns a,b+c,...", "the columns to plot (b+c: in one panel)"},
       {"--animate", "also write the browser animation NAME.html beside the CSV (see mbcc animate)"},
+      {"--set NAME=VALUE", "a run-time parameter of the model (repeatable; not recompiled: the simulator "
+                           "takes the value; docs/model-format.md, Parameters)"},
       SIM_OPTIONS,
       {"--quiet", "print nothing but errors"}}},
     {"bench", "mbcc bench M.yaml [--scene S] [--csv FILE] [--reps N] [--paths a,b,...] [OPTIONS]",

@@ -134,9 +134,12 @@ static int bind_runtime(mbc_unit *u) {
       if (pool == BIND_PRM ? index >= d->padr && index < d->padr + d->pnum : index >= d->ladr && index < d->ladr + d->lnum)
         force = k;
     }
+    /* equal values written several times ([k, k, k]): each slot takes a field of its own first */
     int use = -1;
-    for (int i = 0; i < A->nuses && use < 0; i++)
-      if (A->uses[i].uses_runtime && same(A->uses[i].value, a) && same(B->uses[i].value, b)) use = i;
+    for (int pass = 0; pass < 2 && use < 0; pass++)
+      for (int i = 0; i < A->nuses && use < 0; i++)
+        if (A->uses[i].uses_runtime && (pass || !bound[i]) && same(A->uses[i].value, a) && same(B->uses[i].value, b))
+          use = i;
     const ir_force *F = &A->forces[LA->force_ir[force]];
     if (use < 0) {
       diag_error(u->path, F->loc, "force '%s' uses a value derived from run-time parameter '%s' (only values written "
