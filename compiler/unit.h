@@ -27,7 +27,9 @@ typedef struct mbc_unit {
    * (pipeline.c, bind_runtime); none when the model has no run-time parameter */
   struct runtime_binding *bind;
   int nbind;
-  int overridden;           /* read with --set values (the generic path): nothing to bind */
+  int overridden;           /* read with --set values (the generic path), or the IR changed after
+                               reading (mbcc trade's variants): run-time parameters are not bound,
+                               and the emitted code folds them like compile-time ones */
 } mbc_unit;
 
 /* one pool entry of the lowered model set by an expression over run-time

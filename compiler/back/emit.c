@@ -139,7 +139,11 @@ static const char *law_kind_name(mb_law_kind kind) {
   return "0";
 }
 
-static int runtime_count(const ir_model *ir) {
+/* the run-time parameters the code takes: none when they were not bound
+ * (the IR changed after reading, mbcc trade: the code then folds them) */
+static int runtime_count(const mbc_unit *u) {
+  const ir_model *ir = u->ir;
+  if (u->overridden) return 0;
   int n = 0;
   for (int k = 0; k < ir->nparams; k++) n += ir->params[k].runtime;
   return n;
@@ -157,7 +161,7 @@ static void emit_runtime_params(emit_ctx *cx) {
   const ir_model *ir = u->ir;
   const lmodel *L = cx->L;
   FILE *f = cx->f;
-  int n = runtime_count(ir);
+  int n = runtime_count(u);
   if (!n) return;
   fputs("\n/* --- run-time parameters: the simulator's --set NAME=VALUE --- */\n", f);
   fprintf(f, "static const char *const param_names[%d] = {", n);
@@ -195,7 +199,7 @@ static void emit_force_tables(emit_ctx *cx) {
   const lmodel *L = cx->L;
   const mb_model *m = &L->m;
   /* run-time parameters write the pools (set_params): then not const */
-  const char *pool_const = runtime_count(cx->u->ir) ? "" : "const ";
+  const char *pool_const = runtime_count(cx->u) ? "" : "const ";
   fprintf(f, "static const mb_forcedef forces[%d] = {\n", m->nforce);
   for (int k = 0; k < m->nforce; k++) {
     const mb_forcedef *d = &L->force[k];
@@ -865,8 +869,8 @@ static void emit_source(emit_ctx *cx) {
   fprintf(f, "  .ncols = %s_NCOLS, .col_name = %s,\n  .eval = %s_eval, .init = %s_init,\n", U,
           m->ncols ? "col_names" : "0", nm, nm);
   emit_ldl_fields(cx, ldl);
-  if (runtime_count(L->ir)) {
-    int n = runtime_count(L->ir);
+  if (runtime_count(cx->u)) {
+    int n = runtime_count(cx->u);
     fprintf(f, "  .nparam = %d, .param_name = param_names, .param_value = param_values,\n"
                "  .param_min = param_min, .param_max = param_max, .set_params = set_params,\n", n);
   }

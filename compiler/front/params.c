@@ -560,6 +560,7 @@ static bool param_value(reader *r, int k, const parser *from, size_t pos, double
   } else {
     ok = definition_value(r, k, n, &P->value);
   }
+  bool overridden = false;  /* --set values were checked against the range by their caller */
   for (int i = 0; ok && i < override_count; i++) {
     if (strcmp(override_names[i], P->name)) continue;
     if (!P->runtime) {
@@ -568,12 +569,13 @@ static bool param_value(reader *r, int k, const parser *from, size_t pos, double
       ok = false;
     } else {
       P->value = override_values[i];
+      overridden = true;
     }
   }
   if (ok && P->min > P->max) {
     error_at(r, P->loc, "parameter '%s': 'min' %g is above 'max' %g", P->name, P->min, P->max);
     ok = false;
-  } else if (ok && !(P->value >= P->min && P->value <= P->max)) {
+  } else if (ok && !overridden && !(P->value >= P->min && P->value <= P->max)) {
     error_at(r, P->loc, "parameter '%s' is %g, outside its range [%g, %g]", P->name, P->value, P->min, P->max);
     ok = false;
   }

@@ -449,6 +449,7 @@ static void build_variant(const trade_options *o, const char *workdir, variant *
   int st = mbc_unit_read(&u, o->model, o->scene);
   if (!st) {
     apply_variant(u.ir, v);
+    u.overridden = 1; /* the IR is no longer the file's: run-time parameters stay at their values */
     st = mbc_unit_finish(&u, 0);
   }
   u.real_float = v->real_float;
