@@ -125,6 +125,7 @@ static const char *output_kind_name(mb_output_kind kind) {
   case MB_OUT_MODAL: return "MB_OUT_MODAL";
   case MB_OUT_MOMENTUM: return "MB_OUT_MOMENTUM";
   case MB_OUT_SECTION: return "MB_OUT_SECTION";
+  case MB_OUT_TYRE: return "MB_OUT_TYRE";
   }
   return "0";
 }

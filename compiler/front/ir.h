@@ -204,8 +204,33 @@ typedef enum {
   FORCE_SPRING_DAMPER, /* along the line between two points */
   FORCE_BUSHING,       /* 6 diagonal stiffness and damping terms in a frame */
   FORCE_FIELD,         /* general 6x6 stiffness and damping in a frame */
-  FORCE_BEAM           /* massless Euler-Bernoulli / Timoshenko beam between two points */
+  FORCE_BEAM,          /* massless Euler-Bernoulli / Timoshenko beam between two points */
+  FORCE_TYRE           /* tyre of a wheel body on a road (compiler/elements/force_tyre.c) */
 } ir_force_kind;
+
+/* a road (top-level 'roads'): z = h(x, y) */
+typedef enum { ROAD_FLAT, ROAD_COSINE_BUMP, ROAD_TABLE } ir_road_kind;
+
+typedef struct {
+  char *name;
+  ir_loc loc;
+  ir_road_kind kind;
+  double height;          /* FLAT */
+  double length, start;   /* COSINE_BUMP: height H, length, start x0, y window */
+  double y_range[2];
+  int nx, ny;             /* TABLE: z[i ny + j] at (x[i], y[j]), both rising */
+  double *x, *y, *z;
+} ir_road;
+
+/* a tyre (FORCE_TYRE): the wheel centre is point[0] on body[0] */
+typedef struct {
+  int road;               /* index into ir_model.roads */
+  int model;              /* 0 gim_nikravesh, 1 fiala */
+  double axis[3];         /* spin axis, global at t = 0 */
+  double radius, width, kz, cz, ks, ka, kg, mu0, mu1, crr;
+  double low_speed;       /* slip regularization velocity, m/s */
+  double damping_blend;   /* deflection over which the radial damping fades in, m */
+} ir_tyre;
 
 typedef enum { LAW_NONE = 0, LAW_LINEAR, LAW_POWER, LAW_TABLE } ir_law_kind;
 
@@ -246,6 +271,7 @@ typedef struct {
   /* beam: section and material (node[] unused), damping = ratio * stiffness */
   ir_beam beam;
   double damping_ratio;
+  ir_tyre tyre;
   bool active;
 } ir_force;
 
@@ -266,8 +292,10 @@ typedef enum {
   OUT_DEFLECTION,           /* flexible body: node deflection X_k w, body axes: 3 or 1 */
   OUT_MODAL,                /* flexible body: modal coordinate 'mode' (1-based in the model) */
   OUT_MOMENTUM,             /* system: linear and angular momentum (about the origin): 6 */
-  OUT_SECTION               /* flexible body: a beam's section forces at one end (6 or 1), or the
+  OUT_SECTION,              /* flexible body: a beam's section forces at one end (6 or 1), or the
                                normal stress at a point of the section (1) */
+  OUT_TYRE                  /* tyre force element: Fx Fy Fz Mx My Mz slip slip_angle camber
+                               deflection (10 or 1) */
 } ir_output_kind;
 
 typedef struct {
@@ -288,6 +316,7 @@ typedef struct {
   int element, end;  /* SECTION: the beam (index into the body's beams) and its end (0: A, 1: B) */
   bool has_fiber;    /* SECTION: the stress at fiber (y, z) of the section, element axes */
   double fiber[2];
+  int force;         /* TYRE: index into ir_model.forces */
 } ir_output;
 
 /* --- simulation settings --------------------------------------------------------------- */
@@ -367,6 +396,8 @@ typedef struct {
   int ndrivers;
   ir_force *forces;
   int nforces;
+  ir_road *roads;    /* top-level 'roads' */
+  int nroads;
   ir_output *outputs;
   int noutputs;
   ir_sim sim;

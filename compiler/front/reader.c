@@ -387,7 +387,7 @@ void parse_modal_settings(mapping *m, ir_flex *fx) {
 }
 
 /* a file name given in the model, relative to the model file's directory */
-static char *model_relative_path(reader *r, const yaml_node_t *n) {
+char *model_relative_path(reader *r, const yaml_node_t *n) {
   const char *slash = strrchr(r->path, '/');
   const char *fname = scalar_text(n);
   size_t dl = (slash && fname[0] != '/') ? (size_t)(slash - r->path + 1) : 0;
@@ -1234,8 +1234,11 @@ static void parse_force(reader *r, yaml_node_t *key, yaml_node_t *value) {
 static const char *const output_type_names[] = {
     "position",     "orientation",          "angle",    "velocity",       "angular_velocity",
     "acceleration", "angular_acceleration", "reaction", "effort",         "kinetic_energy",
-    "potential_energy", "total_energy",     "deflection", "modal", "momentum", "section", NULL};
+    "potential_energy", "total_energy",     "deflection", "modal", "momentum", "section", "tyre", NULL};
 static const char *const component_names[] = {"x", "y", "z", NULL};
+/* the columns of a tyre output, in the order of mb_model_outputs */
+const char *const tyre_component_names[] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz", "slip",
+                                            "slip_angle", "camber", "deflection", NULL};
 
 static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_outputs,
                          ir_output *o) {
@@ -1297,6 +1300,10 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
     keys[nkeys++] = "element";
     keys[nkeys++] = "end";
     keys[nkeys++] = "fiber";
+  }
+  if (k == OUT_TYRE) {
+    keys[nkeys++] = "element";
+    keys[nkeys++] = "component";
   }
   keys[nkeys++] = "scale";
   keys[nkeys] = NULL;
@@ -1369,6 +1376,16 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
         o->mode = (int)mode - 1;
     }
   }
+  if (k == OUT_TYRE) {
+    o->force = -1;
+    if (get_ref(&m, "element", NAME_FORCE, true, &o->force, NULL) &&
+        r->model->forces[o->force].kind != FORCE_TYRE) {
+      error_at(r, m.last_loc, "tyre output '%s': force '%s' is not a tyre", o->name ? o->name : "?",
+               r->model->forces[o->force].name);
+      o->force = -1;
+    }
+    get_choice(&m, "component", "tyre component", tyre_component_names, false, &o->component);
+  }
   get_number(&m, "scale", false, &o->scale);
   map_close(&m);
 }
@@ -1430,7 +1447,8 @@ static void parse_model(reader *r, yaml_node_t *root, const char *chosen_scene_n
   mapping top;
   map_open(&top, r, root, file_start, "the model");
   static const char *const keys[] = {"name",    "gravity", "bodies",     "joints", "drivers",
-                                     "forces",  "outputs", "simulation", "scenes", "parameters", NULL};
+                                     "forces",  "outputs", "simulation", "scenes", "parameters", "roads",
+                                     NULL};
   map_check_keys(&top, keys);
   /* first: every numeric field may name parameters */
   parse_parameters(r, map_get(&top, "parameters"));
@@ -1476,6 +1494,11 @@ static void parse_model(reader *r, yaml_node_t *root, const char *chosen_scene_n
   model->drivers = xcalloc((size_t)mapping_size(drivers), sizeof *model->drivers);
   if (drivers != NULL)
     parse_named(r, drivers, "drivers", parse_driver);
+
+  yaml_node_t *roads = map_get(&top, "roads");
+  model->roads = xcalloc((size_t)mapping_size(roads), sizeof *model->roads);
+  if (roads != NULL)
+    parse_named(r, roads, "roads", parse_road);
 
   yaml_node_t *forces = map_get(&top, "forces");
   model->forces = xcalloc((size_t)mapping_size(forces), sizeof *model->forces);
@@ -1718,6 +1741,13 @@ void ir_free(ir_model *m) {
     free(m->forces[i].damping.table);
   }
   free(m->forces);
+  for (int i = 0; i < m->nroads; i++) {
+    free(m->roads[i].name);
+    free(m->roads[i].x);
+    free(m->roads[i].y);
+    free(m->roads[i].z);
+  }
+  free(m->roads);
   free_outputs(m->outputs, m->noutputs);
   params_free(m);
   free(m);

@@ -18,6 +18,13 @@ void parse_profile(reader *r, yaml_node_t *n, const char *label, ir_profile *p);
 void parse_beam_properties(reader *r, mapping *body, ir_beam *proto);
 extern const char *const theory_names[]; /* 'theory' of a beam */
 
+/* a file name given in the model, relative to the model file's directory */
+char *model_relative_path(reader *r, const yaml_node_t *n);
+/* one entry of the top-level 'roads' (compiler/elements/force_tyre.c) */
+void parse_road(reader *r, yaml_node_t *key, yaml_node_t *value);
+/* the components of a tyre output, NULL-terminated */
+extern const char *const tyre_component_names[];
+
 /* what the scenes (scene.c) reuse: a flexible body's modal settings, the
    outputs list (a scene replaces it), freeing outputs */
 void parse_modal_settings(mapping *m, ir_flex *fx);

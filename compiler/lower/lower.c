@@ -245,6 +245,7 @@ static int output_columns(const ir_output *o) {
   case OUT_ORIENTATION: return 4;
   case OUT_REACTION: case OUT_MOMENTUM: return 6;
   case OUT_SECTION: return o->component >= 0 || o->has_fiber ? 1 : 6;
+  case OUT_TYRE: return o->component >= 0 ? 1 : 10;
   default: return 1;
   }
 }
@@ -257,7 +258,8 @@ static const mb_output_kind out_kind_map[] = {
     [OUT_EFFORT] = MB_OUT_EFFORT, [OUT_KINETIC_ENERGY] = MB_OUT_KINETIC_ENERGY,
     [OUT_POTENTIAL_ENERGY] = MB_OUT_POTENTIAL_ENERGY, [OUT_TOTAL_ENERGY] = MB_OUT_TOTAL_ENERGY,
     [OUT_DEFLECTION] = MB_OUT_DEFLECTION, [OUT_MODAL] = MB_OUT_MODAL,
-    [OUT_MOMENTUM] = MB_OUT_MOMENTUM, [OUT_SECTION] = MB_OUT_SECTION};
+    [OUT_MOMENTUM] = MB_OUT_MOMENTUM, [OUT_SECTION] = MB_OUT_SECTION,
+    [OUT_TYRE] = MB_OUT_TYRE};
 
 /* a SECTION output's rows of coefficients on w, appended to L->output_coef */
 static int section_coefficients(lmodel *L, const ir_output *o, mb_outputdef *d) {
@@ -566,6 +568,19 @@ lmodel *lower_model(const ir_model *ir, const flex_product *flex) {
       return NULL;
     }
     if (o->kind == OUT_REACTION) d->reaction_marker = jm1[o->joint];
+    if (o->kind == OUT_TYRE) { /* joint: the lowered force record */
+      d->joint = -1;
+      for (int e = 0; e < m->nforce; e++)
+        if (L->force_ir[e] == o->force) d->joint = e;
+      if (d->joint < 0) {
+        diag_error(ir->path, o->loc, "output '%s': tyre '%s' is switched off in this scene", o->name,
+                   ir->forces[o->force].name);
+        free(jm0);
+        free(jm1);
+        lower_free(L);
+        return NULL;
+      }
+    }
     if (o->kind == OUT_EFFORT) {
       const ir_driver *D = &ir->drivers[o->driver];
       d->driver_marker = jm0[D->joint];
@@ -576,12 +591,15 @@ lmodel *lower_model(const ir_model *ir, const flex_product *flex) {
     static const char *xyz[3] = {"x", "y", "z"}, *e4[4] = {"e0", "e1", "e2", "e3"},
                       *rc[6] = {"fx", "fy", "fz", "tx", "ty", "tz"},
                       *pm[6] = {"px", "py", "pz", "hx", "hy", "hz"},
-                      *sf[6] = {"N", "Vy", "Vz", "T", "My", "Mz"};
+                      *sf[6] = {"N", "Vy", "Vz", "T", "My", "Mz"},
+                      *ty[10] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz", "slip", "slip_angle", "camber",
+                                 "deflection"};
     for (int j = 0; j < d->ncols; j++) {
       const char *suffix = NULL;
       if (d->ncols == 3) suffix = xyz[j];
       else if (d->ncols == 4) suffix = e4[j];
       else if (d->ncols == 6) suffix = o->kind == OUT_MOMENTUM ? pm[j] : o->kind == OUT_SECTION ? sf[j] : rc[j];
+      else if (d->ncols == 10) suffix = ty[j];
       L->col_name[col + j] = suffix ? xstrdup_printf("%s.%s%s", o->name, suffix, "")
                                     : strdup(o->name);
     }

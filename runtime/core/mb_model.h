@@ -18,6 +18,7 @@
 #include "elements/mb_field.h"
 #include "elements/mb_force_point.h"
 #include "elements/mb_spring.h"
+#include "elements/mb_tyre.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -63,7 +64,8 @@ typedef enum {
   MB_FORCE_POINT = 1, /* elements/mb_force_point.h */
   MB_FORCE_TORQUE,    /* elements/mb_force_point.h */
   MB_FORCE_SPRING,    /* elements/mb_spring.h */
-  MB_FORCE_FIELD      /* elements/mb_field.h: fields, bushings, beams */
+  MB_FORCE_FIELD,     /* elements/mb_field.h: fields, bushings, beams */
+  MB_FORCE_TYRE       /* elements/mb_tyre.h: tyre on a road (one marker, the wheel centre) */
 } mb_force_kind;
 
 typedef struct {
@@ -82,7 +84,7 @@ typedef enum {
   MB_OUT_POSITION = 1, MB_OUT_ORIENTATION, MB_OUT_ANGLE, MB_OUT_VELOCITY, MB_OUT_ANGULAR_VELOCITY,
   MB_OUT_ACCELERATION, MB_OUT_ANGULAR_ACCELERATION, MB_OUT_REACTION, MB_OUT_EFFORT,
   MB_OUT_KINETIC_ENERGY, MB_OUT_POTENTIAL_ENERGY, MB_OUT_TOTAL_ENERGY, MB_OUT_DEFLECTION,
-  MB_OUT_MODAL, MB_OUT_MOMENTUM, MB_OUT_SECTION
+  MB_OUT_MODAL, MB_OUT_MOMENTUM, MB_OUT_SECTION, MB_OUT_TYRE
 } mb_output_kind;
 
 typedef struct {
@@ -94,7 +96,8 @@ typedef struct {
   mb_real axis_g[3]; /* ANGLE: the axis, global */
   mb_real u_g[3];    /* ANGLE: the reference direction, global */
   int component;     /* -1: all; else 0..2 */
-  int joint;         /* REACTION: joint index; its marker 1 is reaction_marker */
+  int joint;         /* REACTION: joint index; its marker 1 is reaction_marker; TYRE: the
+                        force element's index */
   int reaction_marker;
   int driver_row;    /* EFFORT: the driver's row, or -1 when redundant */
   int driver_marker; /* EFFORT: marker 0 of the driven joint (its z axis) */

@@ -175,6 +175,12 @@ static mb_real forces_eval(const mb_model *m, mb_real t, const mb_real *q, const
       add_wrench_at(m, F, b0, m1->P, mF, mT, f); /* reaction at the same point */
       break;
     }
+    case MB_FORCE_TYRE: {
+      mb_real Fv[3], T[3];
+      E += mb_tyre(m0, prm, Fv, T, 0, 0);
+      add_wrench(m, F, MK, d->m0, q, Fv, T, f);
+      break;
+    }
     }
   }
   return E;
@@ -356,6 +362,7 @@ void mb_model_energy(const mb_model *m, mb_real t, const mb_real *q, const mb_re
     case MB_FORCE_TORQUE: break; /* applied loads: no potential */
     case MB_FORCE_SPRING: U += mb_spring(&MK[d->m0], &MK[d->m1], prm, m->force_law + d->ladr, F0, F1, 0); break;
     case MB_FORCE_FIELD: U += mb_field(&MK[d->m0], &MK[d->m1], prm, F0, F1, 0); break;
+    case MB_FORCE_TYRE: U += mb_tyre(&MK[d->m0], prm, F0, F1, 0, 0); break;
     }
   }
   (void)t;
@@ -566,6 +573,19 @@ void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_r
       for (int i = 0; i < nval; i++)
         for (int j = 0; j < B->nm; j++) val[i] += c[i * B->nm + j] * w[j];
       break;
+    }
+    case MB_OUT_TYRE: {
+      /* the tyre's forces, moments, slips and deflection (output's component: one of them) */
+      const mb_forcedef *d = &m->force[o->joint];
+      mb_tyre_state ts;
+      mb_real Fv[3], Tv[3], all[10];
+      mb_tyre(&MK[d->m0], m->force_prm + d->padr, Fv, Tv, &ts, 0);
+      all[0] = ts.Fx; all[1] = ts.Fy; all[2] = ts.Fz; all[3] = ts.Mx; all[4] = ts.My;
+      all[5] = ts.Mz; all[6] = ts.slip; all[7] = ts.slip_angle; all[8] = ts.camber;
+      all[9] = ts.deflection;
+      if (o->component >= 0) out[o->col] = o->scale * all[o->component];
+      else for (int j = 0; j < 10; j++) out[o->col + j] = o->scale * all[j];
+      continue;
     }
     case MB_OUT_KINETIC_ENERGY: val[0] = kin; nval = 1; break;
     case MB_OUT_POTENTIAL_ENERGY: val[0] = pot; nval = 1; break;

@@ -146,6 +146,10 @@ static const char *base_unit(const mb_outputdef *o, int k) {
   case MB_OUT_KINETIC_ENERGY: case MB_OUT_POTENTIAL_ENERGY: case MB_OUT_TOTAL_ENERGY: return "J";
   case MB_OUT_MODAL: return "kg^(1/2) m"; /* mass-normalized modal coordinate */
   case MB_OUT_MOMENTUM: return first3 ? "kg m/s" : "kg m^2/s";
+  case MB_OUT_TYRE: { /* Fx Fy Fz Mx My Mz slip slip_angle camber deflection */
+    static const char *const unit[10] = {"N", "N", "N", "N m", "N m", "N m", "1", "rad", "rad", "m"};
+    return unit[o->component >= 0 ? o->component : k - o->col];
+  }
   default: return "";
   }
 }
