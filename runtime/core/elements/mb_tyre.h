@@ -273,13 +273,18 @@ static inline mb_real mb_tyre(const mb_marker *mk, const mb_real *prm, mb_real F
       dMy[0][j] = Crr * sgn * dFz_dd * e[j];
       dMy[1][j] = Crr * sgn * dFz_ddd * e[j];
     }
+    /* the aligning moment through V_y; the lever r = -rho e shortening with delta */
+    mb_real trail = MB_SQRT(8 * R0 * delta) * xi / 6, exF[3];
+    mb_cross3(e, F, exF);
     for (int b = 0; b < 2; b++)
       for (int j = 0; j < 6; j++) {
         mb_real col[3] = {dF[b][0][j], dF[b][1][j], dF[b][2][j]}, rc[3];
         mb_cross3(r, col, rc);
+        mb_real dMz = (b == 1 && j < 3) ? trail * cy * ey[j] / D : 0;
         for (int i = 0; i < 3; i++) {
           tangent[36 * b + 6 * i + j] = col[i];
-          tangent[36 * b + 6 * (3 + i) + j] = rc[i] + a[i] * dMy[b][j];
+          tangent[36 * b + 6 * (3 + i) + j] = rc[i] + a[i] * dMy[b][j] + n[i] * dMz -
+                                              (b == 0 && j < 3 ? exF[i] * e[j] : 0);
         }
       }
   }
