@@ -302,13 +302,19 @@ static void test_cart_straight(void **state) {
   trajectory tr;
   assert_int_equal(simulate(m, &s, "ldl", &tr), 0);
   int cv = column(m, "v.x"), cvy = column(m, "v.y"), cy = column(m, "p.y");
-  const double mass = 400 + 4 * 15, Iw = 1.0, W = mass * 9.81, delta = W / 4 / KZ, Re = R0 - delta / 3;
-  double decel = CRR * W / Re / (mass + 4 * Iw / (Re * Re)); /* wheel spin slows down too */
+  const double mass = 400 + 4 * 15, Iw = 1.0, W = mass * 9.81, delta = W / 4 / KZ, Re = R0 - delta / 3,
+               rho = R0 - delta;
+  /* The loss rate C_rr W / R / (m + 4 I / R^2) (the wheels' spin slows down
+     too) with R between the rolling radius R_e (the power C_rr Fz Omega of
+     the resisting moment) and the lever rho = R0 - delta of the contact
+     force about the centre (the wheel's moment balance): Gim's R_e in the
+     slip and the geometric lever differ by delta / 3 */
+  double lo = CRR * W / Re / (mass + 4 * Iw / (Re * Re)), hi = CRR * W / rho / (mass + 4 * Iw / (Re * rho));
   int last = tr.nrows - 1;
-  double loss = at(&tr, 0, cv) - at(&tr, last, cv), predicted = decel * tr.t[last];
-  print_message("cart: speed loss %.5f m/s in %.2f s, rolling resistance predicts %.5f\n", loss, tr.t[last],
-                predicted);
-  assert_close(loss, predicted, 0.03 * predicted);
+  double T = tr.t[last], loss = at(&tr, 0, cv) - at(&tr, last, cv);
+  print_message("cart: speed loss %.5f m/s in %.2f s, rolling resistance predicts %.5f to %.5f\n", loss, T,
+                lo * T, hi * T);
+  assert_true(loss > 0.995 * lo * T && loss < 1.005 * hi * T);
   for (int k = 0; k < tr.nrows; k++) {
     assert_true(fabs(at(&tr, k, cy)) < 1e-9);
     assert_true(fabs(at(&tr, k, cvy)) < 1e-9);
