@@ -3,7 +3,8 @@
  * Gim-Nikravesh and Fiala models written out here from the spec (§8.1, 8.2)
  * with the unregularized slip definitions (braking and driving separately);
  * the radial force (only pushes); the cosine bump's height and the disc
- * contact on its flank against a brute-force nearest point; the tangent
+ * contact on its flank against a brute-force nearest point; table roads
+ * (inline and from a CSV file); the tangent
  * against finite differences; and, simulated: a quarter car falling freely
  * until it touches (no force while airborne) and settling to deflection =
  * load / K_z; a four-wheel cart at 60 km/h losing speed at the
@@ -230,6 +231,40 @@ static void test_bump(void **state) {
   }
 }
 
+/* table roads: bilinear, so exact for z = a + b x + c y + d x y on every cell;
+   the cart's rear tyres carry the CSV road (tests/models/tyre_cart_road.csv):
+   x along the rows, y along the header */
+static double bilinear_fn(double x, double y) { return 0.1 + 0.2 * x - 0.3 * y + 0.05 * x * y; }
+
+static void test_table_road(void **state) {
+  (void)state;
+  const double xs[3] = {0, 1, 3}, ys[3] = {-1, 0.5, 2};
+  double road[3 + 3 + 3 + 9] = {MB_ROAD_TABLE, 3, 3};
+  for (int i = 0; i < 3; i++) { road[3 + i] = xs[i]; road[6 + i] = ys[i]; }
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) road[9 + 3 * i + j] = bilinear_fn(xs[i], ys[j]);
+  for (int k = 0; k < 50; k++) {
+    double x = urand(0, 3), y = urand(-1, 2), g[2], H[3];
+    assert_close(mb_road_height(road, x, y, g, H), bilinear_fn(x, y), 1e-14);
+    assert_close(g[0], 0.2 + 0.05 * y, 1e-13);
+    assert_close(g[1], -0.3 + 0.05 * x, 1e-13);
+  }
+  const mb_model *m = &tyre_cart_model;
+  int found = 0;
+  for (int e = 0; e < m->nforce; e++) {
+    const mb_real *rd = m->force_prm + m->force[e].padr + MB_TYRE_ROAD;
+    if (m->force[e].kind != MB_FORCE_TYRE || rd[0] != MB_ROAD_TABLE) continue;
+    found++;
+    double g[2], H[3];
+    assert_int_equal((int)rd[1], 12);
+    assert_int_equal((int)rd[2], 6);
+    assert_close(mb_road_height(rd, 50, 1.5, g, H), 0.01 * 11 * 0.6 + 0.005, 1e-12);
+    assert_close(mb_road_height(rd, 0, -1.2, g, H), 0.01 * 1 * 0.3, 1e-12);
+    assert_close(mb_road_height(rd, 12.5, 0.7, g, H), 0, 0); /* under the left wheels */
+  }
+  assert_int_equal(found, 2);
+}
+
 /* tangent: translation and velocity columns against central differences, at
    free rolling on the flat road and with a small slip */
 static void test_tangent(void **state) {
@@ -366,6 +401,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_gim_forces),   cmocka_unit_test(test_fiala_forces),
       cmocka_unit_test(test_radial),       cmocka_unit_test(test_bump),
+      cmocka_unit_test(test_table_road),
       cmocka_unit_test(test_tangent),      cmocka_unit_test(test_quarter_car),
       cmocka_unit_test(test_cart_straight), cmocka_unit_test(test_generated_equals_generic),
   };

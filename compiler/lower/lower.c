@@ -77,6 +77,15 @@ static void natural_spline(const double *d, int n, double *m2) {
 }
 
 double *lower_force_prm(lmodel *L, mb_forcedef *d, int n) {
+  size_t need = (size_t)L->m.nforce_prm + (size_t)n + 1;
+  if (need > L->force_prm_cap) {
+    size_t cap = 2 * need;
+    double *p = realloc(L->force_prm, cap * sizeof *p);
+    if (!p) { fprintf(stderr, "mbcc: out of memory\n"); exit(2); }
+    memset(p + L->force_prm_cap, 0, (cap - L->force_prm_cap) * sizeof *p);
+    L->force_prm = p;
+    L->force_prm_cap = cap;
+  }
   d->padr = L->m.nforce_prm;
   d->pnum = n;
   L->m.nforce_prm += n;
@@ -327,7 +336,8 @@ lmodel *lower_model(const ir_model *ir, const flex_product *flex) {
   L->force = calloc((size_t)ir->nforces + 1, sizeof *L->force);
   L->force_ir = calloc((size_t)ir->nforces + 1, sizeof(int));
   /* pools: at most the largest kind's parameters and laws per force */
-  L->force_prm = calloc((size_t)ir->nforces * MB_FIELD_NPRM + 1, sizeof *L->force_prm);
+  L->force_prm_cap = (size_t)ir->nforces * MB_FIELD_NPRM + 1;
+  L->force_prm = calloc(L->force_prm_cap, sizeof *L->force_prm);
   L->force_law = calloc((size_t)ir->nforces * MB_SPRING_NLAW + 1, sizeof *L->force_law);
   L->profile = calloc((size_t)maxprof, sizeof *L->profile);
   L->profile_driver = calloc((size_t)maxprof, sizeof(int));

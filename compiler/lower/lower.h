@@ -17,6 +17,7 @@ typedef struct {
   mb_rowdef *row;
   mb_forcedef *force;
   double *force_prm;         /* m.nforce_prm reals (mb_forcedef.padr) */
+  size_t force_prm_cap;      /* reals allocated for force_prm (grows: a tyre carries its road) */
   mb_law *force_law;         /* m.nforce_law laws (mb_forcedef.ladr) */
   mb_profile *profile;
   mb_outputdef *output;
