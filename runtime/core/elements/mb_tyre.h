@@ -114,6 +114,8 @@ static inline int mb_tyre_contact(const mb_real *road, const mb_real C[3], const
   mb_real u[3], g[2], Hs[3];
   mb_cross3(f, a, u);
   mb_real s = 0, w = 0, h = 0;
+  /* converged: a step below the precision's resolution of a metre-sized s */
+  const mb_real tol = sizeof(mb_real) < sizeof(double) ? MB_R(1e-6) : MB_R(1e-13);
   for (int it = 0; it < 30; it++) {
     /* w(s): the road under the plane's line through C + s f along u */
     w = mb_road_height(road, C[0] + s * f[0], C[1] + s * f[1], g, Hs) - C[2];
@@ -128,7 +130,7 @@ static inline int mb_tyre_contact(const mb_real *road, const mb_real C[3], const
     if (curv < MB_R(0.1)) curv = MB_R(0.1);
     mb_real ds = -(s + w * w1) / curv;
     s += ds;
-    if (MB_FABS(ds) < MB_R(1e-13)) break;
+    if (MB_FABS(ds) < tol) break;
   }
   w = mb_road_height(road, C[0] + s * f[0], C[1] + s * f[1], g, Hs) - C[2];
   for (int k = 0; k < 3; k++) {
@@ -220,8 +222,8 @@ static inline mb_real mb_tyre(const mb_marker *mk, const mb_real *prm, mb_real F
     mb_real Hx = 1 - Ks * MB_FABS(Sx) / m3, Hy = 1 - Ka * MB_FABS(Sy) / m3;
     Hx = Hx > 0 ? Hx : 0;
     Hy = Hy > 0 ? Hy : 0;
-    Fx = (Sx < 0 ? -1 : 1) * mu0 * Fz * (1 - Hx * Hx * Hx);
-    Fy = -(Sy < 0 ? -1 : 1) * mu0 * Fz * (1 - Hy * Hy * Hy);
+    Fx = (Sx < 0 ? MB_R(-1.0) : MB_R(1.0)) * mu0 * Fz * (1 - Hx * Hx * Hx);
+    Fy = -(Sy < 0 ? MB_R(-1.0) : MB_R(1.0)) * mu0 * Fz * (1 - Hy * Hy * Hy);
     cx = Ks * Hx * Hx;
     cy = Ka * Hy * Hy;
     xi = Hy;
