@@ -64,6 +64,9 @@ static const help_command commands[] = {
       {"--animate", "also write the browser animation NAME.html beside the CSV (see mbcc animate)"},
       {"--set NAME=VALUE", "a run-time parameter of the model (repeatable; not recompiled: the simulator "
                            "takes the value; docs/model-format.md, Parameters)"},
+      {"--equilibrium", "first move the positions to static equilibrium (forces at zero velocity, "
+                        "Newton on the constrained statics); the given velocities are kept. Reports "
+                        "the iterations and residuals; no equilibrium stops the run"},
       SIM_OPTIONS,
       {"--quiet", "print nothing but errors"}}},
     {"bench", "mbcc bench M.yaml [--scene S] [--csv FILE] [--reps N] [--paths a,b,...] [OPTIONS]",

@@ -63,6 +63,11 @@ static int parse_options(int argc, char **argv, options *o) {
     }
     if (!strcmp(a, "--quiet")) { o->quiet = 1; o->sim_args[o->nsim++] = a; continue; }
     if (!strcmp(a, "--animate")) { o->animate = 1; continue; }
+    if (!strcmp(a, "--equilibrium")) {
+      if (o->nsim + 1 > 30) { fprintf(stderr, "mbcc: error: too many options\n"); return 2; }
+      o->sim_args[o->nsim++] = a;
+      continue;
+    }
     if (!v) { fprintf(stderr, "mbcc: error: option '%s' needs a value\n", a); return 2; }
     i++;
     if (!strcmp(a, "--set")) {
@@ -397,6 +402,7 @@ static void settings_from_ir(const ir_sim *s, mb_settings *set) {
   set->rtol = s->rtol; set->atol = s->atol; set->min_step = s->min_step; set->max_step = s->max_step;
   set->stabilization = (int)s->stabilization;
   set->alpha = s->baumgarte_alpha; set->beta = s->baumgarte_beta;
+  set->equilibrium = s->equilibrium;
 }
 
 /* --- the rebuild stamp: a content hash of what goes into an executable --- */
@@ -562,7 +568,7 @@ static int check_run_options(const options *o) {
   mb_settings_default(&scratch);
   for (int i = 0; i < o->nsim; i++) {
     const char *a = o->sim_args[i], *v = i + 1 < o->nsim ? o->sim_args[i + 1] : "";
-    if (!strcmp(a, "--quiet")) continue;
+    if (!strcmp(a, "--quiet") || !strcmp(a, "--equilibrium")) continue;
     i++;
     if (!strcmp(a, "--columns")) continue;
     if (!strcmp(a, "--precision")) { /* the CSV writer's (driver.c), checked the same way */

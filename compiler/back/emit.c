@@ -895,6 +895,7 @@ static void settings_block(FILE *f, const ir_sim *s) {
   fprintf(f, "  s.stabilization = %s;",
           s->stabilization == STAB_PROJECTION ? "MB_STAB_PROJECTION"
           : s->stabilization == STAB_BAUMGARTE ? "MB_STAB_BAUMGARTE" : "MB_STAB_NONE");
+  if (s->equilibrium) fputs("\n  s.equilibrium = 1;", f); /* only when asked: other mains unchanged */
 }
 
 const char *emit_root_dir(void) {

@@ -311,6 +311,7 @@ typedef struct {
   double baumgarte_alpha, baumgarte_beta; /* defaults 10, 10 */
   double rho_inf;            /* generalized-alpha; default 0.8 */
   ir_jof joints_on_flexible; /* default direct */
+  bool equilibrium;          /* static equilibrium before the run; default false */
 } ir_sim;
 
 /* --- parameters and expressions (compiler/front/params.c) ------------------------------ */

@@ -212,7 +212,8 @@ static void usage(const char *prog) {
           "usage: %s [-o results.csv] [--solver ldl|klu|dense] [--integrator rk4|dopri5|genalpha|auto]\n"
           "          [--end T] [--output-step H] [--step H] [--max-step H] [--rtol R] [--atol A]\n"
           "          [--rho-inf R] [--max-steps N]\n"
-          "          [--stabilization projection|baumgarte|none] [--precision N] [--set NAME=VALUE]... [--quiet]\n",
+          "          [--stabilization projection|baumgarte|none] [--precision N] [--set NAME=VALUE]... [--quiet]\n"
+          "          [--equilibrium]\n",
           prog);
 }
 
@@ -285,6 +286,7 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
     const char *a = argv[i], *val = (i + 1 < argc) ? argv[i + 1] : NULL;
     int takes = 1;
     if (!strcmp(a, "--quiet")) { quiet = 1; takes = 0; }
+    else if (!strcmp(a, "--equilibrium")) { set.equilibrium = 1; takes = 0; }
     else if (!val) { usage(argv[0]); return 2; }
     else if (!strcmp(a, "-o")) csv_path = val;
     else if (!strcmp(a, "--solver")) solver = val;
@@ -399,6 +401,23 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
   int st = mb_sim_init(&sim, m, ls, &set);
   sim.on_step = track_angles;
   sim.on_step_user = &w;
+  int equilibrium_failed = 0;
+  if (!st && set.equilibrium) {
+    mb_equilibrium_info eq;
+    st = mb_sim_equilibrium(&sim, &eq);
+    if (st) {
+      fprintf(stderr, "%s: error: static equilibrium: %s; no results written\n", argv[0], eq.why);
+      equilibrium_failed = 1;
+    } else if (!quiet) {
+      fprintf(stderr, "%s: static equilibrium in %d Newton iterations: force residual %.3g of %.6g N "
+              "(the weight or the largest applied force), constraint residual %.3g", argv[0],
+              eq.iterations, eq.force_residual, eq.force_scale, eq.constraint_residual);
+      if (eq.free_directions > 0)
+        fprintf(stderr, "; %d free direction%s without load left as given", eq.free_directions,
+                eq.free_directions > 1 ? "s" : "");
+      fprintf(stderr, "\n");
+    }
+  }
   if (!st) st = mb_sim_run(&sim, write_row, &w);
   if (w.progress && wall() - w.wall0 > 1.0) fprintf(stderr, "\n");
   int nonfinite_output = !st && w.nonfinite;
@@ -413,6 +432,9 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
     fprintf(stderr, "%s: error: cannot write '%s': %s; no results written\n", argv[0], csv_path,
             strerror(w.write_failed));
     rc = 2;
+  } else if (equilibrium_failed) {
+    unlink(tmp);
+    rc = 1;
   } else if (st || nonfinite_output) {
     unlink(tmp);
     if (nonfinite_output)

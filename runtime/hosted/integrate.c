@@ -37,6 +37,7 @@ void mb_settings_default(mb_settings *s) {
   s->rho_inf = 0.8;
   s->max_steps = 1e7;
   s->timers = 1;
+  s->equilibrium = 0;
 }
 
 int mb_sim_fail(mb_sim *s, double t, int status, const char *what) {
