@@ -11,6 +11,8 @@
  *     the modal static solution w_j = S1_j . g / omega_j^2, and the tip
  *     deflection the closed form q L^4 / (8 E I) within the modal truncation;
  *   - every case then runs dynamically and stays at rest;
+ *   - models/pendulum.yaml, released horizontally (a turning point: the
+ *     tangent is singular there), hangs straight down too;
  *   - the command line: the model's own setting (a scene) on the generated
  *     simulator, and a body free under gravity, which has no equilibrium:
  *     stopped with the cause, exit status nonzero, no results file.
@@ -282,6 +284,24 @@ static void test_cli_model_setting(void **state) {
   rc = run_capture(cmd, out, sizeof out);
   assert_int_equal(rc, 0);
   assert_null(strstr(out, "static equilibrium"));
+  /* models/pendulum.yaml starts horizontal, a turning point of its potential
+     (zero curvature: no Newton step): damped steps take it down */
+  snprintf(cmd, sizeof cmd, "%s run models/pendulum.yaml --path generic --equilibrium --end 0.1 "
+           "-o %s/h.csv --plot none 2>&1", mbcc(), dir);
+  rc = run_capture(cmd, out, sizeof out);
+  print_message("horizontal pendulum: %s", out);
+  assert_int_equal(rc, 0);
+  assert_non_null(strstr(out, "damped steps past a turning point"));
+  snprintf(path, sizeof path, "%s/h.csv", dir);
+  f = fopen(path, "r");
+  assert_non_null(f);
+  assert_non_null(fgets(header, sizeof header, f));
+  assert_non_null(fgets(first, sizeof first, f));
+  fclose(f);
+  assert_int_equal(sscanf(first, "%lf,%lf,%lf,%lf", &t, &angle, &x, &y), 4);
+  print_message("horizontal pendulum: settled at (%.3g, %.12g), turned by %.12g rad\n", x, y, angle);
+  assert_true(fabs(x) < 1e-9 && fabs(y + 1) < 1e-9);
+  assert_close(angle, -MB_PI / 2, 1e-9);
   snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
   assert_int_equal(system(cmd), 0);
 }

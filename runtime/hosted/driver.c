@@ -412,6 +412,8 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
       fprintf(stderr, "%s: static equilibrium in %d Newton iterations: force residual %.3g of %.6g N "
               "(the weight or the largest applied force), constraint residual %.3g", argv[0],
               eq.iterations, eq.force_residual, eq.force_scale, eq.constraint_residual);
+      if (eq.damped_steps > 0)
+        fprintf(stderr, "; %d damped steps past a turning point", eq.damped_steps);
       if (eq.free_directions > 0)
         fprintf(stderr, "; %d free direction%s without load left as given", eq.free_directions,
                 eq.free_directions > 1 ? "s" : "");

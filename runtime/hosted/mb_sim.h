@@ -81,6 +81,9 @@ typedef struct {
   double constraint_residual; /* max |phi| */
   int free_directions;        /* unknowns the last tangent left free (no stiffness, no load) */
   double smallest_damping;    /* the shortest line-search step taken (1: full Newton steps) */
+  int damped_steps;           /* pseudo-transient steps past a turning point, where the tangent
+                                 was singular along a loaded direction (a pendulum released
+                                 horizontally) */
   char why[400];              /* the cause of a failure */
 } mb_equilibrium_info;
 /* Move s->q (from mb_sim_init: the model's initial state) to static
