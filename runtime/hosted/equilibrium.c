@@ -46,7 +46,7 @@ typedef struct {
   int nv, nc, n;
   double scale;          /* force scale F (N): force rows are divided by it, mu = lambda / F */
   mb_real *vzero, *qt, *dv;
-  double *R, *Rp, *Rm, *J, *x, *mu, *mut, *colscale, *acc, *mass;
+  double *R, *Rp, *Rm, *J, *x, *mu, *mut, *colscale, *mass;
   int *dslot;
   int *rowp, *colp;
 } eq_work;
@@ -150,9 +150,8 @@ static void name_unknown(const mb_model *m, int i, char *out, size_t n) {
   snprintf(out, n, "coordinate %d", i);
 }
 
-/* At rest at q: the accelerations and multipliers of K [a; lambda] = [f; 0]
- * (v = 0) into e->acc and mu (lambda / F), and R(q, mu) into R; MB_OK or the
- * solver's status */
+/* At rest at q: the multipliers of K [a; lambda] = [f; 0] (v = 0) into mu
+ * (lambda / F), and R(q, mu) into R; MB_OK or the solver's status */
 static int rest_solve(eq_work *e, const mb_real *q, double *mu, double *R) {
   mb_sim *s = e->s;
   int nv = e->nv;
@@ -166,7 +165,6 @@ static int rest_solve(eq_work *e, const mb_real *q, double *mu, double *R) {
   if (st) return st;
   for (int i = 0; i < nv + e->nc; i++)
     if (!isfinite((double)s->x[i])) return MB_ERR_NONFINITE;
-  for (int i = 0; i < nv; i++) e->acc[i] = (double)s->x[i];
   for (int r = 0; r < e->nc; r++) mu[r] = (double)s->x[nv + r] / e->scale;
   residual(e, q, mu, R);
   return MB_OK;
@@ -228,7 +226,7 @@ static int fitted_residual(eq_work *e, const mb_real *q, double *mu, double *R) 
 static void eq_free(eq_work *e) {
   free(e->vzero); free(e->qt); free(e->dv); free(e->R); free(e->Rp); free(e->Rm); free(e->J);
   free(e->x); free(e->mu); free(e->mut); free(e->rowp); free(e->colp); free(e->colscale);
-  free(e->acc); free(e->mass); free(e->dslot);
+  free(e->mass); free(e->dslot);
 }
 
 /* the weight of the model (N), the force scale of the residual */
@@ -277,10 +275,10 @@ int mb_sim_equilibrium(mb_sim *s, mb_equilibrium_info *info) {
   e.rowp = calloc((size_t)n + 1, sizeof(int));
   e.colp = calloc((size_t)n + 1, sizeof(int));
   e.colscale = calloc((size_t)n + 1, sizeof(double));
-  e.acc = calloc((size_t)nv + 1, sizeof(double));
   e.mass = calloc((size_t)nv + 1, sizeof(double));
   e.dslot = calloc((size_t)nv + 1, sizeof(int));
-  if (!e.colscale || !e.acc || !e.mass || !e.dslot || !e.vzero || !e.qt || !e.dv || !e.R || !e.Rp || !e.Rm || !e.J || !e.x || !e.mu || !e.mut ||
+  if (!e.colscale || !e.mass || !e.dslot || !e.vzero || !e.qt || !e.dv || !e.R || !e.Rp || !e.Rm ||
+      !e.J || !e.x || !e.mu || !e.mut ||
       !e.rowp || !e.colp) {
     eq_free(&e);
     snprintf(info->why, sizeof info->why, "out of memory for the static tangent (%d unknowns)", n);
