@@ -125,6 +125,10 @@ static const char *output_kind_name(mb_output_kind kind) {
   case MB_OUT_MODAL: return "MB_OUT_MODAL";
   case MB_OUT_MOMENTUM: return "MB_OUT_MOMENTUM";
   case MB_OUT_SECTION: return "MB_OUT_SECTION";
+  case MB_OUT_FORCE: return "MB_OUT_FORCE";
+  case MB_OUT_RELATIVE: return "MB_OUT_RELATIVE";
+  case MB_OUT_JOINT: return "MB_OUT_JOINT";
+  case MB_OUT_CENTER_OF_MASS: return "MB_OUT_CENTER_OF_MASS";
   }
   return "0";
 }
@@ -383,6 +387,13 @@ static void emit_tables(emit_ctx *cx) {
       if (o->driver_rotation) fputs(", .driver_rotation = 1", f);
       fprintf(f, ", .node = %d, .chord = {%d, %d}, .scale = ", o->node, o->chord[0], o->chord[1]);
       num(f, o->scale);
+      if (o->kind >= MB_OUT_FORCE) { /* the fields of the newer kinds (zero for the others) */
+        fprintf(f, ",\n   .element = %d, .quantity = %d, .body2 = %d, .node2 = %d, .s2 = ", o->element,
+                o->quantity, o->body2, o->node2);
+        vec(f, o->s2, 3);
+        fprintf(f, ", .frame = %d, .jmarker = {%d, %d}, .joint_dofs = %d", o->frame, o->jmarker[0],
+                o->jmarker[1], o->joint_dofs);
+      }
       fprintf(f, ", .ncols = %d, .col = %d},\n", o->ncols, o->col);
     }
     fputs("};\n", f);

@@ -266,9 +266,16 @@ typedef enum {
   OUT_DEFLECTION,           /* flexible body: node deflection X_k w, body axes: 3 or 1 */
   OUT_MODAL,                /* flexible body: modal coordinate 'mode' (1-based in the model) */
   OUT_MOMENTUM,             /* system: linear and angular momentum (about the origin): 6 */
-  OUT_SECTION               /* flexible body: a beam's section forces at one end (6 or 1), or the
+  OUT_SECTION,              /* flexible body: a beam's section forces at one end (6 or 1), or the
                                normal stress at a point of the section (1) */
+  OUT_FORCE,                /* force element: force and torque on its body 1 at its point: 6 or 1 */
+  OUT_RELATIVE,             /* motion of a marker relative to another, in a body's axes: 3 or 1 */
+  OUT_JOINT,                /* joint angle and/or travel from t = 0: 1 or 2 */
+  OUT_CENTER_OF_MASS        /* system (or a subset of bodies): 3 or 1 */
 } ir_output_kind;
+
+/* OUT_RELATIVE and OUT_CENTER_OF_MASS: what is measured */
+typedef enum { QUANTITY_POSITION, QUANTITY_VELOCITY, QUANTITY_ACCELERATION } ir_quantity;
 
 typedef struct {
   char *name;
@@ -288,6 +295,15 @@ typedef struct {
   int element, end;  /* SECTION: the beam (index into the body's beams) and its end (0: A, 1: B) */
   bool has_fiber;    /* SECTION: the stress at fiber (y, z) of the section, element axes */
   double fiber[2];
+  int force;         /* FORCE: index into ir_model.forces; component 6 is the tension */
+  ir_quantity quantity; /* RELATIVE, CENTER_OF_MASS */
+  int rel_body;      /* RELATIVE: the marker measured from ('relative_to'; 0: ground) */
+  int rel_node;      /*   its FE node, or -1 */
+  bool rel_has_point;
+  double rel_point[3]; /* its global point at t = 0 */
+  int frame_body;    /* RELATIVE: the body whose axes resolve the result; 0: global */
+  int *cm_bodies;    /* CENTER_OF_MASS: the bodies (indices into bodies), or NULL for all */
+  int ncm_bodies;
 } ir_output;
 
 /* --- simulation settings --------------------------------------------------------------- */

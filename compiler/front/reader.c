@@ -1234,8 +1234,108 @@ static void parse_force(reader *r, yaml_node_t *key, yaml_node_t *value) {
 static const char *const output_type_names[] = {
     "position",     "orientation",          "angle",    "velocity",       "angular_velocity",
     "acceleration", "angular_acceleration", "reaction", "effort",         "kinetic_energy",
-    "potential_energy", "total_energy",     "deflection", "modal", "momentum", "section", NULL};
+    "potential_energy", "total_energy",     "deflection", "modal", "momentum", "section",
+    "force", "relative", "joint", "center_of_mass", NULL};
 static const char *const component_names[] = {"x", "y", "z", NULL};
+static const char *const force_component_names[] = {"fx", "fy", "fz", "tx", "ty", "tz", "tension", NULL};
+
+/* A marker of a relative output: 'body' with an optional 'point' (global at
+ * t = 0) or FE 'node' (flexible bodies), in mapping m. */
+static void get_output_marker(reader *r, mapping *m, bool required, int *body, bool *has_point,
+                              double point[3], int *node) {
+  if (!get_ref(m, "body", NAME_BODY, required, body, NULL)) return;
+  *has_point = get_vector(m, "point", 3, false, point);
+  yaml_node_t *nd = map_get(m, "node");
+  if (nd == NULL) return;
+  const ir_body *b = &r->model->bodies[*body];
+  if (b->kind != BODY_FLEXIBLE)
+    error_at(r, loc_of(nd), "'node' needs a flexible body ('%s' is not)", b->name);
+  else if (*has_point)
+    error_at(r, loc_of(nd), "give either 'point' or 'node', not both");
+  else
+    *node = to_fe_node(r, nd, b);
+}
+
+/* the keys and values of the output types that measure elements and markers
+ * (force, relative, joint, center_of_mass) */
+static void parse_output_measure(reader *r, mapping *m, ir_output *o) {
+  static const char *const displacement_names[] = {"displacement", "velocity", "acceleration", NULL};
+  static const char *const cm_quantity_names[] = {"position", "velocity", "acceleration", NULL};
+  static const char *const force_keys[] = {"name", "type", "element", "component", "scale", NULL};
+  static const char *const relative_keys[] = {"name", "type", "quantity", "body", "point", "node",
+                                              "relative_to", "frame", "component", "scale", NULL};
+  static const char *const joint_keys[] = {"name", "type", "joint", "scale", NULL};
+  static const char *const cm_keys[] = {"name", "type", "quantity", "bodies", "component", "scale", NULL};
+  int choice = 0;
+  switch (o->kind) {
+  case OUT_FORCE:
+    map_check_keys(m, force_keys);
+    get_ref(m, "element", NAME_FORCE, true, &o->force, NULL);
+    get_choice(m, "component", "component", force_component_names, false, &o->component);
+    if (o->component == 6 && o->force >= 0 && r->model->forces[o->force].kind != FORCE_SPRING_DAMPER)
+      error_at(r, m->last_loc, "component 'tension' needs a spring_damper ('%s' is not)",
+               r->model->forces[o->force].name);
+    break;
+  case OUT_RELATIVE: {
+    map_check_keys(m, relative_keys);
+    if (get_choice(m, "quantity", "quantity", displacement_names, false, &choice))
+      o->quantity = (ir_quantity)choice;
+    get_output_marker(r, m, true, &o->body, &o->has_point, o->point, &o->node);
+    yaml_node_t *rel = map_get(m, "relative_to");
+    if (rel != NULL) {
+      static const char *const marker_keys[] = {"body", "point", "node", NULL};
+      mapping sub;
+      if (map_open(&sub, r, rel, loc_of(rel), "'relative_to' of output '%s'", o->name ? o->name : "?")) {
+        map_check_keys(&sub, marker_keys);
+        get_output_marker(r, &sub, true, &o->rel_body, &o->rel_has_point, o->rel_point, &o->rel_node);
+      }
+      map_close(&sub);
+    }
+    yaml_node_t *fr = map_get(m, "frame");
+    if (fr != NULL && !(fr->type == YAML_SCALAR_NODE && scalar_equals(fr, "global"))) {
+      int b = resolve_name(r, fr, NAME_BODY, "frame");
+      if (b >= 0) o->frame_body = b;
+    }
+    get_choice(m, "component", "component", component_names, false, &o->component);
+    break;
+  }
+  case OUT_JOINT:
+    map_check_keys(m, joint_keys);
+    if (get_ref(m, "joint", NAME_JOINT, true, &o->joint, NULL)) {
+      ir_joint_kind jk = r->model->joints[o->joint].kind;
+      if (jk != JOINT_REVOLUTE && jk != JOINT_PRISMATIC && jk != JOINT_CYLINDRICAL)
+        error_at(r, m->last_loc, "joint output '%s' needs a revolute, prismatic or cylindrical joint ('%s' is not)",
+                 o->name ? o->name : "?", r->model->joints[o->joint].name);
+    }
+    break;
+  case OUT_CENTER_OF_MASS: {
+    map_check_keys(m, cm_keys);
+    if (get_choice(m, "quantity", "quantity", cm_quantity_names, false, &choice))
+      o->quantity = (ir_quantity)choice;
+    get_choice(m, "component", "component", component_names, false, &o->component);
+    yaml_node_t *list = map_get(m, "bodies");
+    if (list == NULL) break;
+    int n = list->type == YAML_SEQUENCE_NODE ? seq_length(list) : 0;
+    if (n == 0) {
+      error_at(r, loc_of(list), "'bodies' must be a list of body names (got %s)", show_node(r, list));
+      break;
+    }
+    o->cm_bodies = xcalloc((size_t)n, sizeof *o->cm_bodies);
+    for (int i = 0; i < n; i++) {
+      yaml_node_t *item = seq_item(r, list, i);
+      int b = resolve_name(r, item, NAME_BODY, "bodies");
+      if (b == 0) error_at(r, loc_of(item), "'bodies': the ground has no centre of mass");
+      for (int j = 0; j < o->ncm_bodies && b > 0; j++)
+        if (o->cm_bodies[j] == b) error_at(r, loc_of(item), "'bodies': '%s' is listed twice", r->model->bodies[b].name);
+      if (b > 0) o->cm_bodies[o->ncm_bodies++] = b;
+    }
+    break;
+  }
+  default:
+    break;
+  }
+  get_number(m, "scale", false, &o->scale);
+}
 
 static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_outputs,
                          ir_output *o) {
@@ -1245,6 +1345,8 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
   o->mode = -1;
   o->component = -1;
   o->scale = 1;
+  o->force = o->rel_node = -1;
+  o->rel_body = o->frame_body = 0; /* the ground, global axes */
 
   mapping m;
   if (!map_open(&m, r, n, o->loc, "output %d", item + 1))
@@ -1266,6 +1368,11 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
   map_describe(&m, "%s output '%s'", output_type_names[type], o->name ? o->name : "?");
 
   ir_output_kind k = o->kind;
+  if (k >= OUT_FORCE) {
+    parse_output_measure(r, &m, o);
+    map_close(&m);
+    return;
+  }
   bool of_body = k <= OUT_ANGULAR_ACCELERATION || k == OUT_DEFLECTION || k == OUT_MODAL || k == OUT_SECTION;
   bool has_point = k == OUT_POSITION || k == OUT_VELOCITY || k == OUT_ACCELERATION;
   bool has_component = of_body && k != OUT_ORIENTATION && k != OUT_ANGLE && k != OUT_MODAL;
@@ -1277,7 +1384,7 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
     keys[nkeys++] = "body";
   if (has_point)
     keys[nkeys++] = "point";
-  if (k == OUT_POSITION || k == OUT_VELOCITY)
+  if (k == OUT_POSITION || k == OUT_VELOCITY || k == OUT_ACCELERATION)
     keys[nkeys++] = "node";
   if (k == OUT_ANGLE)
     keys[nkeys++] = "axis";
@@ -1306,7 +1413,7 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
     get_ref(&m, "body", NAME_BODY, true, &o->body, NULL);
   if (has_point)
     o->has_point = get_vector(&m, "point", 3, false, o->point);
-  if ((k == OUT_POSITION || k == OUT_VELOCITY) && map_has(&m, "node") && o->body >= 0) {
+  if (has_point && map_has(&m, "node") && o->body >= 0) {
     const ir_body *b = &r->model->bodies[o->body];
     yaml_node_t *nd = map_get(&m, "node");
     if (b->kind != BODY_FLEXIBLE)
@@ -1393,8 +1500,10 @@ void parse_outputs(reader *r, yaml_node_t *n, name_table *scene_outputs,
 }
 
 void free_outputs(ir_output *outputs, int count) {
-  for (int i = 0; i < count; i++)
+  for (int i = 0; i < count; i++) {
     free(outputs[i].name);
+    free(outputs[i].cm_bodies);
+  }
   free(outputs);
 }
 

@@ -82,8 +82,12 @@ typedef enum {
   MB_OUT_POSITION = 1, MB_OUT_ORIENTATION, MB_OUT_ANGLE, MB_OUT_VELOCITY, MB_OUT_ANGULAR_VELOCITY,
   MB_OUT_ACCELERATION, MB_OUT_ANGULAR_ACCELERATION, MB_OUT_REACTION, MB_OUT_EFFORT,
   MB_OUT_KINETIC_ENERGY, MB_OUT_POTENTIAL_ENERGY, MB_OUT_TOTAL_ENERGY, MB_OUT_DEFLECTION,
-  MB_OUT_MODAL, MB_OUT_MOMENTUM, MB_OUT_SECTION
+  MB_OUT_MODAL, MB_OUT_MOMENTUM, MB_OUT_SECTION, MB_OUT_FORCE, MB_OUT_RELATIVE, MB_OUT_JOINT,
+  MB_OUT_CENTER_OF_MASS
 } mb_output_kind;
+
+/* what a RELATIVE or CENTER_OF_MASS output measures */
+enum { MB_QUANTITY_POSITION = 0, MB_QUANTITY_VELOCITY = 1, MB_QUANTITY_ACCELERATION = 2 };
 
 typedef struct {
   mb_output_kind kind;
@@ -104,6 +108,20 @@ typedef struct {
                         of its ncols x nm coefficients (row-major) in the model's output_coef:
                         the output is output_coef rows times w */
   int chord[2];      /* DEFLECTION: minus the chord between these nodes' deflections, or -1 */
+  /* FORCE, RELATIVE, JOINT, CENTER_OF_MASS (the fields below are zero for other kinds):
+   * FORCE: 'element' is the force element; component 0..5 picks one of fx..tz, 6 the
+   * tension of a spring.  RELATIVE: the marker (body, s, node) relative to (body2,
+   * s2, node2; body2 = -1: the ground, s2 global), resolved in the axes of body 'frame'
+   * (-1: global).  JOINT: the joint's markers jmarker[0], jmarker[1] and joint_dofs
+   * (1: rotation, 2: translation, 3: both, angle first).  CENTER_OF_MASS: with node
+   * >= 0, output_coef + node holds nbody weights (1: in the subset, 0: not); -1: all. */
+  int element;
+  int quantity;      /* RELATIVE, CENTER_OF_MASS: MB_QUANTITY_* */
+  int body2, node2;
+  mb_real s2[3];
+  int frame;
+  int jmarker[2];
+  int joint_dofs;
   mb_real scale;
   int ncols, col;    /* columns in the output vector and the first of them */
 } mb_outputdef;
@@ -215,6 +233,11 @@ void mb_model_track_angles(const struct mb_model *m, const mb_real *q, const mb_
  * at most a quarter turn at its present angular velocity (INFINITY without
  * angle outputs): beyond it unwrapping would be ambiguous. */
 double mb_model_angle_step(const struct mb_model *m, const mb_real *q, const mb_real *v, void *work);
+/* The force F and torque T (global) that force element k applies on its body 1
+ * (the second body; for one-body elements, its body), about its attachment point
+ * (that body's marker point).  'work' as for mb_model_outputs. */
+void mb_force_wrench(const mb_model *m, int k, mb_real t, const mb_real *q, const mb_real *v,
+                     mb_real F[3], mb_real T[3], void *work);
 /* kinetic and potential energy (gravity and force elements) */
 void mb_model_energy(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
                      mb_real *kinetic, mb_real *potential, void *work);

@@ -146,6 +146,12 @@ static const char *base_unit(const mb_outputdef *o, int k) {
   case MB_OUT_KINETIC_ENERGY: case MB_OUT_POTENTIAL_ENERGY: case MB_OUT_TOTAL_ENERGY: return "J";
   case MB_OUT_MODAL: return "kg^(1/2) m"; /* mass-normalized modal coordinate */
   case MB_OUT_MOMENTUM: return first3 ? "kg m/s" : "kg m^2/s";
+  case MB_OUT_FORCE: /* one column: fx..tz or the tension */
+    if (o->ncols == 1) return o->component >= 3 && o->component < 6 ? "N m" : "N";
+    return first3 ? "N" : "N m";
+  case MB_OUT_RELATIVE: case MB_OUT_CENTER_OF_MASS:
+    return o->quantity == MB_QUANTITY_POSITION ? "m" : o->quantity == MB_QUANTITY_VELOCITY ? "m/s" : "m/s^2";
+  case MB_OUT_JOINT: return o->joint_dofs == 2 || k > o->col ? "m" : "rad";
   default: return "";
   }
 }
