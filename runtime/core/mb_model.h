@@ -108,6 +108,7 @@ typedef struct {
                         of its ncols x nm coefficients (row-major) in the model's output_coef:
                         the output is output_coef rows times w */
   int chord[2];      /* DEFLECTION: minus the chord between these nodes' deflections, or -1 */
+  mb_real scale;
   /* FORCE, RELATIVE, JOINT, CENTER_OF_MASS (the fields below are zero for other kinds):
    * FORCE: 'element' is the force element; component 0..5 picks one of fx..tz, 6 the
    * tension of a spring.  RELATIVE: the marker (body, s, node) relative to (body2,
@@ -122,7 +123,6 @@ typedef struct {
   int frame;
   int jmarker[2];
   int joint_dofs;
-  mb_real scale;
   int ncols, col;    /* columns in the output vector and the first of them */
 } mb_outputdef;
 
