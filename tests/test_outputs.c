@@ -270,6 +270,13 @@ static void wrench_and_generic_path(void **state) {
     assert_close(F[j], at(&tr, 0, mf + j), 1e-12);
     assert_close(T[j], at(&tr, 0, mf + 3 + j), 1e-12);
   }
+  /* at the initial state itself (the very array q0), the displacement is 0 */
+  double *out = calloc((size_t)m->ncols, sizeof(double)), *zero = calloc((size_t)(m->nv + m->nc + 1), sizeof(double));
+  mb_model_outputs(m, 0, m->q0, m->v0, zero, zero, NULL, out, work);
+  int u = col(m, "b_in_a.x");
+  for (int j = 0; j < 3; j++) assert_close(out[u + j], 0, 0);
+  free(out);
+  free(zero);
   free(work);
   const mb_model *models[3] = {&outputs_free_model, &outputs_driven_model, &outputs_flexible_model};
   for (int i = 0; i < 3; i++) {

@@ -446,9 +446,9 @@ static void point_motion(const mb_model *m, int b, const mb_real s[3], int node,
  * and its first and second time derivatives as seen in that body,
  *   d' = R^T r' - w x d,  d'' = R^T r'' - wd x d - 2 w x d' - w x (w x d)
  * (w, wd: the body's angular velocity and acceleration in its own axes); the
- * displacement is d less its value at the initial state q0. */
+ * displacement is d less its value at the initial state q0 (from_initial). */
 static void relative_motion(const mb_model *m, const mb_outputdef *o, const mb_real *q, const mb_real *v,
-                            const mb_real *vd, mb_real val[3]) {
+                            const mb_real *vd, int from_initial, mb_real val[3]) {
   mb_real P[3], V[3], Acc[3] = {0, 0, 0}, P2[3], V2[3], Acc2[3] = {0, 0, 0}, r[3], rd[3], rdd[3];
   const mb_real *need_vd = o->quantity == MB_QUANTITY_ACCELERATION ? vd : 0;
   point_motion(m, o->body, o->s, o->node, q, v, need_vd, P, V, Acc);
@@ -476,9 +476,9 @@ static void relative_motion(const mb_model *m, const mb_outputdef *o, const mb_r
       for (int j = 0; j < 3; j++) val[j] -= t1[j] + 2 * t2[j] + t3[j];
     }
   }
-  if (o->quantity == MB_QUANTITY_POSITION && q != m->q0) {
+  if (o->quantity == MB_QUANTITY_POSITION && from_initial) {
     mb_real d0[3];
-    relative_motion(m, o, m->q0, m->v0, 0, d0);
+    relative_motion(m, o, m->q0, m->v0, 0, 0, d0);
     for (int j = 0; j < 3; j++) val[j] -= d0[j];
   }
 }
@@ -802,7 +802,7 @@ void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_r
       break;
     }
     case MB_OUT_RELATIVE:
-      relative_motion(m, o, q, v, vd, val);
+      relative_motion(m, o, q, v, vd, 1, val);
       break;
     case MB_OUT_JOINT: {
       mb_real angle, travel;
