@@ -174,11 +174,25 @@ static int ga_newton(mb_sim *s, ga_work *g, double h, int *st, double *rate_out)
     double eta = weighted_rms(g->r, g->sc, nv, 1 / bp);
     if (it > 0) *rate_out = eta / fmax(eta_prev, 1e-300);
     eta_prev = eta;
-    /* converged: the correction is far below the error tolerance, or it has
-       stopped shrinking (round-off, e.g. in single precision) while already
-       below the tolerance */
+    /* converged: the correction is far below the error tolerance, or (single
+       precision) it has stopped shrinking at the round-off floor while already
+       below the tolerance.  In double precision a stall is not convergence:
+       a slowly contracting modified Newton (an iteration matrix without the
+       stiffness that dominates, e.g. force elements compiled without their
+       tangents) stalls with the error still far above the tolerance, and
+       accepting it gave wrong reactions with no warning */
     int stalled = it > 1 && *rate_out > 0.9;
-    if (eta <= 1e-2 || (stalled && eta <= 1)) {
+#ifdef MB_REAL_FLOAT
+    int floor_ok = stalled && eta <= 1;
+#else
+    int floor_ok = 0;
+#endif
+    /* and with a known rate theta, the error left after this correction,
+       about eta theta / (1 - theta), is below the same bound: a correction
+       that shrinks slowly overstates convergence (theta 0.9: 9 eta left) */
+    double theta = it > 0 ? *rate_out : 0;
+    int small = eta <= 1e-2 && theta < 1 && eta * theta <= 1e-2 * (1 - theta);
+    if (small || floor_ok) {
       ga_predict(s, g, h);
       return GA_CONVERGED;
     }
