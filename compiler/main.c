@@ -137,12 +137,23 @@ static int refuse_input_as_output(const options *o, const char *out, const char 
   return 2;
 }
 
+/* --integrator genalpha or auto on the command line asks for the implicit
+ * method as the model's simulation block would: the pattern then carries
+ * the force elements' tangents (lower_pattern) */
+static void implicit_requested(const options *o, ir_model *ir) {
+  for (int i = 0; i + 1 < o->nsim; i++)
+    if (!strcmp(o->sim_args[i], "--integrator")) {
+      if (!strcmp(o->sim_args[i + 1], "genalpha")) ir->sim.integrator = INTEGRATOR_GENALPHA;
+      else if (!strcmp(o->sim_args[i + 1], "auto")) ir->sim.integrator = INTEGRATOR_AUTO;
+    }
+}
+
 /* the whole pipeline into *u, --animate's pose outputs added to the IR
  * between reading and the rest; 0, or 2 after reporting (u is then freed) */
 static int build_read(const options *o, mbc_unit *u, int verbose, int overridden) {
   mb_lapack_context = o->model; /* a LAPACK argument error names the model */
   if (mbc_unit_read(u, o->model, o->scene) || (o->animate && animate_add_pose_outputs(u->ir)) ||
-      ((u->overridden = overridden), mbc_unit_finish(u, verbose))) {
+      (implicit_requested(o, u->ir), 0) || ((u->overridden = overridden), mbc_unit_finish(u, verbose))) {
     mbc_unit_free(u);
     return 2;
   }

@@ -270,6 +270,10 @@ static void emit_tables(emit_ctx *cx) {
       emit_flex_contract(cx, b);
     }
   if (L->nmodal_slot) int_array(f, "modal_slot", L->modal_slot, L->nmodal_slot);
+  if (L->force_tslot) { /* force tangents for the implicit method (mb_model_force_tangent) */
+    int_array(f, "force_tslot", L->force_tslot, m->nforce);
+    int_array(f, "tangent_slot", L->tangent_slot, L->ntangent_slot);
+  }
   for (int k = 0; k < m->nprofile; k++) {
     const mb_profile *p = &L->profile[k];
     if (p->kind != MB_PROFILE_TABLE) continue;
@@ -885,6 +889,8 @@ static void emit_source(emit_ctx *cx) {
     fprintf(f, "  .nparam = %d, .param_name = param_names, .param_value = param_values,\n"
                "  .param_min = param_min, .param_max = param_max, .set_params = set_params,\n", n);
   }
+  if (L->force_tslot)
+    fputs("  .force_tslot = force_tslot, .tangent_slot = tangent_slot,\n", f);
   fputs("};\n", f);
 }
 

@@ -792,11 +792,42 @@ static int find_slot(const int *Kp, const int *Ki, int row, int col) {
   return -1;
 }
 
+/* does the model ask for an implicit method (genalpha, or auto, which may
+ * choose it)?  Then the pattern carries the force elements' tangent blocks */
+static int wants_tangents(const lmodel *L) {
+  return L->ir && (L->ir->sim.integrator == INTEGRATOR_GENALPHA ||
+                   L->ir->sim.integrator == INTEGRATOR_AUTO);
+}
+
+/* the entries of force e's tangent blocks: the columns of each side's body
+ * against each other's (E NULL: count them) */
+static size_t tangent_entries(const lmodel *L, int e, entry *E) {
+  const mb_forcedef *d = &L->force[e];
+  size_t ne = 0;
+  for (int s = 0; s < 2; s++)
+    for (int u = 0; u < 2; u++) {
+      int ns = mb_force_tangent_side_cols(L->body, L->marker, d, s);
+      int nu = mb_force_tangent_side_cols(L->body, L->marker, d, u);
+      if (!ns || !nu) continue;
+      int rs = L->body[L->marker[s ? d->m1 : d->m0].body].vadr;
+      int cu = L->body[L->marker[u ? d->m1 : d->m0].body].vadr;
+      for (int i = 0; i < ns; i++)
+        for (int j = 0; j < nu; j++) {
+          if (E) E[ne] = (entry){rs + i, cu + j};
+          ne++;
+        }
+    }
+  return ne;
+}
+
 int lower_pattern(lmodel *L) {
   mb_model *m = &L->m;
   m->nc = m->nrow;
   m->n = m->nv + m->nc;
+  int tangents = wants_tangents(L);
   size_t cap = 24 * (size_t)m->nrow + 1;
+  if (tangents)
+    for (int e = 0; e < m->nforce; e++) cap += tangent_entries(L, e, NULL);
   for (int b = 0; b < m->nbody; b++) cap += (size_t)(6 + L->body[b].nm) * (size_t)(6 + L->body[b].nm) + 12;
   for (int r = 0; r < m->nrow; r++)
     for (int s = 0; s < 2; s++) {
@@ -839,6 +870,8 @@ int lower_pattern(lmodel *L) {
         }
     }
   }
+  if (tangents)
+    for (int e = 0; e < m->nforce; e++) ne += tangent_entries(L, e, E + ne);
   qsort(E, ne, sizeof *E, entry_cmp);
   free(L->Kp);
   free(L->Ki);
@@ -879,6 +912,32 @@ int lower_pattern(lmodel *L) {
     for (int i = 0; i < 3; i++)
       for (int j = 0; j < 3; j++)
         B->mslot[3 + 3 * i + j] = find_slot(L->Kp, L->Ki, B->vadr + 3 + i, B->vadr + 3 + j);
+  }
+  /* force tangents: each element's blocks in the order of tangent_entries */
+  free(L->force_tslot);
+  free(L->tangent_slot);
+  L->force_tslot = NULL;
+  L->tangent_slot = NULL;
+  L->ntangent_slot = 0;
+  m->force_tslot = m->tangent_slot = NULL;
+  if (tangents) {
+    size_t nts = 0;
+    for (int e = 0; e < m->nforce; e++) nts += tangent_entries(L, e, NULL);
+    entry *T = malloc((nts + 1) * sizeof *T);
+    L->force_tslot = malloc(((size_t)m->nforce + 1) * sizeof(int));
+    L->tangent_slot = malloc((nts + 1) * sizeof(int));
+    if (!T || !L->force_tslot || !L->tangent_slot) { free(T); return -1; }
+    nts = 0;
+    for (int e = 0; e < m->nforce; e++) {
+      size_t k = tangent_entries(L, e, T + nts);
+      L->force_tslot[e] = k ? (int)nts : -1;
+      for (size_t i = nts; i < nts + k; i++) L->tangent_slot[i] = find_slot(L->Kp, L->Ki, T[i].row, T[i].col);
+      nts += k;
+    }
+    free(T);
+    L->ntangent_slot = (int)nts;
+    m->force_tslot = L->force_tslot;
+    m->tangent_slot = L->tangent_slot;
   }
   /* modal columns of rows on node markers: nm slots, then nm transposed slots */
   size_t nms = 0;
@@ -977,5 +1036,6 @@ void lower_free(lmodel *L) {
   }
   free(L->name);
   free(L->mslotf); free(L->body_name); free(L->modal_slot);
+  free(L->force_tslot); free(L->tangent_slot);
   free(L);
 }

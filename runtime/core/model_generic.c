@@ -203,6 +203,81 @@ void mb_generic_init(const mb_model *m, mb_real *Kx) {
   }
 }
 
+
+/* the velocity Jacobian of side s of force element d, as d rows (the wrench
+ * components the kernel's tangent is of: 3 forces for a spring, force and
+ * torque for a field) over the side's nc body columns: row k is the body
+ * columns of a unit wrench component k (J^T e_k) at the side's point */
+static int tangent_jacobian(const mb_model *m, const mb_frame *F, const mb_marker *MK,
+                            const mb_forcedef *d, int s, int dim, mb_real *A) {
+  static const mb_real zero[3] = {0, 0, 0};
+  int nc = mb_force_tangent_cols(m, (int)(d - m->force), s);
+  if (!nc) return 0;
+  int k = s ? d->m1 : d->m0;
+  for (int r = 0; r < dim; r++) {
+    mb_real e[3] = {0, 0, 0};
+    e[r % 3] = 1;
+    const mb_real *dV = r < 3 ? e : zero, *dW = r < 3 ? zero : e;
+    if (d->kind == MB_FORCE_FIELD && s == 0) /* the reaction at marker 1's point */
+      mb_rigid_cols(&F[m->marker[k].body], MK[d->m1].P, dV, dW, A + r * nc);
+    else
+      marker_cols(m, F, MK, k, 0, dV, dW, A + r * nc);
+  }
+  return nc;
+}
+
+void mb_model_force_tangent(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
+                            mb_real kfac, mb_real cfac, mb_real *Kx, void *work) {
+  (void)t; /* no force kernel with a tangent depends on time */
+  if (!m->force_tslot) return;
+  mb_frame *F = (mb_frame *)work;
+  mb_marker *MK = (mb_marker *)(F + m->nbody);
+  frames_and_markers(m, q, v, F, MK);
+  for (int e = 0; e < m->nforce; e++) {
+    const mb_forcedef *d = &m->force[e];
+    if (m->force_tslot[e] < 0) continue;
+    const int *slot = m->tangent_slot + m->force_tslot[e];
+    mb_real tan[72], F0[3], F1[3], T[3], S[36];
+    int dim;
+    if (d->kind == MB_FORCE_SPRING) {
+      mb_spring(&MK[d->m0], &MK[d->m1], m->force_prm + d->padr, m->force_law + d->ladr, F0, F1, tan);
+      dim = 3;
+      for (int i = 0; i < 9; i++) S[i] = kfac * tan[i] + cfac * tan[9 + i];
+    } else if (d->kind == MB_FORCE_FIELD) {
+      mb_field(&MK[d->m0], &MK[d->m1], m->force_prm + d->padr, F1, T, tan);
+      dim = 6;
+      for (int i = 0; i < 36; i++) S[i] = kfac * tan[i] + cfac * tan[36 + i];
+    } else {
+      continue;
+    }
+    /* the wrench W on side 1 depends on the relative motion A1 dq1 - A0 dq0
+       (side 0 gets -W through A0): -df_s/dq_t = -sg_s sg_t A_s^T S A_t */
+    mb_real A[2][6 * (6 + MB_MAX_MODES)], SA[6 * (6 + MB_MAX_MODES)];
+    int nc[2];
+    for (int s = 0; s < 2; s++) nc[s] = tangent_jacobian(m, F, MK, d, s, dim, A[s]);
+    for (int s = 0; s < 2; s++)
+      for (int u = 0; u < 2; u++) {
+        int ns = nc[s], nu = nc[u];
+        if (!ns || !nu) { slot += ns * nu; continue; }
+        mb_real sign = (s == u) ? -1 : 1;
+        for (int k = 0; k < dim; k++) /* SA = S A_u */
+          for (int j = 0; j < nu; j++) {
+            mb_real x = 0;
+            for (int l = 0; l < dim; l++) x += S[dim * k + l] * A[u][l * nu + j];
+            SA[k * nu + j] = x;
+          }
+        for (int i = 0; i < ns; i++)
+          for (int j = 0; j < nu; j++) {
+            mb_real x = 0;
+            for (int k = 0; k < dim; k++) x += A[s][k * ns + i] * SA[k * nu + j];
+            int sl = slot[i * nu + j];
+            if (sl >= 0) Kx[sl] += sign * x;
+          }
+        slot += ns * nu;
+      }
+  }
+}
+
 /* The evaluation of both generic variants: entries of K go to the fixed
  * pattern's slots (K written by the caller's init for constants), or, on
  * the general path, every entry of every element block goes to triplets. */

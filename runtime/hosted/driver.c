@@ -403,6 +403,16 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
     set.integrator = mb_integrator_auto(m, &set, why, sizeof why);
     if (!quiet) fprintf(stderr, "%s: integrator auto: %s\n", argv[0], why);
   }
+  if (set.integrator == MB_GENALPHA && !m->force_tslot && !quiet) {
+    int nstiff = 0;
+    for (int e = 0; e < m->nforce; e++)
+      nstiff += m->force[e].kind == MB_FORCE_SPRING || m->force[e].kind == MB_FORCE_FIELD;
+    if (nstiff)
+      fprintf(stderr, "%s: note: the model was compiled without its force elements' tangents "
+                      "(its integrator is not genalpha or auto): generalized-alpha's Newton sees "
+                      "only the masses and the modes, and stiff springs, bushings or beams force "
+                      "small steps\n", argv[0]);
+  }
   mb_sim sim;
   int st = mb_sim_init(&sim, m, ls, &set);
   sim.on_step = track_angles;
