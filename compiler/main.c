@@ -28,6 +28,7 @@
 #include "proc.h"
 #include "trade.h"
 #include "unit.h"
+#include "vec3.h"
 #include "version.h"
 
 #ifndef MBCC_GEN_CFLAGS
@@ -242,7 +243,17 @@ static int cmd_check(const options *o) {
            rigid ? "rigid (no modes)" : coupling[m->body[b].flex->coupling]);
     printf("    frequencies (Hz):");
     for (int j = 0; j < m->body[b].nm; j++) printf(" %.6g", fm->freq_hz[j]);
-    printf("\n    mass %.6g kg, damping ratios:", m->body[b].flex->mass);
+    /* the centre of mass, global at t = 0 (undeformed): r + A S0 / m */
+    const ir_body *B = &L->ir->bodies[b + 1];
+    const mb_flex *fl = m->body[b].flex;
+    double A[9], cg[3];
+    quaternion_to_matrix(B->orientation, A);
+    for (int i = 0; i < 3; i++)
+      cg[i] = B->position[i] + (fl->mass > 0 ? (A[3 * i] * fl->S0[0] + A[3 * i + 1] * fl->S0[1] +
+                                                A[3 * i + 2] * fl->S0[2]) / fl->mass : 0);
+    printf("\n    mass %.6g kg, centre of mass [%.6g, %.6g, %.6g] (global, undeformed)\n", fl->mass,
+           fabs(cg[0]) < 1e-12 ? 0 : cg[0], fabs(cg[1]) < 1e-12 ? 0 : cg[1], fabs(cg[2]) < 1e-12 ? 0 : cg[2]);
+    printf("    damping ratios:");
     for (int j = 0; j < m->body[b].nm; j++)
       printf(" %.3g", m->body[b].flex->damping[j] / (2 * 2 * MB_PI * fm->freq_hz[j] * sqrt(m->body[b].flex->Mff[j * m->body[b].nm + j])));
     printf("\n");

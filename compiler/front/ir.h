@@ -54,6 +54,8 @@ typedef struct {
   double A, Iy, Iz, J;     /* section: area, second moments about local y and z, torsion constant */
   double shear_y, shear_z; /* Timoshenko shear area ratios (A_s = ratio * A); 0 for Euler-Bernoulli */
   double yaxis[3];         /* unit local y of the section (perpendicular to the element), body axes */
+  double nsm;              /* non-structural mass per length, kg/m: lumped like rho A (translation and
+                              bending rotary inertia), none in torsion (it sits on the beam's axis) */
   ir_loc loc;
 } ir_beam;
 
@@ -110,6 +112,11 @@ typedef struct ir_flex {
   ir_rigid_link *links;    /* RBE2 */
   int nlinks;
   ir_fe_matrix *K_given, *M_given; /* Matrix Market: the whole K and M (instead of beams) */
+  char *fe_source;         /* a YAML FE file (fe_file: X.fe.yaml): the file the locations of nodes,
+                              beams and point masses refer to; NULL: the model file */
+  char **node_names;       /* named nodes (node_names: {J1: 16}): usable wherever a node number is */
+  int *node_name_index;
+  int nnode_names;
   double *w0, *wd0;        /* initial modal coordinates and rates (n0, nd0 of them), or NULL */
   int nw0, nwd0;
   ir_loc w0_loc, wd0_loc;
