@@ -22,7 +22,7 @@ CC_SRC  := $(wildcard compiler/*.c) $(foreach d,$(CC_DIRS),$(wildcard $(d)/*.c))
 B       ?= build
 DEPFLAGS = -MMD -MP
 
-.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser embedded man release-check  install scaling chassis
+.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser embedded man release-check  install scaling chassis vehicle
 all: $(B)/mbcc $(B)/libmbrt.a $(B)/libmbrt_float.a
 
 # objects keep the source's folders: $(B)/rt/core/x.o, $(B)/cc/front/x.o
@@ -134,6 +134,7 @@ install: all
 
 include tests/tests.mk
 include docs/results.mk
+include docs/vehicle.mk
 
 clean:
 	rm -rf $(B) generated/*/ results

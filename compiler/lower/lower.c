@@ -530,6 +530,16 @@ lmodel *lower_model(const ir_model *ir, const flex_product *flex) {
         for (int i = 0; i < 9; i++) Cg[i] = A[i];
         memcpy(L->q0 + d->qadr, P, sizeof P);
         memcpy(L->q0 + d->qadr + 3, qb + 3, sizeof(double) * 4);
+        /* it starts moving with the frame at the node (v + w x r; the same
+           body-axis angular velocity): at rest, the assembly's minimum-norm
+           velocity correction would slow the whole system down */
+        const double *vb = L->v0 + L->body[b].vadr;
+        double wg[3], r[3], wxr[3];
+        mb_mul3(A, vb + 3, wg);
+        for (int i = 0; i < 3; i++) r[i] = P[i] - qb[i];
+        mb_cross3(wg, r, wxr);
+        for (int i = 0; i < 3; i++) L->v0[d->vadr + i] = vb[i] + wxr[i];
+        memcpy(L->v0 + d->vadr + 3, vb + 3, sizeof(double) * 3);
         int mn = add_marker(L, b, node, P, Cg,
                             xstrdup_printf("node of body '%s' under virtual body '%s'%s",
                                            L->body[b].name, name, ""), J->body_loc[s]);
