@@ -49,6 +49,7 @@ present() {
     libclang-rt-14-dev) [ -e "$(clang -print-file-name=libclang_rt.fuzzer-x86_64.a)" ] ;; # make fuzz
     time)               [ -x /usr/bin/time ] ;;
     python3)            command -v python3 ;;
+    parallel)           parallel --version | grep -q 'GNU parallel' ;;
     *)                  false ;;
   esac >/dev/null 2>&1
 }
@@ -61,10 +62,12 @@ present() {
 # 924 MB installed, about 2 minutes of apt (measured).  pkgconf (pkg-config)
 # for tests/test_install.sh; libclang-rt-14-dev (libFuzzer) for make fuzz;
 # time (/usr/bin/time, peak memory) for make scaling; python3 (the standard
-# library only) for make chassis and tests/test_chassis.sh.
+# library only) for make chassis and tests/test_chassis.sh; GNU parallel runs
+# the variants of mbcc sweep (tests/test_sweep.sh).
 packages=(build-essential libyaml-dev libsuitesparse-dev liblapack-dev libblas-dev
           libcmocka-dev libsundials-dev libarpack2-dev gnuplot-nox clang nodejs npm chromium
-          gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm pkgconf libclang-rt-14-dev time python3)
+          gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm pkgconf libclang-rt-14-dev time python3
+          parallel)
 missing=()
 for p in "${packages[@]}"; do
   present "$p" || missing+=("$p")
