@@ -22,7 +22,7 @@ CC_SRC  := $(wildcard compiler/*.c) $(foreach d,$(CC_DIRS),$(wildcard $(d)/*.c))
 B       ?= build
 DEPFLAGS = -MMD -MP
 
-.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser embedded man release-check  install scaling chassis vehicle
+.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser embedded man release-check  install scaling chassis vehicle sweeps
 all: $(B)/mbcc $(B)/libmbrt.a $(B)/libmbrt_float.a
 
 # objects keep the source's folders: $(B)/rt/core/x.o, $(B)/cc/front/x.o
@@ -138,3 +138,7 @@ include docs/vehicle.mk
 
 clean:
 	rm -rf $(B) generated/*/ results
+
+# the design-of-experiments study (scripts/sweeps.sh): writes docs/sweeps.md and docs/img/sweep_*.png
+sweeps: all
+	MBCC=$(B)/mbcc bash scripts/sweeps.sh
