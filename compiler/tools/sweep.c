@@ -195,6 +195,16 @@ int sweep_design(const sweep_plan *p, const double *baseline, double **table, in
   return 0;
 }
 
+/* the shortest of %.15g, %.16g, %.17g that reads back as x: what the
+ * design and the jobs say is exactly the run's value */
+static const char *shortest(char buf[32], double x) {
+  for (int digits = 15; digits <= 17; digits++) {
+    snprintf(buf, 32, "%.*g", digits, x);
+    if (strtod(buf, NULL) == x) break;
+  }
+  return buf;
+}
+
 /* s in single quotes for the shell */
 static void shell_quote(FILE *f, const char *s) {
   fputc('\'', f);
@@ -247,7 +257,8 @@ int sweep_write_jobs(const char *dir, const char *exe, const sweep_plan *p, cons
   fputc('\n', f);
   for (int r = 0; r < nrun; r++) {
     fprintf(f, "%d", r + 1);
-    for (int k = 0; k < nv; k++) fprintf(f, ",%.17g", table[(long long)r * nv + k]);
+    char b[32];
+    for (int k = 0; k < nv; k++) fprintf(f, ",%s", shortest(b, table[(long long)r * nv + k]));
     fputc('\n', f);
   }
   if (out_file_commit(&df)) return 2;
@@ -269,7 +280,8 @@ int sweep_write_jobs(const char *dir, const char *exe, const sweep_plan *p, cons
       fputc(' ', f);
       shell_quote(f, fixed_args[i]);
     }
-    for (int k = 0; k < nv; k++) fprintf(f, " --set %s=%.17g", p->var[k].name, table[(long long)r * nv + k]);
+    char b[32];
+    for (int k = 0; k < nv; k++) fprintf(f, " --set %s=%s", p->var[k].name, shortest(b, table[(long long)r * nv + k]));
     fputs(" 2>", f);
     snprintf(csv, sizeof csv, "%s.log", base);
     shell_quote(f, csv);
