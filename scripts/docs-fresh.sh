@@ -17,7 +17,8 @@ table='docs/results.md|results|scripts/results.sh compiler runtime templates mod
 docs/benchmarks.md|bench|scripts/bench.sh compiler runtime templates models
 docs/trade.md|trade|scripts/trade.sh compiler runtime templates models/slider_crank_flexible.yaml
 docs/stability.md|extremes|tests/extremes compiler runtime templates
-docs/vehicle.md|vehicle|scripts/vehicle.sh compiler runtime templates models/sports_car.yaml models/sports_car_chassis.fe.yaml'
+docs/vehicle.md|vehicle|scripts/vehicle.sh compiler runtime templates models/sports_car.yaml models/sports_car_chassis.fe.yaml
+docs/sweeps.md|sweeps|scripts/sweeps.sh compiler/tools/sweep.c runtime models/quarter_car.yaml'
 
 stale=0
 while IFS='|' read -r doc target sources; do

@@ -32,9 +32,11 @@ runs=$(($(wc -l < "$csv") - 1))
 failed=$(awk -F, 'NR > 1 && $4 != "ok"' "$csv" | wc -l)
 [ "$failed" = 0 ] || die "$failed runs failed (see $W/sweep.log)"
 
-# columns: run,k_susp,c_susp,status,body_acc.maxabs,travel.max,travel.min,tyre_load.min
+# columns: run,k_susp,c_susp,status,body_acc.maxabs,travel.max,travel.min,tyre_load.min;
+# gnuplot's pm3d wants the grid in scans: a blank line whenever k_susp changes
+awk -F, 'NR > 1 { if (NR > 2 && $2 != k) print ""; k = $2; print }' "$csv" > "$W/grid.csv"
 gnuplot <<EOG
-set terminal pngcairo size 1100,450 font ",10"
+set terminal pngcairo size 1100,450 font ",10" noenhanced
 set output "docs/img/sweep_quarter_car.png"
 set datafile separator ","
 set multiplot layout 1,2
@@ -43,9 +45,9 @@ set xlabel "suspension rate k_susp [kN/m]"
 set ylabel "damping c_susp [kN s/m]"
 set title "peak body acceleration [m/s^2]"
 set pm3d map interpolate 0,0
-splot "$csv" every ::1 using (\$2/1000):(\$3/1000):5 with pm3d notitle
+splot "$W/grid.csv" using (\$2/1000):(\$3/1000):5 with pm3d notitle
 set title "least tyre load [N] (0: the wheel leaves the road)"
-splot "$csv" every ::1 using (\$2/1000):(\$3/1000):(\$8) with pm3d notitle
+splot "$W/grid.csv" using (\$2/1000):(\$3/1000):(\$8) with pm3d notitle
 unset multiplot
 EOG
 
@@ -88,14 +90,19 @@ best=$(awk -F, 'NR > 1 && $8 > 0 { if (!n || $5 < a) { a = $5; line = $0 }; n = 
   echo "## The quarter car: suspension rate against damping"
   echo
   echo "models/quarter_car.yaml: one front corner of the sports car (180 kg sprung,"
-  echo "33.5 kg unsprung, a 200 kN/m tyre that only pushes) over a 5 cm cosine bump"
+  echo "33.5 kg unsprung, a 200 kN/m tyre that only pushes) over a 3 cm cosine bump 4 m long"
   echo "at 60 km/h. $runs variants (40 rates from 10 to 60 kN/m, 25 dampings from 0.5"
   echo "to 5 kN s/m), $failed failed, in $(printf '%.1f' "$wall") s of wall time (compile included)."
   echo
   echo "![peak body acceleration and least tyre load over the design](img/sweep_quarter_car.png)"
   echo
-  echo "Soft springs and light damping give the smallest body acceleration but the"
-  echo "largest travel; light damping lets the wheel leave the road (least tyre load 0)."
+  awk -F, -v runs="$runs" 'NR > 1 { on += $8 > 0; if ($3 < 2750) { lo += $8; nlo++ } else { hi += $8; nhi++ }
+       if ($2 < 35000) { alo += $5; nalo++ } else { ahi += $5; nahi++ } }
+    END { printf "%d of the %d variants keep the tyre on the road (least tyre load above 0; where the\n", on, runs
+          printf "right plot is black, the wheel leaves it). The least tyre load averages %.0f N over the variants damped\n", lo / nlo
+          printf "below 2.75 kN s/m and %.0f N over those above; the peak body acceleration averages\n", hi / nhi
+          printf "%.2f m/s² over the rates below 35 kN/m and %.2f m/s² over those above.\n", alo / nalo, ahi / nahi }' "$csv"
+  echo
   echo "The most comfortable variant that keeps the tyre on the road:"
   echo
   echo "| k_susp [N/m] | c_susp [N s/m] | peak body acceleration [m/s²] | travel [mm] | least tyre load [N] |"
