@@ -17,23 +17,33 @@ static uint64_t fnv1a(uint64_t h, const unsigned char *b, size_t n) {
   return h;
 }
 
-/* the input hash (unit.h); 0 after reporting if the file cannot be read */
-static int hash_input(mbc_unit *u) {
-  FILE *f = fopen(u->path, "rb");
+/* folds the bytes of file 'path' into *h; 2 after reporting */
+static int hash_file(const char *path, uint64_t *h) {
+  FILE *f = fopen(path, "rb");
   if (!f) {
-    diag_error(u->path, (ir_loc){0, 0}, "cannot read the model file again to hash it");
+    diag_error(path, (ir_loc){0, 0}, "cannot read the model file again to hash it");
     return 2;
   }
-  uint64_t h = 0xcbf29ce484222325ULL;
   unsigned char buf[8192];
   size_t n;
-  while ((n = fread(buf, 1, sizeof buf, f)) > 0) h = fnv1a(h, buf, n);
+  while ((n = fread(buf, 1, sizeof buf, f)) > 0) *h = fnv1a(*h, buf, n);
   int bad = ferror(f);
   fclose(f);
   if (bad) {
-    diag_error(u->path, (ir_loc){0, 0}, "cannot read the model file again to hash it");
+    diag_error(path, (ir_loc){0, 0}, "cannot read the model file again to hash it");
     return 2;
   }
+  return 0;
+}
+
+/* the input hash (unit.h); 0 after reporting if the file cannot be read */
+static int hash_input(mbc_unit *u) {
+  uint64_t h = 0xcbf29ce484222325ULL;
+  if (hash_file(u->path, &h)) return 2;
+  /* included files, and the recorded motion of a rig, after the model's
+     own bytes (a model without them hashes as before) */
+  for (int i = 0; i < u->ir->nincluded; i++)
+    if (hash_file(u->ir->included[i], &h)) return 2;
   h = fnv1a(h, (const unsigned char *)"", 1);
   if (u->scene) h = fnv1a(h, (const unsigned char *)u->scene, strlen(u->scene));
   u->input_hash = h;

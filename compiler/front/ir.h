@@ -374,6 +374,8 @@ typedef struct {
   int nparams;
   ir_expr_use *uses;    /* fields given by expressions over parameters, in reading order */
   int nuses, cap_uses;
+  char **included;   /* files read through 'include:' (the input hash covers them) */
+  int nincluded;
 } ir_model;
 
 /* Read and validate a model, applying scene 'scene' (NULL: the base model).
