@@ -7,6 +7,8 @@
 #include "diag.h"
 #include "params.h"
 #include "unit.h"
+#include "scene.h"
+#include <stdlib.h>
 
 /* FNV-1a 64 step over n bytes */
 static uint64_t fnv1a(uint64_t h, const unsigned char *b, size_t n) {
@@ -196,6 +198,14 @@ done:
 
 int mbc_unit_finish(mbc_unit *u, int verbose) {
   if (flex_reduce(u->ir, &u->flex)) return 2;
+  if (u->ir->scene) { /* a scene's modal changes drop the outputs of modes gone */
+    int *modes = calloc((size_t)u->ir->nbodies + 1, sizeof *modes);
+    if (!modes) return 2;
+    for (int b = 0; b < u->ir->nbodies; b++)
+      modes[b] = u->ir->bodies[b].kind == BODY_FLEXIBLE ? u->flex.data[b].flex.nm : 0;
+    scene_drop_modal_outputs(u->ir, modes);
+    free(modes);
+  }
   u->lowered = lower_model(u->ir, &u->flex);
   if (!u->lowered) {
     if (!diag_errors()) diag_error(u->path, (ir_loc){0, 0}, "out of memory while lowering");

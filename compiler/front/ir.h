@@ -375,6 +375,7 @@ typedef struct {
   ir_expr_use *uses;    /* fields given by expressions over parameters, in reading order */
   int nuses, cap_uses;
   char **included;   /* files read through 'include:' (the input hash covers them) */
+  char *pruned;      /* what the scene removed, one line each ("body 'x'"), or NULL */
   int nincluded;
 } ir_model;
 

@@ -1690,7 +1690,7 @@ ir_model *ir_read(const char *path, const char *scene) {
   return model;
 }
 
-static void free_flex(ir_flex *fx) {
+void free_flex(ir_flex *fx) {
   if (fx == NULL)
     return;
   free(fx->nodes);
@@ -1713,6 +1713,7 @@ void ir_free(ir_model *m) {
   for (int i = 0; i < m->nincluded; i++)
     free(m->included[i]);
   free(m->included);
+  free(m->pruned);
   free(m->name);
   free(m->scene);
   for (int i = 0; i < m->nbodies; i++) {

@@ -116,6 +116,118 @@ static ir_flex **parse_scene_bodies(reader *r, yaml_node_t *n, const char *what)
   return flex;
 }
 
+/* the index of body 'n' (a name), or -1 after reporting; ground is refused */
+static int scene_body(reader *r, yaml_node_t *n, const char *where) {
+  ir_model *model = r->model;
+  if (n->type == YAML_SCALAR_NODE)
+    for (int b = 1; b < model->nbodies; b++)
+      if (model->bodies[b].name && scalar_equals(n, model->bodies[b].name)) return b;
+  if (scalar_equals(n, "ground")) {
+    error_at(r, loc_of(n), "the ground cannot be removed (in %s)", where);
+    return -1;
+  }
+  name_list l = {.length = 0};
+  for (int b = 1; b < model->nbodies; b++) name_list_add(&l, model->bodies[b].name);
+  error_at(r, loc_of(n), "unknown body %s in %s (%s%s)", show_node(r, n), where,
+           l.count ? "expected one of: " : "the model has none", l.text);
+  return -1;
+}
+
+/* 'remove: [body, ...]' */
+static void parse_remove(reader *r, yaml_node_t *n, bool *removed) {
+  if (n->type != YAML_SEQUENCE_NODE) {
+    error_at(r, loc_of(n), "'remove': expected a list of body names, got %s", show_node(r, n));
+    return;
+  }
+  for (int i = 0; i < seq_length(n); i++) {
+    int b = scene_body(r, seq_item(r, n, i), "'remove'");
+    if (b > 0) removed[b] = true;
+  }
+}
+
+/* 'rig: {bodies: [kept, ...], attachments: ground}': every other body removed */
+static bool parse_rig(reader *r, yaml_node_t *n, const char *what, bool *removed) {
+  mapping m;
+  if (!map_open(&m, r, n, loc_of(n), "'rig' of %s", what)) return false;
+  static const char *const keys[] = {"bodies", "attachments", NULL};
+  map_check_keys(&m, keys);
+  yaml_node_t *list = map_require(&m, "bodies", true, "a list of the bodies kept on the rig");
+  bool ok = list != NULL;
+  if (list != NULL && (list->type != YAML_SEQUENCE_NODE || seq_length(list) == 0)) {
+    error_at(r, loc_of(list), "'bodies' of the rig: expected a list of body names, got %s", show_node(r, list));
+    ok = false;
+  } else if (list != NULL) {
+    bool *kept = xcalloc((size_t)r->model->nbodies, sizeof *kept);
+    for (int i = 0; i < seq_length(list); i++) {
+      int b = scene_body(r, seq_item(r, list, i), "'bodies' of the rig");
+      if (b > 0) kept[b] = true;
+    }
+    for (int b = 1; b < r->model->nbodies; b++) removed[b] = removed[b] || !kept[b];
+    free(kept);
+  }
+  yaml_node_t *at = map_get(&m, "attachments");
+  if (at != NULL && !scalar_equals(at, "ground")) {
+    error_at(r, loc_of(at), "'attachments' of the rig: only 'ground' is supported (the joints to removed "
+             "bodies become joints to the ground; a recorded motion is not implemented), got %s",
+             show_node(r, at));
+    ok = false;
+  }
+  map_close(&m);
+  return ok;
+}
+
+/* 'replace: {joint: {type: bushing, stiffness: [6], damping: [6]}}' */
+static scene_replacement *parse_replace(reader *r, yaml_node_t *n, const char *what, int *count) {
+  ir_model *model = r->model;
+  mapping m;
+  *count = 0;
+  if (!map_open(&m, r, n, loc_of(n), "'replace' of %s", what)) return NULL;
+  scene_replacement *out = xcalloc((size_t)m.npairs + 1, sizeof *out);
+  for (int i = 0; i < m.npairs; i++) {
+    if (m.handled[i]) continue;
+    m.handled[i] = true;
+    yaml_node_t *key = map_key_node(&m, i), *value = map_value_node(&m, i);
+    int j = -1;
+    for (int k = 0; k < model->njoints; k++)
+      if (model->joints[k].name && scalar_equals(key, model->joints[k].name)) j = k;
+    if (j < 0) {
+      name_list l = {.length = 0};
+      list_names_of_kind(r, NAME_JOINT, &l);
+      error_at(r, loc_of(key), "unknown joint %s in 'replace' (%s%s)", show_node(r, key),
+               l.count ? "expected one of: " : "the model has none", l.text);
+      continue;
+    }
+    if (model->joints[j].kind == JOINT_DISTANCE) {
+      error_at(r, loc_of(key), "joint '%s' is a distance joint: it has two points, a bushing one; "
+               "replace it by a spring_damper in 'forces' and deactivate it instead", model->joints[j].name);
+      continue;
+    }
+    mapping bm;
+    if (!map_open(&bm, r, value, loc_of(key), "the replacement of joint '%s'", model->joints[j].name)) continue;
+    static const char *const keys[] = {"type", "stiffness", "damping", NULL};
+    map_check_keys(&bm, keys);
+    static const char *const types[] = {"bushing", NULL};
+    int type = 0;
+    scene_replacement *rp = &out[*count];
+    bool ok = get_choice(&bm, "type", "replacement", types, true, &type);
+    ok = get_vector(&bm, "stiffness", 6, true, rp->k6) && ok;
+    if (map_has(&bm, "damping")) ok = get_vector(&bm, "damping", 6, false, rp->c6) && ok;
+    for (int k = 0; ok && k < 6; k++)
+      if (rp->k6[k] < 0 || rp->c6[k] < 0) {
+        error_at(r, loc_of(key), "the bushing replacing joint '%s' needs stiffness and damping >= 0",
+                 model->joints[j].name);
+        ok = false;
+      }
+    map_close(&bm);
+    if (!ok) continue;
+    rp->joint = j;
+    rp->loc = loc_of(key);
+    (*count)++;
+  }
+  map_close(&m);
+  return out;
+}
+
 static void parse_scene(reader *r, yaml_node_t *key, yaml_node_t *value,
                         const sim_settings *base_sim, bool chosen) {
   ir_model *model = r->model;
@@ -125,7 +237,8 @@ static void parse_scene(reader *r, yaml_node_t *key, yaml_node_t *value,
   mapping m;
   if (!map_open(&m, r, value, loc_of(key), "%s", what))
     return;
-  static const char *const keys[] = {"simulation", "outputs", "deactivate", "gravity", "bodies", NULL};
+  static const char *const keys[] = {"simulation", "outputs", "deactivate", "gravity", "bodies",
+                                     "remove", "replace", "rig", NULL};
   map_check_keys(&m, keys);
 
   sim_settings sim = *base_sim;
@@ -156,6 +269,17 @@ static void parse_scene(reader *r, yaml_node_t *key, yaml_node_t *value,
   n = map_get(&m, "bodies");
   if (n != NULL)
     flex = parse_scene_bodies(r, n, what);
+  bool *body_removed = xcalloc((size_t)model->nbodies, sizeof *body_removed);
+  n = map_get(&m, "remove");
+  if (n != NULL)
+    parse_remove(r, n, body_removed);
+  n = map_get(&m, "rig");
+  bool rig = n != NULL && parse_rig(r, n, what, body_removed);
+  scene_replacement *replace = NULL;
+  int nreplace = 0;
+  n = map_get(&m, "replace");
+  if (n != NULL)
+    replace = parse_replace(r, n, what, &nreplace);
   double gravity[3];
   bool has_gravity = get_vector(&m, "gravity", 3, false, gravity);
   bool has_outputs = map_has(&m, "outputs");
@@ -167,9 +291,15 @@ static void parse_scene(reader *r, yaml_node_t *key, yaml_node_t *value,
     free(joint_off);
     free(driver_off);
     free(force_off);
+    free(body_removed);
+    free(replace);
     free_scene_flex(flex, model->nbodies);
     return;
   }
+  s->body_removed = body_removed;
+  s->rig = rig;
+  s->replace = replace;
+  s->nreplace = nreplace;
   s->found = true;
   s->name = xstrndup(scalar_text(key), scalar_length(key));
   s->has_gravity = has_gravity;
@@ -256,6 +386,220 @@ void mark_virtual_joints(reader *r, yaml_node_t *list) {
   }
 }
 
+/* ---------------------------------------------------------------------------
+ * pruning: removed bodies and what hangs on them, joints made bushings
+ * ------------------------------------------------------------------------- */
+
+/* one line of model->pruned, for 'mbcc check --scene' */
+static void pruned_add(ir_model *model, const char *fmt, const char *name, const char *why) {
+  char line[SHOWN_SIZE * 2];
+  snprintf(line, sizeof line, fmt, name, why);
+  size_t old = model->pruned ? strlen(model->pruned) : 0, add = strlen(line);
+  char *text = xcalloc(old + add + 2, 1);
+  if (old) memcpy(text, model->pruned, old);
+  memcpy(text + old, line, add);
+  text[old + add] = '\n';
+  free(model->pruned);
+  model->pruned = text;
+}
+
+/* bodies connected to the ground through active joints and two-body forces
+ * that touch no removed body */
+static void reach_ground(const ir_model *model, const bool *removed, bool *reached) {
+  memset(reached, 0, sizeof *reached * (size_t)model->nbodies);
+  reached[0] = true;
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (int k = 0; k < model->njoints + model->nforces; k++) {
+      const int *body = k < model->njoints ? model->joints[k].body : model->forces[k - model->njoints].body;
+      bool active = k < model->njoints ? model->joints[k].active : model->forces[k - model->njoints].active;
+      int a = body[0], b = body[1];
+      if (!active || a < 0 || b < 0 || removed[a] || removed[b] || reached[a] == reached[b]) continue;
+      reached[a] = reached[b] = true;
+      changed = true;
+    }
+  }
+}
+
+static void drop_output(ir_model *model, const ir_output *o, const char *why) {
+  diag_note(model->path, o->loc, "output '%s' dropped: %s (scene '%s')", o->name, why, model->scene);
+  pruned_add(model, "output '%s' (%s)", o->name, why);
+}
+
+static void prune_model(ir_model *model, chosen_scene *s) {
+  int nb = model->nbodies, nj = model->njoints, nd = model->ndrivers, nf = model->nforces;
+  bool *removed = s->body_removed;
+  /* a rig: the kept side of a joint or a two-body force to a removed body
+     is held by the ground, at the same place */
+  for (int k = 0; s->rig && k < nj + nf; k++) {
+    bool joint = k < nj;
+    int *body = joint ? model->joints[k].body : model->forces[k - nj].body;
+    int *node = joint ? model->joints[k].node : model->forces[k - nj].node;
+    const char *name = joint ? model->joints[k].name : model->forces[k - nj].name;
+    if (body[1] < 0 || removed[body[0]] == removed[body[1]]) continue;
+    int side = removed[body[0]] ? 0 : 1;
+    if (body[1 - side] == 0) continue; /* between a removed body and the ground: goes */
+    body[side] = 0;
+    node[side] = -1;
+    pruned_add(model, joint ? "joint '%s' attached to the ground (%s)" : "force '%s' attached to the ground (%s)",
+               name, "rig");
+  }
+  /* bodies that hung on the ground only through removed ones go too */
+  bool *before = xcalloc((size_t)nb, sizeof *before), *after = xcalloc((size_t)nb, sizeof *after);
+  bool *none = xcalloc((size_t)nb, sizeof *none);
+  reach_ground(model, none, before);
+  reach_ground(model, removed, after);
+  for (int b = 1; b < nb; b++)
+    if (removed[b]) {
+      pruned_add(model, "body '%s'%s", model->bodies[b].name, "");
+    } else if (before[b] && !after[b]) {
+      removed[b] = true;
+      diag_note(model->path, model->bodies[b].loc, "body '%s' removed too: it hung on the ground only "
+                "through removed bodies (scene '%s')", model->bodies[b].name, model->scene);
+      pruned_add(model, "body '%s' (%s)", model->bodies[b].name, "connected only through removed bodies");
+    }
+  free(before);
+  free(after);
+  free(none);
+
+  bool *joint_gone = xcalloc((size_t)nj + 1, sizeof *joint_gone);
+  bool *driver_gone = xcalloc((size_t)nd + 1, sizeof *driver_gone);
+  bool *force_gone = xcalloc((size_t)nf + 1, sizeof *force_gone);
+  for (int j = 0; j < nj; j++) {
+    joint_gone[j] = removed[model->joints[j].body[0]] || removed[model->joints[j].body[1]];
+    if (joint_gone[j]) pruned_add(model, "joint '%s'%s", model->joints[j].name, "");
+  }
+  /* joints made bushings: a force at the joint's point, in its axes */
+  ir_force *bushings = xcalloc((size_t)s->nreplace + 1, sizeof *bushings);
+  int nbushings = 0;
+  for (int i = 0; i < s->nreplace; i++) {
+    const ir_joint *J = &model->joints[s->replace[i].joint];
+    if (joint_gone[s->replace[i].joint]) continue;
+    joint_gone[s->replace[i].joint] = true;
+    ir_force *F = &bushings[nbushings++];
+    F->name = xstrdup(J->name);
+    F->loc = s->replace[i].loc;
+    F->kind = FORCE_BUSHING;
+    for (int side = 0; side < 2; side++) {
+      F->body[side] = J->body[side];
+      F->body_loc[side] = J->body_loc[side];
+      F->node[side] = J->node[side];
+      memcpy(F->point[side], J->point[side], sizeof F->point[side]);
+    }
+    /* rows x, y, z: the joint's marker frame (z the axis, x its reference) */
+    const double *z = J->axis[0], *x = J->ref;
+    double y[3] = {z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2], z[0] * x[1] - z[1] * x[0]};
+    memcpy(F->axes, x, 3 * sizeof *x);
+    memcpy(F->axes + 3, y, sizeof y);
+    memcpy(F->axes + 6, z, 3 * sizeof *z);
+    memcpy(F->k6, s->replace[i].k6, sizeof F->k6);
+    memcpy(F->c6, s->replace[i].c6, sizeof F->c6);
+    F->active = J->active;
+    pruned_add(model, "joint '%s' (%s)", J->name, "replaced by a bushing");
+  }
+  for (int d = 0; d < nd; d++) {
+    driver_gone[d] = joint_gone[model->drivers[d].joint];
+    if (driver_gone[d]) pruned_add(model, "driver '%s' (%s)", model->drivers[d].name, "its joint is gone");
+  }
+  for (int f = 0; f < nf; f++) {
+    const ir_force *F = &model->forces[f];
+    force_gone[f] = removed[F->body[0]] || (F->body[1] >= 0 && removed[F->body[1]]);
+    if (force_gone[f]) pruned_add(model, "force '%s'%s", F->name, "");
+  }
+
+  /* compact, renumbering bodies, joints and drivers */
+  int *body_to = xcalloc((size_t)nb, sizeof *body_to), *joint_to = xcalloc((size_t)nj + 1, sizeof *joint_to);
+  int *driver_to = xcalloc((size_t)nd + 1, sizeof *driver_to);
+  int count = 0;
+  for (int b = 0; b < nb; b++) {
+    body_to[b] = removed[b] ? -1 : count;
+    if (removed[b]) {
+      free(model->bodies[b].name);
+      ir_flex *fx = model->bodies[b].flex;
+      model->bodies[b].flex = NULL;
+      free_flex(fx);
+    } else {
+      model->bodies[count++] = model->bodies[b];
+    }
+  }
+  model->nbodies = count;
+  count = 0;
+  for (int j = 0; j < nj; j++) {
+    joint_to[j] = joint_gone[j] ? -1 : count;
+    if (joint_gone[j]) { free(model->joints[j].name); continue; }
+    ir_joint *J = &model->joints[count++];
+    *J = model->joints[j];
+    for (int side = 0; side < 2; side++) J->body[side] = body_to[J->body[side]];
+  }
+  model->njoints = count;
+  count = 0;
+  for (int d = 0; d < nd; d++) {
+    driver_to[d] = driver_gone[d] ? -1 : count;
+    if (driver_gone[d]) { free(model->drivers[d].name); free(model->drivers[d].motion.table); continue; }
+    ir_driver *D = &model->drivers[count++];
+    *D = model->drivers[d];
+    D->joint = joint_to[D->joint];
+  }
+  model->ndrivers = count;
+  ir_force *forces = xcalloc((size_t)nf + (size_t)nbushings + 1, sizeof *forces);
+  count = 0;
+  for (int f = 0; f < nf + nbushings; f++) {
+    ir_force *F = f < nf ? &model->forces[f] : &bushings[f - nf];
+    if (f < nf && force_gone[f]) {
+      free(F->name); free(F->scale.table); free(F->stiffness.table); free(F->damping.table);
+      continue;
+    }
+    forces[count] = *F;
+    for (int side = 0; side < 2; side++)
+      if (forces[count].body[side] >= 0) forces[count].body[side] = body_to[forces[count].body[side]];
+    count++;
+  }
+  free(model->forces);
+  free(bushings);
+  model->forces = forces;
+  model->nforces = count;
+  count = 0;
+  for (int k = 0; k < model->noutputs; k++) {
+    ir_output *o = &model->outputs[k];
+    const char *why = NULL;
+    if (o->body >= 0 && body_to[o->body] < 0) {
+      why = "it refers to a removed body";
+    } else if (o->joint >= 0 && joint_to[o->joint] < 0) {
+      why = "it refers to a removed or replaced joint";
+    } else if (o->driver >= 0 && driver_to[o->driver] < 0) {
+      why = "it refers to a removed driver";
+    }
+    if (why) { drop_output(model, o, why); free(o->name); continue; }
+    ir_output *to = &model->outputs[count++];
+    *to = *o;
+    if (to->body >= 0) to->body = body_to[to->body];
+    if (to->joint >= 0) to->joint = joint_to[to->joint];
+    if (to->driver >= 0) to->driver = driver_to[to->driver];
+  }
+  model->noutputs = count;
+  free(body_to); free(joint_to); free(driver_to);
+  free(joint_gone); free(driver_gone); free(force_gone);
+}
+
+/* A scene that changes a flexible body's modes (or makes it rigid) drops
+ * the outputs of modes the body no longer has, with a note. */
+void scene_drop_modal_outputs(ir_model *model, const int *modes_of_body) {
+  if (model->scene == NULL) return;
+  int count = 0;
+  for (int k = 0; k < model->noutputs; k++) {
+    ir_output *o = &model->outputs[k];
+    if (o->kind == OUT_MODAL && o->body >= 0 && model->bodies[o->body].kind == BODY_FLEXIBLE &&
+        o->mode >= modes_of_body[o->body]) {
+      drop_output(model, o, modes_of_body[o->body] ? "the body has fewer modes in this scene"
+                                                   : "the body is rigid in this scene");
+      free(o->name);
+      continue;
+    }
+    model->outputs[count++] = *o;
+  }
+  model->noutputs = count;
+}
+
 void apply_scene(ir_model *model, chosen_scene *s) {
   model->scene = s->name;
   s->name = NULL;
@@ -291,6 +635,10 @@ void apply_scene(ir_model *model, chosen_scene *s) {
     free(from);
     s->flex[b] = NULL;
   }
+  bool prunes = s->nreplace > 0;
+  for (int b = 1; b < model->nbodies; b++) prunes = prunes || s->body_removed[b];
+  if (prunes)
+    prune_model(model, s);
   model->sim = s->sim;
 }
 
@@ -301,5 +649,7 @@ void free_chosen_scene(chosen_scene *s, int nbodies) {
   free(s->joint_off);
   free(s->driver_off);
   free(s->force_off);
+  free(s->body_removed);
+  free(s->replace);
   memset(s, 0, sizeof *s);
 }
