@@ -17,6 +17,8 @@
 #     rod hinged at its end released from the horizontal: reaction m g / 4 at
 #     t = 0 (2.4525 N), angle -(3 g / 4 L) t^2 at t = 0.01 to 1e-3 relative,
 #     energy conserved to 1e-8;
+#   - the flexible slider-crank's rod made rigid by a scene: its modal output
+#     is dropped with a note, and the scene runs;
 #   - the merge-key and the include versions of the double pendulum give
 #     its results bit for bit; errors in an included file point into it;
 #     an include cycle and a bad merge are located errors.
@@ -65,6 +67,13 @@ awk -F, 'NR == 2 { if ($4 < 2.4524 || $4 > 2.4526) { print "reaction at t = 0: "
             if (e > 1e-3) { print "angle at t = 0.01: " $2 " vs " ref; bad = 1 } }
   NR > 1 { e = $9 < 0 ? -$9 : $9; if (e > 1e-8) { print "energy drift " $9; bad = 1 } }
   END { exit bad }' rig.csv || err "rig_lower is not the hinged rod"
+
+# a flexible body made rigid by a scene: its modal output is dropped with a note
+"$MBCC" run scenes/flexible_rigid.yaml --scene rigid_rod --end 0.002 -o fr.csv > /dev/null 2> notes3.txt ||
+  err "the rigid_rod scene does not run: $(cat notes3.txt)"
+grep -q "^scenes/flexible_rigid.yaml:64:5: note: output 'mode1' dropped: the body is rigid" notes3.txt ||
+  err "no note for the modal output of the rod made rigid"
+head -1 fr.csv | grep -q mode1 && err "the rigid rod still has its modal output"
 
 # merge key and include: the double pendulum's results bit for bit
 "$MBCC" run compose/merge_pendulum.yaml --end 0.5 -o m.csv > /dev/null 2>&1 || err "merge run failed"
