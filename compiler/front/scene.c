@@ -4,12 +4,15 @@
  * choices and joints on flexible bodies (scene.h). */
 #include "scene.h"
 
+#include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "reader.h"
 #include "bounds.h"
+#include "diag.h"
 
 /* ---------------------------------------------------------------------------
  * scenes
@@ -145,8 +148,126 @@ static void parse_remove(reader *r, yaml_node_t *n, bool *removed) {
   }
 }
 
-/* 'rig: {bodies: [kept, ...], attachments: ground}': every other body removed */
-static bool parse_rig(reader *r, yaml_node_t *n, const char *what, bool *removed) {
+/* the column of 'name' in a CSV header (comma-separated), or -1 */
+static int csv_column(const char *header, const char *name) {
+  size_t length = strlen(name);
+  int column = 0;
+  for (const char *p = header; p; column++) {
+    const char *end = strpbrk(p, ",\r\n");
+    size_t field = end ? (size_t)(end - p) : strlen(p);
+    if (field == length && memcmp(p, name, length) == 0) return column;
+    p = end && *end == ',' ? end + 1 : NULL;
+  }
+  return -1;
+}
+
+/* A results CSV of the full model (mbcc run): for every body with a
+ * 'position' (no point, no node, all components) and an 'orientation'
+ * output among the base model's outputs, its rows t, x, y, z, e0..e3 in
+ * motion[b]; rows whose t does not rise are skipped.  false after reporting. */
+static bool read_motion(reader *r, yaml_node_t *n, chosen_scene *s) {
+  ir_model *model = r->model;
+  const char *base = diag_loc_file(loc_of(n), r->path);
+  const char *slash = strrchr(base, '/');
+  size_t dl = slash && scalar_text(n)[0] != '/' ? (size_t)(slash - base + 1) : 0;
+  char *path = xcalloc(dl + scalar_length(n) + 1, 1);
+  memcpy(path, base, dl);
+  memcpy(path + dl, scalar_text(n), scalar_length(n));
+  s->motion_path = path;
+  s->motion_loc = loc_of(n);
+  FILE *f = fopen(path, "rb");
+  if (f == NULL) {
+    error_at(r, loc_of(n), "cannot read the recorded motion '%s': %s", path, strerror(errno));
+    return false;
+  }
+  size_t capacity = 1 << 16, length = 0;
+  char *data = xcalloc(capacity + 1, 1);
+  for (;;) {
+    length += fread(data + length, 1, capacity - length, f);
+    if (length < capacity) break;
+    if ((double)capacity > 64.0 * LIMIT_INPUT_BYTES) {
+      fclose(f);
+      free(data);
+      error_at(r, loc_of(n), "the recorded motion '%s' is larger than %.0f bytes", path, 64.0 * LIMIT_INPUT_BYTES);
+      return false;
+    }
+    char *bigger = realloc(data, 2 * capacity + 1);
+    if (bigger == NULL) out_of_memory();
+    data = bigger;
+    capacity *= 2;
+  }
+  fclose(f);
+  data[length] = '\0';
+  int rows = 0;
+  for (size_t i = 0; i < length; i++) rows += data[i] == '\n';
+  s->motion = xcalloc((size_t)model->nbodies, sizeof *s->motion);
+  /* the columns of each recorded body */
+  int column[64][8];
+  int bodies[64], nrecorded = 0;
+  for (int b = 1; b < model->nbodies && nrecorded < 64; b++) {
+    const ir_output *pos = NULL, *ori = NULL;
+    for (int k = 0; k < model->noutputs; k++) {
+      const ir_output *o = &model->outputs[k];
+      if (o->body != b) continue;
+      if (o->kind == OUT_POSITION && !o->has_point && o->node < 0 && o->component < 0 && o->scale == 1) pos = o;
+      if (o->kind == OUT_ORIENTATION) ori = o;
+    }
+    if (!pos || !ori) continue;
+    char name[SHOWN_SIZE + 8];
+    bool all = true;
+    static const char *const suffix[8] = {NULL, "x", "y", "z", "e0", "e1", "e2", "e3"};
+    column[nrecorded][0] = csv_column(data, "t");
+    for (int c = 1; c < 8; c++) {
+      snprintf(name, sizeof name, "%s.%s", c < 4 ? pos->name : ori->name, suffix[c]);
+      column[nrecorded][c] = csv_column(data, name);
+      all = all && column[nrecorded][c] >= 0;
+    }
+    if (all && column[nrecorded][0] >= 0) bodies[nrecorded++] = b;
+  }
+  for (int i = 0; i < nrecorded; i++) s->motion[bodies[i]] = xcalloc((size_t)rows * 8 + 8, sizeof(double));
+  /* the data rows */
+  char *line = strchr(data, '\n');
+  int count = 0, lineno = 1;
+  bool ok = true;
+  double *fields = xcalloc(4096, sizeof *fields);
+  while (ok && line != NULL && line[1] != '\0') {
+    line++;
+    lineno++;
+    char *end = strchr(line, '\n');
+    if (end) *end = '\0';
+    int nfields = 0;
+    for (char *p = line; p && nfields < 4096; nfields++) {
+      char *stop;
+      fields[nfields] = strtod(p, &stop);
+      if (stop == p || (*stop != ',' && *stop != '\0' && *stop != '\r')) {
+        error_at(r, loc_of(n), "the recorded motion '%s', line %d: field %d is not a number", path, lineno, nfields + 1);
+        ok = false;
+        break;
+      }
+      p = *stop == ',' ? stop + 1 : NULL;
+    }
+    for (int i = 0; ok && i < nrecorded; i++) {
+      double *row = s->motion[bodies[i]] + 8 * count;
+      for (int c = 0; c < 8; c++) row[c] = column[i][c] < nfields ? fields[column[i][c]] : 0;
+    }
+    double t = nrecorded ? s->motion[bodies[0]][8 * count] : 0;
+    if (ok && (count == 0 || t > s->motion[bodies[0]][8 * (count - 1)])) count++;
+    line = end;
+  }
+  free(fields);
+  free(data);
+  s->nmotion_rows = count;
+  if (ok && nrecorded > 0 && count < 2) {
+    error_at(r, loc_of(n), "the recorded motion '%s' has fewer than 2 rows", path);
+    ok = false;
+  }
+  return ok;
+}
+
+/* 'rig: {bodies: [kept, ...], attachments: ground | {motion: results.csv}}':
+ * every other body removed */
+static bool parse_rig(reader *r, yaml_node_t *n, const char *what, bool *removed, chosen_scene *s,
+                      bool chosen) {
   mapping m;
   if (!map_open(&m, r, n, loc_of(n), "'rig' of %s", what)) return false;
   static const char *const keys[] = {"bodies", "attachments", NULL};
@@ -166,9 +287,21 @@ static bool parse_rig(reader *r, yaml_node_t *n, const char *what, bool *removed
     free(kept);
   }
   yaml_node_t *at = map_get(&m, "attachments");
-  if (at != NULL && !scalar_equals(at, "ground")) {
-    error_at(r, loc_of(at), "'attachments' of the rig: only 'ground' is supported (the joints to removed "
-             "bodies become joints to the ground; a recorded motion is not implemented), got %s",
+  if (at != NULL && at->type == YAML_MAPPING_NODE) {
+    mapping am;
+    map_open(&am, r, at, loc_of(at), "'attachments' of the rig");
+    static const char *const akeys[] = {"motion", NULL};
+    map_check_keys(&am, akeys);
+    yaml_node_t *file = map_require(&am, "motion", true, "a results CSV of the full model");
+    if (file != NULL && (file->type != YAML_SCALAR_NODE || scalar_length(file) == 0)) {
+      error_at(r, loc_of(file), "'motion': expected the name of a results CSV, got %s", show_node(r, file));
+      ok = false;
+    } else if (file != NULL && chosen) {
+      ok = read_motion(r, file, s) && ok;
+    }
+    map_close(&am);
+  } else if (at != NULL && !scalar_equals(at, "ground")) {
+    error_at(r, loc_of(at), "'attachments' of the rig: expected 'ground' or {motion: results.csv}, got %s",
              show_node(r, at));
     ok = false;
   }
@@ -274,7 +407,8 @@ static void parse_scene(reader *r, yaml_node_t *key, yaml_node_t *value,
   if (n != NULL)
     parse_remove(r, n, body_removed);
   n = map_get(&m, "rig");
-  bool rig = n != NULL && parse_rig(r, n, what, body_removed);
+  chosen_scene *cs = &r->scene;
+  bool rig = n != NULL && parse_rig(r, n, what, body_removed, cs, chosen);
   scene_replacement *replace = NULL;
   int nreplace = 0;
   n = map_get(&m, "replace");
@@ -301,6 +435,7 @@ static void parse_scene(reader *r, yaml_node_t *key, yaml_node_t *value,
   s->replace = replace;
   s->nreplace = nreplace;
   s->found = true;
+  s->nbodies = model->nbodies;
   s->name = xstrndup(scalar_text(key), scalar_length(key));
   s->has_gravity = has_gravity;
   memcpy(s->gravity, gravity, sizeof gravity);
@@ -426,24 +561,152 @@ static void drop_output(ir_model *model, const ir_output *o, const char *why) {
   pruned_add(model, "output '%s' (%s)", o->name, why);
 }
 
-static void prune_model(ir_model *model, chosen_scene *s) {
-  int nb = model->nbodies, nj = model->njoints, nd = model->ndrivers, nf = model->nforces;
-  bool *removed = s->body_removed;
-  /* a rig: the kept side of a joint or a two-body force to a removed body
-     is held by the ground, at the same place */
-  for (int k = 0; s->rig && k < nj + nf; k++) {
-    bool joint = k < nj;
-    int *body = joint ? model->joints[k].body : model->forces[k - nj].body;
-    int *node = joint ? model->joints[k].node : model->forces[k - nj].node;
-    const char *name = joint ? model->joints[k].name : model->forces[k - nj].name;
-    if (body[1] < 0 || removed[body[0]] == removed[body[1]]) continue;
-    int side = removed[body[0]] ? 0 : 1;
-    if (body[1 - side] == 0) continue; /* between a removed body and the ground: goes */
-    body[side] = 0;
-    node[side] = -1;
-    pruned_add(model, joint ? "joint '%s' attached to the ground (%s)" : "force '%s' attached to the ground (%s)",
-               name, "rig");
+/* grows an array of 'count' elements of 'size' bytes by 'more' (zeroed) */
+static void *grow(void *array, int count, int more, size_t size) {
+  char *bigger = xcalloc((size_t)(count + more) + 1, size);
+  if (count) memcpy(bigger, array, (size_t)count * size);
+  free(array);
+  return bigger;
+}
+
+/* ZYX angles (a about z, then b about the new y, then c about the newest x)
+ * of the rotation A(t) A(0)^T between two Euler-parameter sets */
+static void rotation_since(const double *e_now, const double *e0, double angles[3]) {
+  double A[2][9];
+  const double *e[2] = {e_now, e0};
+  for (int k = 0; k < 2; k++) {
+    double w = e[k][0], x = e[k][1], y = e[k][2], z = e[k][3];
+    double n = w * w + x * x + y * y + z * z;
+    w /= sqrt(n); x /= sqrt(n); y /= sqrt(n); z /= sqrt(n);
+    double M[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+                   2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                   2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)};
+    memcpy(A[k], M, sizeof M);
   }
+  double R[9];
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      R[3 * i + j] = A[0][3 * i] * A[1][3 * j] + A[0][3 * i + 1] * A[1][3 * j + 1] + A[0][3 * i + 2] * A[1][3 * j + 2];
+  double sb = -R[6];
+  angles[0] = atan2(R[3], R[0]);
+  angles[1] = asin(sb > 1 ? 1 : sb < -1 ? -1 : sb);
+  angles[2] = atan2(R[7], R[8]);
+}
+
+/* The stand-in of removed body 'removed' on a rig driven by its recorded
+ * motion: a chain ground -> x -> y -> z (prismatic) -> about z -> about y
+ * -> about x (revolute) of six massless (virtual) bodies at the body's
+ * initial pose, each joint driven by a table profile (natural cubic spline
+ * through the recorded rows) of the body's displacement and of the ZYX
+ * angles of its rotation since t = 0.  Returns the last body: the stand-in. */
+static int add_driven_chain(ir_model *model, int removed, const double *rows, int nrows, ir_loc loc) {
+  const ir_body *B = &model->bodies[removed];
+  char *name = xstrdup(B->name);
+  double position[3], orientation[4];
+  memcpy(position, B->position, sizeof position);
+  memcpy(orientation, B->orientation, sizeof orientation);
+  int nb = model->nbodies, nj = model->njoints, nd = model->ndrivers;
+  model->bodies = grow(model->bodies, nb, 6, sizeof *model->bodies);
+  model->joints = grow(model->joints, nj, 6, sizeof *model->joints);
+  model->drivers = grow(model->drivers, nd, 6, sizeof *model->drivers);
+  static const char *const dof_name[6] = {"x", "y", "z", "rz", "ry", "rx"};
+  static const int axis_of[6] = {0, 1, 2, 2, 1, 0};
+  double *profile[6];
+  for (int k = 0; k < 6; k++) profile[k] = xcalloc(2 * (size_t)nrows, sizeof(double));
+  double previous[3] = {0, 0, 0};
+  for (int i = 0; i < nrows; i++) {
+    const double *row = rows + 8 * i;
+    double angles[3];
+    rotation_since(row + 4, rows + 4, angles);
+    for (int k = 0; k < 3; k++) { /* unwrapped: continuous through +-pi */
+      double turn = 2 * acos(-1.0);
+      while (i > 0 && angles[k] - previous[k] > turn / 2) angles[k] -= turn;
+      while (i > 0 && angles[k] - previous[k] < -turn / 2) angles[k] += turn;
+      previous[k] = angles[k];
+    }
+    for (int k = 0; k < 6; k++) {
+      profile[k][2 * i] = row[0];
+      profile[k][2 * i + 1] = k < 3 ? row[1 + k] - rows[1 + k] : angles[k - 3];
+    }
+  }
+  for (int k = 0; k < 6; k++) {
+    ir_body *v = &model->bodies[nb + k];
+    char label[SHOWN_SIZE * 2];
+    snprintf(label, sizeof label, "%s_rig_%s", name, dof_name[k]);
+    v->name = xstrdup(label);
+    v->loc = loc;
+    v->kind = BODY_VIRTUAL;
+    memcpy(v->position, position, sizeof position);
+    memcpy(v->orientation, orientation, sizeof orientation);
+    ir_joint *J = &model->joints[nj + k];
+    J->name = xstrdup(label);
+    J->loc = J->body_loc[0] = J->body_loc[1] = loc;
+    J->kind = k < 3 ? JOINT_PRISMATIC : JOINT_REVOLUTE;
+    J->body[0] = k == 0 ? 0 : nb + k - 1;
+    J->body[1] = nb + k;
+    J->node[0] = J->node[1] = -1;
+    for (int side = 0; side < 2; side++) {
+      memcpy(J->point[side], position, sizeof position);
+      J->axis[side][axis_of[k]] = 1;
+    }
+    J->ref[(axis_of[k] + 1) % 3] = 1;
+    J->active = true;
+    ir_driver *D = &model->drivers[nd + k];
+    snprintf(label, sizeof label, "%s_rig_%s_motion", name, dof_name[k]);
+    D->name = xstrdup(label);
+    D->loc = loc;
+    D->joint = nj + k;
+    D->dof = k < 3 ? DRIVER_TRANSLATION : DRIVER_ROTATION;
+    D->motion.kind = PROFILE_TABLE;
+    D->motion.table = profile[k];
+    D->motion.ntable = nrows;
+    D->motion.loc = loc;
+    D->active = true;
+  }
+  model->nbodies = nb + 6;
+  model->njoints = nj + 6;
+  model->ndrivers = nd + 6;
+  free(name);
+  return nb + 5;
+}
+
+static void prune_model(ir_model *model, chosen_scene *s) {
+  int nb0 = model->nbodies, nj0 = model->njoints, nf = model->nforces;
+  /* the driven chains of a recorded motion add bodies: 'removed' grows */
+  bool *removed = xcalloc((size_t)nb0 + 6 * (size_t)(nj0 + nf) + 1, sizeof *removed);
+  memcpy(removed, s->body_removed, sizeof *removed * (size_t)nb0);
+  int *standin = xcalloc((size_t)nb0 + 1, sizeof *standin);
+  /* a rig: the kept side of a joint or a two-body force to a removed body
+     is held by the ground at the same place, or by the removed body's
+     stand-in that follows its recorded motion */
+  for (int k = 0; s->rig && k < nj0 + nf; k++) {
+    bool joint = k < nj0;
+    const int *body = joint ? model->joints[k].body : model->forces[k - nj0].body;
+    if (body[1] < 0 || removed[body[0]] == removed[body[1]]) continue;
+    int side = removed[body[0]] ? 0 : 1, gone = body[side];
+    if (body[1 - side] == 0) continue; /* between a removed body and the ground: goes */
+    int to = 0;
+    if (s->motion) {
+      if (!s->motion[gone]) {
+        diag_error(model->path, s->motion_loc, "the rig's recorded motion '%s' lacks body '%s': the full model must "
+                   "output its position (type: position, no point) and its orientation (type: orientation)",
+                   s->motion_path, model->bodies[gone].name);
+        continue;
+      }
+      if (!standin[gone])
+        standin[gone] = add_driven_chain(model, gone, s->motion[gone], s->nmotion_rows, s->motion_loc);
+      to = standin[gone];
+    }
+    int *changed = joint ? model->joints[k].body : model->forces[k - nj0].body;
+    int *node = joint ? model->joints[k].node : model->forces[k - nj0].node;
+    changed[side] = to;
+    node[side] = -1;
+    pruned_add(model, joint ? "joint '%s' attached to %s (rig)" : "force '%s' attached to %s (rig)",
+               joint ? model->joints[k].name : model->forces[k - nj0].name,
+               to ? "a body driven by the recorded motion" : "the ground");
+  }
+  free(standin);
+  int nb = model->nbodies, nj = model->njoints, nd = model->ndrivers;
   /* bodies that hung on the ground only through removed ones go too */
   bool *before = xcalloc((size_t)nb, sizeof *before), *after = xcalloc((size_t)nb, sizeof *after);
   bool *none = xcalloc((size_t)nb, sizeof *none);
@@ -579,6 +842,7 @@ static void prune_model(ir_model *model, chosen_scene *s) {
   model->noutputs = count;
   free(body_to); free(joint_to); free(driver_to);
   free(joint_gone); free(driver_gone); free(force_gone);
+  free(removed);
 }
 
 /* A scene that changes a flexible body's modes (or makes it rigid) drops
@@ -635,7 +899,11 @@ void apply_scene(ir_model *model, chosen_scene *s) {
     free(from);
     s->flex[b] = NULL;
   }
-  bool prunes = s->nreplace > 0;
+  if (s->motion_path) { /* the input hash covers the recorded motion */
+    model->included = grow(model->included, model->nincluded, 1, sizeof *model->included);
+    model->included[model->nincluded++] = xstrdup(s->motion_path);
+  }
+  bool prunes = s->nreplace > 0 || s->rig;
   for (int b = 1; b < model->nbodies; b++) prunes = prunes || s->body_removed[b];
   if (prunes)
     prune_model(model, s);
@@ -643,6 +911,7 @@ void apply_scene(ir_model *model, chosen_scene *s) {
 }
 
 void free_chosen_scene(chosen_scene *s, int nbodies) {
+  if (s->found) nbodies = s->nbodies;
   free_scene_flex(s->flex, nbodies);
   free(s->name);
   free_outputs(s->outputs, s->noutputs);
@@ -651,5 +920,8 @@ void free_chosen_scene(chosen_scene *s, int nbodies) {
   free(s->force_off);
   free(s->body_removed);
   free(s->replace);
+  for (int b = 0; s->motion && b < nbodies; b++) free(s->motion[b]);
+  free(s->motion);
+  free(s->motion_path);
   memset(s, 0, sizeof *s);
 }
