@@ -38,6 +38,18 @@ static int hash_file(const char *path, uint64_t *h) {
   return 0;
 }
 
+/* a scene's modal changes drop the outputs of modes gone (scene.c); 2 when out of memory */
+static int drop_modal_outputs(ir_model *ir, const flex_product *flex) {
+  if (!ir->scene) return 0;
+  int *modes = calloc((size_t)ir->nbodies + 1, sizeof *modes);
+  if (!modes) return 2;
+  for (int b = 0; b < ir->nbodies; b++)
+    modes[b] = ir->bodies[b].kind == BODY_FLEXIBLE ? flex->data[b].flex.nm : 0;
+  scene_drop_modal_outputs(ir, modes);
+  free(modes);
+  return 0;
+}
+
 /* the input hash (unit.h); 0 after reporting if the file cannot be read */
 static int hash_input(mbc_unit *u) {
   uint64_t h = 0xcbf29ce484222325ULL;
@@ -120,7 +132,7 @@ static int bind_runtime(mbc_unit *u) {
   ir_model *B = ir_read(u->path, u->scene);
   flex_product flexB;
   memset(&flexB, 0, sizeof flexB);
-  lmodel *LB = B && !flex_reduce(B, &flexB) ? lower_model(B, &flexB) : NULL;
+  lmodel *LB = B && !flex_reduce(B, &flexB) && !drop_modal_outputs(B, &flexB) ? lower_model(B, &flexB) : NULL;
   diag_mute(0);
   params_set_overrides(NULL, NULL, 0);
   int rc = 0;
@@ -165,7 +177,7 @@ static int bind_runtime(mbc_unit *u) {
     if (pool == BIND_PRM) u->lowered->prm_runtime[index] = 1;
   }
   for (int i = 0; i < A->nuses; i++)
-    if (A->uses[i].uses_runtime && !bound[i] && !same(A->uses[i].value, B->uses[i].value)) {
+    if (A->uses[i].uses_runtime && !A->uses[i].pruned && !bound[i] && !same(A->uses[i].value, B->uses[i].value)) {
       diag_error(u->path, A->uses[i].loc,
                  "this value depends on run-time parameter '%s', but the generated code fixes it at compile "
                  "time (run-time parameters can set force-element constants: stiffness, damping, preload, free "
@@ -198,14 +210,7 @@ done:
 
 int mbc_unit_finish(mbc_unit *u, int verbose) {
   if (flex_reduce(u->ir, &u->flex)) return 2;
-  if (u->ir->scene) { /* a scene's modal changes drop the outputs of modes gone */
-    int *modes = calloc((size_t)u->ir->nbodies + 1, sizeof *modes);
-    if (!modes) return 2;
-    for (int b = 0; b < u->ir->nbodies; b++)
-      modes[b] = u->ir->bodies[b].kind == BODY_FLEXIBLE ? u->flex.data[b].flex.nm : 0;
-    scene_drop_modal_outputs(u->ir, modes);
-    free(modes);
-  }
+  if (drop_modal_outputs(u->ir, &u->flex)) return 2;
   u->lowered = lower_model(u->ir, &u->flex);
   if (!u->lowered) {
     if (!diag_errors()) diag_error(u->path, (ir_loc){0, 0}, "out of memory while lowering");

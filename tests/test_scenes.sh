@@ -89,6 +89,11 @@ sed 's/chain_full.csv/chain_full_bad.csv/' scenes/chain.yaml > scenes/chain_bad.
 "$MBCC" check scenes/chain_bad.yaml --scene rig_driven > /dev/null 2> e.txt && err "a motion without the orientation is accepted"
 grep -q "lacks body 'middle'" e.txt || err "no error for a recorded motion without the body: $(cat e.txt)"
 
+# a run-time parameter used only by a pruned force: the scene still builds
+sed 's/^name: chain/name: chainp\nparameters:\n  k_tip: {value: 50, runtime: true}/; s/    stiffness: 50/    stiffness: k_tip/' \
+  scenes/chain.yaml > scenes/chainp.yaml
+"$MBCC" check scenes/chainp.yaml --scene no_lower > /dev/null 2> e.txt || err "a run-time parameter of a pruned force breaks the scene: $(cat e.txt)"
+
 # a flexible body made rigid by a scene: its modal output is dropped with a note
 "$MBCC" run scenes/flexible_rigid.yaml --scene rigid_rod --end 0.002 -o fr.csv > /dev/null 2> notes3.txt ||
   err "the rigid_rod scene does not run: $(cat notes3.txt)"

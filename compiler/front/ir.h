@@ -351,6 +351,7 @@ typedef struct {
   ir_expr *expr;
   double value;
   bool uses_runtime;
+  bool pruned;        /* in a body, joint, driver or force that the scene removed */
 } ir_expr_use;
 
 /* --- the model ------------------------------------------------------------------------- */

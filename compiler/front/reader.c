@@ -1509,6 +1509,7 @@ static void parse_model(reader *r, yaml_node_t *root, const char *chosen_scene_n
   yaml_node_t *jof_list = r->scene.found ? r->scene.jof_list : base_sim.jof_list;
   if (r->scene.found)
     apply_scene(model, &r->scene);
+  scene_mark_pruned_uses(r, root);
   check_drivers(r);
   mark_virtual_joints(r, jof_list);
 }

@@ -556,6 +556,16 @@ static void reach_ground(const ir_model *model, const bool *removed, bool *reach
   }
 }
 
+/* remembers a pruned element for scene_mark_pruned_uses */
+static void gone_add(chosen_scene *s, const char *section, const char *name) {
+  size_t old = s->gone ? strlen(s->gone) : 0, add = strlen(section) + strlen(name) + 2;
+  char *text = xcalloc(old + add + 1, 1);
+  if (old) memcpy(text, s->gone, old);
+  snprintf(text + old, add + 1, "%s %s\n", section, name);
+  free(s->gone);
+  s->gone = text;
+}
+
 static void drop_output(ir_model *model, const ir_output *o, const char *why) {
   diag_note(model->path, o->loc, "output '%s' dropped: %s (scene '%s')", o->name, why, model->scene);
   pruned_add(model, "output '%s' (%s)", o->name, why);
@@ -715,11 +725,13 @@ static void prune_model(ir_model *model, chosen_scene *s) {
   for (int b = 1; b < nb; b++)
     if (removed[b]) {
       pruned_add(model, "body '%s'%s", model->bodies[b].name, "");
+      gone_add(s, "bodies", model->bodies[b].name);
     } else if (before[b] && !after[b]) {
       removed[b] = true;
       diag_note(model->path, model->bodies[b].loc, "body '%s' removed too: it hung on the ground only "
                 "through removed bodies (scene '%s')", model->bodies[b].name, model->scene);
       pruned_add(model, "body '%s' (%s)", model->bodies[b].name, "connected only through removed bodies");
+      gone_add(s, "bodies", model->bodies[b].name);
     }
   free(before);
   free(after);
@@ -730,7 +742,10 @@ static void prune_model(ir_model *model, chosen_scene *s) {
   bool *force_gone = xcalloc((size_t)nf + 1, sizeof *force_gone);
   for (int j = 0; j < nj; j++) {
     joint_gone[j] = removed[model->joints[j].body[0]] || removed[model->joints[j].body[1]];
-    if (joint_gone[j]) pruned_add(model, "joint '%s'%s", model->joints[j].name, "");
+    if (joint_gone[j]) {
+      pruned_add(model, "joint '%s'%s", model->joints[j].name, "");
+      gone_add(s, "joints", model->joints[j].name);
+    }
   }
   /* joints made bushings: a force at the joint's point, in its axes */
   ir_force *bushings = xcalloc((size_t)s->nreplace + 1, sizeof *bushings);
@@ -762,12 +777,18 @@ static void prune_model(ir_model *model, chosen_scene *s) {
   }
   for (int d = 0; d < nd; d++) {
     driver_gone[d] = joint_gone[model->drivers[d].joint];
-    if (driver_gone[d]) pruned_add(model, "driver '%s' (%s)", model->drivers[d].name, "its joint is gone");
+    if (driver_gone[d]) {
+      pruned_add(model, "driver '%s' (%s)", model->drivers[d].name, "its joint is gone");
+      gone_add(s, "drivers", model->drivers[d].name);
+    }
   }
   for (int f = 0; f < nf; f++) {
     const ir_force *F = &model->forces[f];
     force_gone[f] = removed[F->body[0]] || (F->body[1] >= 0 && removed[F->body[1]]);
-    if (force_gone[f]) pruned_add(model, "force '%s'%s", F->name, "");
+    if (force_gone[f]) {
+      pruned_add(model, "force '%s'%s", F->name, "");
+      gone_add(s, "forces", F->name);
+    }
   }
 
   /* compact, renumbering bodies, joints and drivers */
@@ -910,6 +931,36 @@ void apply_scene(ir_model *model, chosen_scene *s) {
   model->sim = s->sim;
 }
 
+/* The fields written with parameters inside pruned elements (their YAML
+ * text) are marked, so that run-time parameter binding does not look for
+ * them in the generated code. */
+void scene_mark_pruned_uses(reader *r, yaml_node_t *root) {
+  ir_model *model = r->model;
+  const char *gone = r->scene.gone;
+  if (gone == NULL || model->nuses == 0 || root == NULL || root->type != YAML_MAPPING_NODE) return;
+  for (yaml_node_pair_t *p = root->data.mapping.pairs.start; p < root->data.mapping.pairs.top; p++) {
+    yaml_node_t *section = node_at(r, p->key), *map = node_at(r, p->value);
+    if (section->type != YAML_SCALAR_NODE || map->type != YAML_MAPPING_NODE) continue;
+    for (yaml_node_pair_t *q = map->data.mapping.pairs.start; q < map->data.mapping.pairs.top; q++) {
+      yaml_node_t *key = node_at(r, q->key), *value = node_at(r, q->value);
+      if (key->type != YAML_SCALAR_NODE) continue;
+      char line[2 * SHOWN_SIZE];
+      snprintf(line, sizeof line, "%.*s %.*s\n", (int)scalar_length(section), scalar_text(section),
+               (int)scalar_length(key), scalar_text(key));
+      bool found = false;
+      for (const char *at = gone; (at = strstr(at, line)) != NULL && !found; at++)
+        found = at == gone || at[-1] == '\n';
+      if (!found) continue;
+      long from = ((long)value->start_mark.line + 1) * 100000 + (long)value->start_mark.column + 1;
+      long to = ((long)value->end_mark.line + 1) * 100000 + (long)value->end_mark.column + 1;
+      for (int i = 0; i < model->nuses; i++) {
+        long at = (long)model->uses[i].loc.line * 100000 + model->uses[i].loc.col;
+        if (at >= from && at <= to) model->uses[i].pruned = true;
+      }
+    }
+  }
+}
+
 void free_chosen_scene(chosen_scene *s, int nbodies) {
   if (s->found) nbodies = s->nbodies;
   free_scene_flex(s->flex, nbodies);
@@ -923,5 +974,6 @@ void free_chosen_scene(chosen_scene *s, int nbodies) {
   for (int b = 0; s->motion && b < nbodies; b++) free(s->motion[b]);
   free(s->motion);
   free(s->motion_path);
+  free(s->gone);
   memset(s, 0, sizeof *s);
 }

@@ -48,6 +48,7 @@ typedef struct {
   double **motion;    /* rig with a recorded motion: per removed body its rows
                          t, x, y, z, e0, e1, e2, e3 (NULL: not recorded) */
   int nmotion_rows;
+  char *gone;         /* "section name\n" of each body, joint, driver, force pruned */
   int nbodies;        /* the model's bodies when the scene was read (the
                          per-body arrays' length; pruning changes the model's) */
   char *motion_path;
