@@ -207,6 +207,34 @@ static int build_with_sets(const options *o, mbc_unit *u) {
   return rc;
 }
 
+/* check --scene: what the scene pruned, and the system's size in the base
+ * model and in the scene (the base model built without its report) */
+static void check_scene_report(const options *o, const mbc_unit *u) {
+  const char *pruned = u->ir->pruned;
+  printf("  pruned by the scene%s\n", pruned ? ":" : ": nothing");
+  for (const char *line = pruned; line && *line;) {
+    const char *end = strchr(line, '\n');
+    int length = end ? (int)(end - line) : (int)strlen(line);
+    printf("    %.*s\n", length, line);
+    line += length + (end != NULL);
+  }
+  mbc_unit base;
+  if (mbc_unit_build(&base, o->model, NULL, 0)) {
+    printf("  base model        does not build (see above)\n");
+    return;
+  }
+  const mb_model *b = &base.lowered->m, *s = &u->lowered->m;
+  printf("  size              base model -> scene '%s'\n", u->ir->scene);
+  printf("    bodies          %d -> %d\n", b->nbody, s->nbody);
+  printf("    n               %d -> %d\n", b->n, s->n);
+  printf("    nnz(K)          %d -> %d\n", b->nnz, s->nnz);
+  if (base.have_plan && u->have_plan) {
+    printf("    nnz(L)          %ld -> %ld\n", base.plan.nnzL, u->plan.nnzL);
+    printf("    LDL^T flops     %.0f -> %.0f per factorization\n", base.plan.flops, u->plan.flops);
+  }
+  mbc_unit_free(&base);
+}
+
 static int cmd_check(const options *o) {
   mbc_unit u;
   if (build(o, &u, 1)) return 2;
@@ -268,7 +296,7 @@ static int cmd_check(const options *o) {
     int nused = 0;
     for (int i = 0; i < ir->nuses; i++) {
       if (!expr_names(ir->uses[i].expr, k)) continue;
-      printf("%s%d:%d", nused++ ? ", " : ", used at ", ir->uses[i].loc.line, ir->uses[i].loc.col);
+      printf("%s%d:%d", nused++ ? ", " : ", used at ", diag_loc_in_file(ir->uses[i].loc).line, ir->uses[i].loc.col);
     }
     for (int j = 0; j < ir->nparams; j++)
       if (ir->params[j].expr && expr_names(ir->params[j].expr, k))
@@ -276,6 +304,7 @@ static int cmd_check(const options *o) {
     if (!nused) printf(", unused");
     printf("\n");
   }
+  if (ir->scene) check_scene_report(o, &u);
   mbc_unit_free(&u);
   return 0;
 }

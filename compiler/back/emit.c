@@ -49,8 +49,10 @@ static const char *comment_text(const char *s) {
 /* file:line:col of a YAML element, the file named in its own directory (as
  * mbc_unit's file_name): the comment does not depend on how the path was typed */
 static void loc_comment(FILE *f, const lmodel *L, ir_loc loc) {
-  const char *slash = strrchr(L->ir->path, '/');
-  fprintf(f, "%s:%d:%d", comment_text(slash ? slash + 1 : L->ir->path), loc.line, loc.col);
+  const char *file = diag_loc_file(loc, L->ir->path); /* an included file's element: that file */
+  const char *slash = strrchr(file, '/');
+  loc = diag_loc_in_file(loc);
+  fprintf(f, "%s:%d:%d", comment_text(slash ? slash + 1 : file), loc.line, loc.col);
 }
 
 static void emit_flex_tables(emit_ctx *cx, int b);

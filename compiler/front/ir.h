@@ -375,6 +375,7 @@ typedef struct {
   ir_expr *expr;
   double value;
   bool uses_runtime;
+  bool pruned;        /* in a body, joint, driver or force that the scene removed */
 } ir_expr_use;
 
 /* --- the model ------------------------------------------------------------------------- */
@@ -398,6 +399,9 @@ typedef struct {
   int nparams;
   ir_expr_use *uses;    /* fields given by expressions over parameters, in reading order */
   int nuses, cap_uses;
+  char **included;   /* files read through 'include:' (the input hash covers them) */
+  char *pruned;      /* what the scene removed, one line each ("body 'x'"), or NULL */
+  int nincluded;
 } ir_model;
 
 /* Read and validate a model, applying scene 'scene' (NULL: the base model).

@@ -28,6 +28,7 @@
 #include "quantities.h"
 #include "reader.h"
 #include "scene.h"
+#include "compose.h"
 #include "sim.h"
 #include "element.h"
 #include "yaml_map.h"
@@ -527,13 +528,15 @@ void parse_modal_settings(mapping *m, ir_flex *fx) {
   }
 }
 
-/* a file name given in the model, relative to the model file's directory */
+/* a file name given in the model, relative to the directory of the file
+ * that names it (the model file or an included one) */
 static char *model_relative_path(reader *r, const yaml_node_t *n) {
-  const char *slash = strrchr(r->path, '/');
+  const char *base = diag_loc_file(loc_of(n), r->path);
+  const char *slash = strrchr(base, '/');
   const char *fname = scalar_text(n);
-  size_t dl = (slash && fname[0] != '/') ? (size_t)(slash - r->path + 1) : 0;
+  size_t dl = (slash && fname[0] != '/') ? (size_t)(slash - base + 1) : 0;
   char *path = xcalloc(dl + scalar_length(n) + 1, 1);
-  memcpy(path, r->path, dl);
+  memcpy(path, base, dl);
   memcpy(path + dl, fname, scalar_length(n));
   return path;
 }
@@ -1977,7 +1980,8 @@ static void parse_model(reader *r, yaml_node_t *root, const char *chosen_scene_n
   mapping top;
   map_open(&top, r, root, file_start, "the model");
   static const char *const keys[] = {"name",    "gravity", "bodies",     "joints", "drivers",
-                                     "forces",  "outputs", "simulation", "scenes", "parameters", NULL};
+                                     "forces",  "outputs", "simulation", "scenes", "parameters",
+                                     "include", "templates", NULL};
   map_check_keys(&top, keys);
   /* first: every numeric field may name parameters */
   parse_parameters(r, map_get(&top, "parameters"));
@@ -2052,6 +2056,7 @@ static void parse_model(reader *r, yaml_node_t *root, const char *chosen_scene_n
   yaml_node_t *jof_list = r->scene.found ? r->scene.jof_list : base_sim.jof_list;
   if (r->scene.found)
     apply_scene(model, &r->scene);
+  scene_mark_pruned_uses(r, root);
   check_drivers(r);
   mark_virtual_joints(r, jof_list);
 }
@@ -2186,12 +2191,22 @@ static ir_model *read_model(const char *path, const char *scene) {
       }
       model = xcalloc(1, sizeof *model);
       model->path = xstrdup(path);
+      compose_files files;
+      bool composed = compose_document(path, &doc, &files);
+      if (files.count > 0) {
+        model->included = xcalloc((size_t)files.count, sizeof *model->included);
+        for (int i = 0; i < files.count; i++) model->included[i] = xstrdup(files.path[i]);
+        model->nincluded = files.count;
+      }
+      compose_files_free(&files);
+      root = yaml_document_get_root_node(&doc);
       reader r;
       memset(&r, 0, sizeof r);
       r.path = path;
       r.doc = &doc;
       r.model = model;
-      parse_model(&r, root, scene);
+      if (composed)
+        parse_model(&r, root, scene);
       table_free(&r.names);
       free_chosen_scene(&r.scene, model->nbodies);
       free(r.param_nodes);
@@ -2223,7 +2238,7 @@ ir_model *ir_read(const char *path, const char *scene) {
   return model;
 }
 
-static void free_flex(ir_flex *fx) {
+void free_flex(ir_flex *fx) {
   if (fx == NULL)
     return;
   free(fx->nodes);
@@ -2247,6 +2262,10 @@ void ir_free(ir_model *m) {
   if (m == NULL)
     return;
   free(m->path);
+  for (int i = 0; i < m->nincluded; i++)
+    free(m->included[i]);
+  free(m->included);
+  free(m->pruned);
   free(m->name);
   free(m->scene);
   for (int i = 0; i < m->nbodies; i++) {
