@@ -156,7 +156,7 @@ static int runtime_count(const mbc_unit *u) {
 }
 
 static void limit_literal(FILE *f, double x) {
-  if (isinf(x)) fputs(x < 0 ? "-HUGE_VAL" : "HUGE_VAL", f);
+  if (isinf(x)) fputs(x < 0 ? "(mb_real)-HUGE_VAL" : "(mb_real)HUGE_VAL", f); /* explicit: no narrowing in C++ */
   else num(f, x);
 }
 
