@@ -119,4 +119,13 @@ sed 's#parts/lower_link.yaml#c1.yaml#' compose/include_pendulum.yaml > compose/c
 printf 'name: m\nbodies:\n  b:\n    <<: 5\n    type: rigid\n' > merge_bad.yaml
 "$MBCC" check merge_bad.yaml > /dev/null 2> e.txt; st=$?
 [ $st = 2 ] && grep -q "^merge_bad.yaml:4:9: error: '<<' merges a mapping" e.txt || err "bad merge (exit $st): $(cat e.txt)"
+# outputs that name forces and bodies follow the pruning: after removing
+# body a (and its spring ka), fb is kb's tension (the weight of b, 19.62 N, at
+# rest) and cm is b's x (1); fa and the relative output from a are dropped
+"$MBCC" run scenes/prune_outputs.yaml --scene only_b -o prune.csv --plot none --quiet 2> notes.txt ||
+  err "run prune_outputs only_b failed: $(cat notes.txt)"
+[ "$(head -1 prune.csv)" = "t,fb,cm" ] || err "pruned outputs: columns $(head -1 prune.csv)"
+awk -F, 'NR > 1 { d = $2 - 19.62; if (d < 0) d = -d; if (d > 1e-6 || $3 != 1) bad = 1 } END { exit bad }' prune.csv ||
+  err "pruned outputs follow the wrong force or body: $(sed -n 2p prune.csv)"
+grep -q "output 'fa' dropped" notes.txt && grep -q "output 'rb' dropped" notes.txt || err "pruned outputs: notes $(cat notes.txt)"
 exit $fail

@@ -826,9 +826,11 @@ static void prune_model(ir_model *model, chosen_scene *s) {
   }
   model->ndrivers = count;
   ir_force *forces = xcalloc((size_t)nf + (size_t)nbushings + 1, sizeof *forces);
+  int *force_to = xcalloc((size_t)nf + 1, sizeof *force_to);
   count = 0;
   for (int f = 0; f < nf + nbushings; f++) {
     ir_force *F = f < nf ? &model->forces[f] : &bushings[f - nf];
+    if (f < nf) force_to[f] = force_gone[f] ? -1 : count;
     if (f < nf && force_gone[f]) {
       free(F->name); free(F->scale.table); free(F->stiffness.table); free(F->damping.table);
       continue;
@@ -852,17 +854,31 @@ static void prune_model(ir_model *model, chosen_scene *s) {
       why = "it refers to a removed or replaced joint";
     } else if (o->driver >= 0 && driver_to[o->driver] < 0) {
       why = "it refers to a removed driver";
+    } else if (o->kind == OUT_FORCE && force_to[o->force] < 0) {
+      why = "it refers to a removed force";
+    } else if (o->kind == OUT_RELATIVE && (body_to[o->rel_body] < 0 || body_to[o->frame_body] < 0)) {
+      why = "it is measured from, or in the axes of, a removed body";
+    } else if (o->kind == OUT_CENTER_OF_MASS) {
+      for (int i = 0; i < o->ncm_bodies; i++)
+        if (body_to[o->cm_bodies[i]] < 0) why = "its 'bodies' include a removed body";
     }
-    if (why) { drop_output(model, o, why); free(o->name); continue; }
+    if (why) { drop_output(model, o, why); free(o->name); free(o->cm_bodies); continue; }
     ir_output *to = &model->outputs[count++];
     *to = *o;
     if (to->body >= 0) to->body = body_to[to->body];
     if (to->joint >= 0) to->joint = joint_to[to->joint];
     if (to->driver >= 0) to->driver = driver_to[to->driver];
+    if (to->kind == OUT_FORCE) to->force = force_to[to->force];
+    if (to->kind == OUT_RELATIVE) {
+      to->rel_body = body_to[to->rel_body];
+      to->frame_body = body_to[to->frame_body];
+    }
+    if (to->kind == OUT_CENTER_OF_MASS)
+      for (int i = 0; i < to->ncm_bodies; i++) to->cm_bodies[i] = body_to[to->cm_bodies[i]];
   }
   model->noutputs = count;
   free(body_to); free(joint_to); free(driver_to);
-  free(joint_gone); free(driver_gone); free(force_gone);
+  free(joint_gone); free(driver_gone); free(force_gone); free(force_to);
   free(removed);
 }
 
