@@ -12,7 +12,7 @@ LIBS    := -lyaml -lcholmod -larpack -lklu -lamd -lcolamd -lbtf -lsuitesparsecon
 RT_INC  := -Iruntime/core -Iruntime/hosted
 RT_SRC  := runtime/core/model_generic.c runtime/core/mb_step.c \
            $(addprefix runtime/hosted/,solver_select.c genalpha.c solver_klu.c solver_dense.c \
-             solver_generic.c solver_ldl.c integrate.c driver.c ida.c bench.c)
+             solver_generic.c solver_ldl.c integrate.c equilibrium.c driver.c ida.c bench.c)
 # the compiler, one folder a stage: front (YAML -> IR), flex (FE models and
 # modal reduction), lower (IR -> coordinates, rows, pattern, assembly),
 # back (ordering, LDL^T plan, C emission), tools (trade)
@@ -22,7 +22,7 @@ CC_SRC  := $(wildcard compiler/*.c) $(foreach d,$(CC_DIRS),$(wildcard $(d)/*.c))
 B       ?= build
 DEPFLAGS = -MMD -MP
 
-.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser embedded man release-check  install scaling
+.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser embedded man release-check  install scaling chassis vehicle sweeps
 all: $(B)/mbcc $(B)/libmbrt.a $(B)/libmbrt_float.a
 
 # objects keep the source's folders: $(B)/rt/core/x.o, $(B)/cc/front/x.o
@@ -36,7 +36,7 @@ $(B)/libmbrt.a: $(patsubst runtime/%.c,$(B)/rt/%.o,$(RT_SRC))
 # the single-precision runtime (mbcc compile --real float): the emitted LDL^T
 # only, since KLU, LAPACK and SUNDIALS work in double
 RT_FLOAT_SRC := runtime/core/model_generic.c runtime/core/mb_step.c \
-                $(addprefix runtime/hosted/,solver_select.c solver_ldl.c integrate.c genalpha.c driver.c)
+                $(addprefix runtime/hosted/,solver_select.c solver_ldl.c integrate.c equilibrium.c genalpha.c driver.c)
 $(B)/rt-float/%.o: runtime/%.c
 	@mkdir -p $(@D)
 	$(CC) $(STD) $(WARN) $(CFLAGS) $(DEPFLAGS) -DMB_REAL_FLOAT $(RT_INC) -c $< -o $@
@@ -61,6 +61,11 @@ $(B)/mbcc: $(CC_OBJ) $(B)/libmbrt.a
 
 demo: all
 	$(B)/mbcc run models/slider_crank.yaml
+
+# the sports car's chassis FE model from the vehicle spec's recipe (section 10.2);
+# tests/test_chassis.sh checks that the committed file is what this writes
+chassis:
+	python3 scripts/sports_car_chassis.py models/sports_car_chassis.fe.yaml
 
 # the timing comparison of every path (scripts/bench.sh): writes docs/benchmarks.md
 bench: all
@@ -129,6 +134,11 @@ install: all
 
 include tests/tests.mk
 include docs/results.mk
+include docs/vehicle.mk
 
 clean:
 	rm -rf $(B) generated/*/ results
+
+# the design-of-experiments study (scripts/sweeps.sh): writes docs/sweeps.md and docs/img/sweep_*.png
+sweeps: all
+	MBCC=$(B)/mbcc bash scripts/sweeps.sh

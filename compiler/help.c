@@ -64,6 +64,9 @@ static const help_command commands[] = {
       {"--animate", "also write the browser animation NAME.html beside the CSV (see mbcc animate)"},
       {"--set NAME=VALUE", "a run-time parameter of the model (repeatable; not recompiled: the simulator "
                            "takes the value; docs/model-format.md, Parameters)"},
+      {"--equilibrium", "first move the positions to static equilibrium (forces at zero velocity, "
+                        "Newton on the constrained statics); the given velocities are kept. Reports "
+                        "the iterations and residuals; no equilibrium stops the run"},
       SIM_OPTIONS,
       {"--quiet", "print nothing but errors"}}},
     {"bench", "mbcc bench M.yaml [--scene S] [--csv FILE] [--reps N] [--paths a,b,...] [OPTIONS]",
@@ -129,6 +132,31 @@ static const help_command commands[] = {
       {"--ref-rtol R", "the reference's tolerance (default 1e-10)"},
       {"--workdir DIR", "keep the runs' files in DIR"},
       {"--quiet", "print the summary only"}}},
+    {"sweep", "mbcc sweep M.yaml --vary NAME=SPEC ... [--design full|lhs|oat] [--samples N] [--csv FILE] [OPTIONS]",
+     "run a design of experiments over a model's run-time parameters",
+     "Compiles the model once, writes one job per variant (the simulator with --set NAME=VALUE) to "
+     "DIR/jobs.txt and runs them with GNU parallel, locally or on other machines (--sshlogin, which "
+     "must share the file system), or writes a Slurm job array over the same list (--slurm). Then "
+     "merges the runs into one CSV: the run number, the parameters, the status and, per run, the "
+     "chosen statistics of its output columns (default: the maximum and minimum of each). A failed "
+     "run is marked failed with its reason on stderr, and the exit status is then 1. See "
+     "docs/sweeps.md.",
+     {{"--vary NAME=v1,v2,...", "a run-time parameter's values; NAME=lo:hi:n for n evenly spaced "
+                                "(lo:hi:n:log: logarithmically), NAME=lo:hi a range (lhs)"},
+      {"--design full|lhs|oat", "full factorial (default), Latin hypercube of --samples N runs, or one "
+                                "at a time from the middle values"},
+      {"--samples N", "lhs: the number of runs"}, {"--seed N", "lhs: the random seed (default 1)"},
+      {"--metric COLUMN:STAT", "a result per run; STAT max, min, maxabs, final, mean or rms (repeatable)"},
+      {"--set NAME=VALUE", "a run-time parameter fixed for every run"},
+      {"--dir DIR", "the jobs, the design and the runs' files (default: sweeps/NAME/)"},
+      {"--csv FILE", "the merged results (default: DIR/sweep.csv)"},
+      {"--jobs N, -j N", "runs at once (default: one per core)"},
+      {"--sshlogin LOGINS", "GNU parallel's --sshlogin: run on these machines"},
+      {"--slurm FILE", "write a Slurm job-array script instead of running"},
+      {"--merge DIR", "merge the runs of DIR again (e.g. after the Slurm array)"},
+      {"--scene S", "apply scene S of the model file"},
+      {"--end T, --rtol R, ...", "the simulation options of mbcc run"},
+      {"--quiet", "print nothing but errors"}}},
     {"help", "mbcc help [CMD]",
      "this help; mbcc CMD --help is the same as mbcc help CMD",
      "mbcc --version prints the version; mbcc help --man prints the man page.",

@@ -1,4 +1,4 @@
-/* main.c: the mbcc command line: check, compile, run, bench, modes, plot, trade, animate. */
+/* main.c: the mbcc command line: check, compile, run, bench, modes, plot, trade, animate, sweep. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <math.h>
@@ -26,8 +26,10 @@
 #include "paths.h"
 #include "plot.h"
 #include "proc.h"
+#include "sweep.h"
 #include "trade.h"
 #include "unit.h"
+#include "vec3.h"
 #include "version.h"
 
 #ifndef MBCC_GEN_CFLAGS
@@ -63,6 +65,11 @@ static int parse_options(int argc, char **argv, options *o) {
     }
     if (!strcmp(a, "--quiet")) { o->quiet = 1; o->sim_args[o->nsim++] = a; continue; }
     if (!strcmp(a, "--animate")) { o->animate = 1; continue; }
+    if (!strcmp(a, "--equilibrium")) {
+      if (o->nsim + 1 > 30) { fprintf(stderr, "mbcc: error: too many options\n"); return 2; }
+      o->sim_args[o->nsim++] = a;
+      continue;
+    }
     if (!v) { fprintf(stderr, "mbcc: error: option '%s' needs a value\n", a); return 2; }
     i++;
     if (!strcmp(a, "--set")) {
@@ -132,12 +139,23 @@ static int refuse_input_as_output(const options *o, const char *out, const char 
   return 2;
 }
 
+/* --integrator genalpha or auto on the command line asks for the implicit
+ * method as the model's simulation block would: the pattern then carries
+ * the force elements' tangents (lower_pattern) */
+static void implicit_requested(const options *o, ir_model *ir) {
+  for (int i = 0; i + 1 < o->nsim; i++)
+    if (!strcmp(o->sim_args[i], "--integrator")) {
+      if (!strcmp(o->sim_args[i + 1], "genalpha")) ir->sim.integrator = INTEGRATOR_GENALPHA;
+      else if (!strcmp(o->sim_args[i + 1], "auto")) ir->sim.integrator = INTEGRATOR_AUTO;
+    }
+}
+
 /* the whole pipeline into *u, --animate's pose outputs added to the IR
  * between reading and the rest; 0, or 2 after reporting (u is then freed) */
 static int build_read(const options *o, mbc_unit *u, int verbose, int overridden) {
   mb_lapack_context = o->model; /* a LAPACK argument error names the model */
   if (mbc_unit_read(u, o->model, o->scene) || (o->animate && animate_add_pose_outputs(u->ir)) ||
-      ((u->overridden = overridden), mbc_unit_finish(u, verbose))) {
+      (implicit_requested(o, u->ir), 0) || ((u->overridden = overridden), mbc_unit_finish(u, verbose))) {
     mbc_unit_free(u);
     return 2;
   }
@@ -189,6 +207,34 @@ static int build_with_sets(const options *o, mbc_unit *u) {
   return rc;
 }
 
+/* check --scene: what the scene pruned, and the system's size in the base
+ * model and in the scene (the base model built without its report) */
+static void check_scene_report(const options *o, const mbc_unit *u) {
+  const char *pruned = u->ir->pruned;
+  printf("  pruned by the scene%s\n", pruned ? ":" : ": nothing");
+  for (const char *line = pruned; line && *line;) {
+    const char *end = strchr(line, '\n');
+    int length = end ? (int)(end - line) : (int)strlen(line);
+    printf("    %.*s\n", length, line);
+    line += length + (end != NULL);
+  }
+  mbc_unit base;
+  if (mbc_unit_build(&base, o->model, NULL, 0)) {
+    printf("  base model        does not build (see above)\n");
+    return;
+  }
+  const mb_model *b = &base.lowered->m, *s = &u->lowered->m;
+  printf("  size              base model -> scene '%s'\n", u->ir->scene);
+  printf("    bodies          %d -> %d\n", b->nbody, s->nbody);
+  printf("    n               %d -> %d\n", b->n, s->n);
+  printf("    nnz(K)          %d -> %d\n", b->nnz, s->nnz);
+  if (base.have_plan && u->have_plan) {
+    printf("    nnz(L)          %ld -> %ld\n", base.plan.nnzL, u->plan.nnzL);
+    printf("    LDL^T flops     %.0f -> %.0f per factorization\n", base.plan.flops, u->plan.flops);
+  }
+  mbc_unit_free(&base);
+}
+
 static int cmd_check(const options *o) {
   mbc_unit u;
   if (build(o, &u, 1)) return 2;
@@ -226,7 +272,17 @@ static int cmd_check(const options *o) {
            rigid ? "rigid (no modes)" : coupling[m->body[b].flex->coupling]);
     printf("    frequencies (Hz):");
     for (int j = 0; j < m->body[b].nm; j++) printf(" %.6g", fm->freq_hz[j]);
-    printf("\n    mass %.6g kg, damping ratios:", m->body[b].flex->mass);
+    /* the centre of mass, global at t = 0 (undeformed): r + A S0 / m */
+    const ir_body *B = &L->ir->bodies[b + 1];
+    const mb_flex *fl = m->body[b].flex;
+    double A[9], cg[3];
+    quaternion_to_matrix(B->orientation, A);
+    for (int i = 0; i < 3; i++)
+      cg[i] = B->position[i] + (fl->mass > 0 ? (A[3 * i] * fl->S0[0] + A[3 * i + 1] * fl->S0[1] +
+                                                A[3 * i + 2] * fl->S0[2]) / fl->mass : 0);
+    printf("\n    mass %.6g kg, centre of mass [%.6g, %.6g, %.6g] (global, undeformed)\n", fl->mass,
+           fabs(cg[0]) < 1e-12 ? 0 : cg[0], fabs(cg[1]) < 1e-12 ? 0 : cg[1], fabs(cg[2]) < 1e-12 ? 0 : cg[2]);
+    printf("    damping ratios:");
     for (int j = 0; j < m->body[b].nm; j++)
       printf(" %.3g", m->body[b].flex->damping[j] / (2 * 2 * MB_PI * fm->freq_hz[j] * sqrt(m->body[b].flex->Mff[j * m->body[b].nm + j])));
     printf("\n");
@@ -240,7 +296,7 @@ static int cmd_check(const options *o) {
     int nused = 0;
     for (int i = 0; i < ir->nuses; i++) {
       if (!expr_names(ir->uses[i].expr, k)) continue;
-      printf("%s%d:%d", nused++ ? ", " : ", used at ", ir->uses[i].loc.line, ir->uses[i].loc.col);
+      printf("%s%d:%d", nused++ ? ", " : ", used at ", diag_loc_in_file(ir->uses[i].loc).line, ir->uses[i].loc.col);
     }
     for (int j = 0; j < ir->nparams; j++)
       if (ir->params[j].expr && expr_names(ir->params[j].expr, k))
@@ -248,6 +304,7 @@ static int cmd_check(const options *o) {
     if (!nused) printf(", unused");
     printf("\n");
   }
+  if (ir->scene) check_scene_report(o, &u);
   mbc_unit_free(&u);
   return 0;
 }
@@ -397,6 +454,7 @@ static void settings_from_ir(const ir_sim *s, mb_settings *set) {
   set->rtol = s->rtol; set->atol = s->atol; set->min_step = s->min_step; set->max_step = s->max_step;
   set->stabilization = (int)s->stabilization;
   set->alpha = s->baumgarte_alpha; set->beta = s->baumgarte_beta;
+  set->equilibrium = s->equilibrium;
 }
 
 /* --- the rebuild stamp: a content hash of what goes into an executable --- */
@@ -562,7 +620,7 @@ static int check_run_options(const options *o) {
   mb_settings_default(&scratch);
   for (int i = 0; i < o->nsim; i++) {
     const char *a = o->sim_args[i], *v = i + 1 < o->nsim ? o->sim_args[i + 1] : "";
-    if (!strcmp(a, "--quiet")) continue;
+    if (!strcmp(a, "--quiet") || !strcmp(a, "--equilibrium")) continue;
     i++;
     if (!strcmp(a, "--columns")) continue;
     if (!strcmp(a, "--precision")) { /* the CSV writer's (driver.c), checked the same way */
@@ -600,9 +658,43 @@ static void default_csv(const options *o, const char *name, char *csv, size_t n)
   snprintf(csv, n, "%s/%s.csv", dir, name);
 }
 
+/* emit the model and compile its simulator generated/NAME/NAME_sim (reused
+ * when nothing it is made of changed); its path in exe_final.  The unit is
+ * kept in *u for the caller to free; 0, or 2 after reporting (u freed). */
+static int build_simulator(const options *o, char *exe_final, size_t n, mbc_unit *u) {
+  char dir[4096];
+  options o2 = *o;
+  o2.outdir = NULL;
+  memset(u, 0, sizeof *u);
+  int rc = cmd_compile(&o2, dir, sizeof dir, u);
+  if (!rc) rc = check_sets(o, u->ir);
+  if (rc) { mbc_unit_free(u); return rc; }
+  const lmodel *L = u->lowered;
+  /* the simulator under a name of this process's own (two runs of one
+     model at once must not build over each other), then put in place */
+  char exe[8420], src_main[8400];
+  snprintf(exe_final, n, "%s/%s_sim", dir, L->m.name);
+  snprintf(exe, sizeof exe, "%s.XXXXXX", exe_final);
+  snprintf(src_main, sizeof src_main, "%s/main.c", dir);
+  int efd = mkstemp(exe);
+  if (efd < 0) {
+    fprintf(stderr, "mbcc: error: cannot write '%s': %s\n", exe_final, strerror(errno));
+    mbc_unit_free(u);
+    return 2;
+  }
+  close(efd);
+  proc_cleanup_add(exe);
+  int reused = 0;
+  rc = compile_generated_into(dir, L->m.name, src_main, exe, exe_final, NULL, o->quiet, o->real_float, &reused);
+  /* built under its own name and renamed into place whole, or reused */
+  unlink(exe);
+  proc_cleanup_remove(exe);
+  if (rc) { mbc_unit_free(u); return 2; }
+  return 0;
+}
+
 static int cmd_run(const options *o) {
   if (check_run_options(o)) return 2;
-  char dir[4096];
   mbc_unit u;
   char csv[4096];
   if (o->csv) snprintf(csv, sizeof csv, "%s", o->csv);
@@ -631,36 +723,10 @@ static int cmd_run(const options *o) {
     rc = refuse_input_as_output(o, csv, "the results file");
     if (!rc) rc = mb_main(na, args, &Lg->m, &set, s->solver == SOLVER_DENSE ? "dense" : "klu");
   } else {
-    options o2 = *o;
-    o2.outdir = NULL;
-    memset(&u, 0, sizeof u);
-    rc = cmd_compile(&o2, dir, sizeof dir, &u);
-    if (!rc) rc = check_sets(o, u.ir);
-    if (rc) { mbc_unit_free(&u); return rc; }
-    const lmodel *L = u.lowered;
-    if (!o->csv) default_csv(o, L->m.name, csv, sizeof csv);
-    /* compile the generated code against the runtime library */
-    /* the simulator under a name of this process's own (two runs of one
-       model at once must not build over each other), then put in place */
-    char exe[8420], exe_final[8400], src_main[8400];
-    snprintf(exe_final, sizeof exe_final, "%s/%s_sim", dir, L->m.name);
-    snprintf(exe, sizeof exe, "%s.XXXXXX", exe_final);
-    snprintf(src_main, sizeof src_main, "%s/main.c", dir);
-    int efd = mkstemp(exe);
-    if (efd < 0) {
-      fprintf(stderr, "mbcc: error: cannot write '%s': %s\n", exe_final, strerror(errno));
-      mbc_unit_free(&u);
-      return 2;
-    }
-    close(efd);
-    proc_cleanup_add(exe);
-    int reused = 0;
-    if (compile_generated_into(dir, L->m.name, src_main, exe, exe_final, NULL, o->quiet, o->real_float, &reused)) {
-      unlink(exe);
-      proc_cleanup_remove(exe);
-      mbc_unit_free(&u);
-      return 2;
-    }
+    char exe_final[8400];
+    rc = build_simulator(o, exe_final, sizeof exe_final, &u);
+    if (rc) return rc;
+    if (!o->csv) default_csv(o, u.lowered->m.name, csv, sizeof csv);
     char *args[40 + 2 * 64];
     int na = 0;
     args[na++] = exe_final;
@@ -674,9 +740,6 @@ static int cmd_run(const options *o) {
       if (strcmp(o->sim_args[i], "--columns")) args[na++] = (char *)o->sim_args[i];
       else i++;
     args[na] = NULL;
-    /* built under its own name and renamed into place whole, or reused */
-    unlink(exe);
-    proc_cleanup_remove(exe);
     if (refuse_input_as_output(o, csv, "the results file")) rc = 2;
     else rc = run_command(args);
   }
@@ -770,6 +833,173 @@ static int cmd_plot(int argc, char **argv) {
   return plot_files(nfiles, files, png, columns, quiet);
 }
 
+
+/* mbcc sweep M.yaml --vary NAME=SPEC ... : compile once, run the design's
+ * variants of the run-time parameters with GNU parallel (or write a Slurm
+ * job array), merge the results; mbcc sweep --merge DIR merges again */
+static int cmd_sweep(int argc, char **argv) {
+  sweep_plan p;
+  memset(&p, 0, sizeof p);
+  p.design = SWEEP_FULL;
+  p.seed = 1;
+  const char *dir = NULL, *csv = NULL, *sshlogin = NULL, *slurm = NULL, *merge = NULL;
+  int jobs = 0, quiet = 0, rc = 2;
+  char *rest[80 + 2 * 64], *fixed[64 + 2 * 64];
+  int nrest = 0, nfixed = 0;
+  rest[nrest++] = argv[0];
+  rest[nrest++] = argv[1];
+  for (int i = 2; i < argc; i++) {
+    const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+    int takes = !strcmp(a, "--vary") || !strcmp(a, "--design") || !strcmp(a, "--samples") ||
+                !strcmp(a, "--seed") || !strcmp(a, "--metric") || !strcmp(a, "--dir") ||
+                !strcmp(a, "--csv") || !strcmp(a, "--jobs") || !strcmp(a, "-j") ||
+                !strcmp(a, "--sshlogin") || !strcmp(a, "--slurm") || !strcmp(a, "--merge");
+    if (!takes) {
+      if (!strcmp(a, "--quiet")) quiet = 1;
+      if (nrest >= 78 + 2 * 64) { fprintf(stderr, "mbcc: error: too many options\n"); goto done; }
+      rest[nrest++] = argv[i];
+      continue;
+    }
+    if (!v) { fprintf(stderr, "mbcc: error: option '%s' needs a value\n", a); goto done; }
+    i++;
+    char *end;
+    if (!strcmp(a, "--vary")) {
+      if (p.nvar == SWEEP_MAX_VARS) { fprintf(stderr, "mbcc: error: at most %d --vary\n", SWEEP_MAX_VARS); goto done; }
+      if (sweep_parse_vary(v, &p.var[p.nvar])) { p.nvar++; goto done; }
+      for (int k = 0; k < p.nvar; k++)
+        if (!strcmp(p.var[k].name, p.var[p.nvar].name)) {
+          fprintf(stderr, "mbcc: error: '%s' is varied twice\n", p.var[k].name);
+          p.nvar++;
+          goto done;
+        }
+      p.nvar++;
+    } else if (!strcmp(a, "--design")) {
+      if (!strcmp(v, "full")) p.design = SWEEP_FULL;
+      else if (!strcmp(v, "lhs")) p.design = SWEEP_LHS;
+      else if (!strcmp(v, "oat")) p.design = SWEEP_OAT;
+      else { fprintf(stderr, "mbcc: error: '--design' must be full, lhs or oat, got '%s'\n", v); goto done; }
+    } else if (!strcmp(a, "--samples")) {
+      long n = strtol(v, &end, 10);
+      if (*end || n < 1 || n > SWEEP_MAX_RUNS) {
+        fprintf(stderr, "mbcc: error: '--samples' needs a whole number from 1 to %d, got '%s'\n", SWEEP_MAX_RUNS, v);
+        goto done;
+      }
+      p.samples = (int)n;
+    } else if (!strcmp(a, "--seed")) {
+      p.seed = strtoull(v, &end, 10);
+      if (*end || !*v) { fprintf(stderr, "mbcc: error: '--seed' needs a whole number, got '%s'\n", v); goto done; }
+    } else if (!strcmp(a, "--metric")) {
+      if (p.nmetric == SWEEP_MAX_METRICS) { fprintf(stderr, "mbcc: error: at most %d --metric\n", SWEEP_MAX_METRICS); goto done; }
+      p.metric[p.nmetric++] = v;
+    } else if (!strcmp(a, "--jobs") || !strcmp(a, "-j")) {
+      long n = strtol(v, &end, 10);
+      if (*end || n < 1 || n > 4096) { fprintf(stderr, "mbcc: error: '%s' needs a number of jobs from 1 to 4096, got '%s'\n", a, v); goto done; }
+      jobs = (int)n;
+    } else if (!strcmp(a, "--dir")) dir = v;
+    else if (!strcmp(a, "--csv")) csv = v;
+    else if (!strcmp(a, "--sshlogin")) sshlogin = v;
+    else if (!strcmp(a, "--slurm")) slurm = v;
+    else merge = v;
+  }
+  char csv_default[4200];
+  if (merge) {
+    if (!csv) { snprintf(csv_default, sizeof csv_default, "%.4000s/sweep.csv", merge); csv = csv_default; }
+    rc = sweep_merge(merge, &p, csv, quiet);
+    goto done;
+  }
+  if (!p.nvar) { fprintf(stderr, "mbcc: error: mbcc sweep needs at least one --vary NAME=...\n"); goto done; }
+  options o;
+  rest[nrest] = NULL;
+  if (parse_options(nrest, rest, &o)) goto done;
+  if (strcmp(o.path, "generated")) { fprintf(stderr, "mbcc: error: a sweep runs the generated simulator (drop '--path')\n"); goto done; }
+  if (o.outdir) { fprintf(stderr, "mbcc: error: a sweep writes its runs to --dir DIR and the merged results to --csv FILE (not -o)\n"); goto done; }
+  if (check_run_options(&o)) goto done;
+  /* the simulation options of the runs, as mbcc run passes them, and the
+     --set values every run shares */
+  for (int i = 0; i < o.nset; i++) {
+    fixed[nfixed++] = "--set";
+    fixed[nfixed++] = (char *)o.set_args[i];
+  }
+  for (int i = 0; i < o.nsim; i++) {
+    if (!strcmp(o.sim_args[i], "--quiet")) continue;
+    if (!strcmp(o.sim_args[i], "--columns") || !strcmp(o.sim_args[i], "--precision")) {
+      if (!strcmp(o.sim_args[i], "--columns")) { i++; continue; }
+    }
+    if (nfixed >= 62 + 2 * 64) { fprintf(stderr, "mbcc: error: too many options\n"); goto done; }
+    fixed[nfixed++] = (char *)o.sim_args[i];
+  }
+  fixed[nfixed] = NULL;
+  double *table = NULL;
+  int nrun = 0;
+  double baseline[SWEEP_MAX_VARS], pmin[SWEEP_MAX_VARS], pmax[SWEEP_MAX_VARS];
+  for (int k = 0; k < p.nvar; k++) baseline[k] = NAN;
+  mbc_unit u;
+  char exe[8400];
+  if (build_simulator(&o, exe, sizeof exe, &u)) goto done;
+  char dir_default[4200];
+  if (!dir) {
+    mkdir("sweeps", 0777);
+    snprintf(dir_default, sizeof dir_default, "sweeps/%.4000s", u.lowered->m.name);
+    dir = dir_default;
+  }
+  char name[256];
+  snprintf(name, sizeof name, "%s", u.lowered->m.name);
+  /* every varied name a run-time parameter, not also fixed by --set; one
+     at a time starts from the parameters' values in the model */
+  for (int k = 0; k < p.nvar && rc == 2; k++) {
+    char suggest[128];
+    int ip = params_find(u.ir, p.var[k].name, suggest, sizeof suggest);
+    if (ip < 0) {
+      fprintf(stderr, "mbcc: error: --vary %s: the model has no parameter '%s'", p.var[k].name, p.var[k].name);
+      if (suggest[0]) fprintf(stderr, " (did you mean '%s'?)", suggest);
+      fputc('\n', stderr);
+      rc = 3;
+    } else if (!u.ir->params[ip].runtime) {
+      diag_error(u.ir->path, u.ir->params[ip].loc, "--vary %s: parameter '%s' is compile-time (give it "
+                 "'runtime: true' to vary it without recompiling)", p.var[k].name, p.var[k].name);
+      rc = 3;
+    } else {
+      baseline[k] = u.ir->params[ip].value;
+      pmin[k] = u.ir->params[ip].min;
+      pmax[k] = u.ir->params[ip].max;
+      for (int i = 0; i < o.nset; i++)
+        if (!strcmp(o.set_names[i], p.var[k].name)) {
+          fprintf(stderr, "mbcc: error: '%s' is both varied and set\n", p.var[k].name);
+          rc = 3;
+        }
+    }
+  }
+  mbc_unit_free(&u);
+  if (rc != 2) { rc = 2; goto done; }
+  if (sweep_design(&p, baseline, &table, &nrun)) goto done;
+  for (int r = 0; r < nrun; r++)
+    for (int k = 0; k < p.nvar; k++) {
+      double x = table[(long)r * p.nvar + k];
+      if (!(x >= pmin[k] && x <= pmax[k])) {
+        fprintf(stderr, "mbcc: error: --vary %s: the value %.17g is outside the parameter's range [%g, %g]\n",
+                p.var[k].name, x, pmin[k], pmax[k]);
+        free(table);
+        goto done;
+      }
+    }
+  if (sweep_write_jobs(dir, exe, &p, table, nrun, fixed)) { free(table); goto done; }
+  free(table);
+  if (!quiet) fprintf(stderr, "mbcc sweep: %d runs of %s; jobs in %s/jobs.txt\n", nrun, name, dir);
+  if (slurm) {
+    rc = sweep_write_slurm(dir, slurm, name, nrun, jobs);
+    if (!rc && !quiet)
+      fprintf(stderr, "mbcc sweep: wrote the Slurm job array %s: submit it with 'sbatch %s', then merge "
+              "with 'mbcc sweep --merge %s'\n", slurm, slurm, dir);
+    goto done;
+  }
+  if (sweep_run_parallel(dir, nrun, jobs, sshlogin, quiet)) goto done;
+  if (!csv) { snprintf(csv_default, sizeof csv_default, "%.4000s/sweep.csv", dir); csv = csv_default; }
+  rc = sweep_merge(dir, &p, csv, quiet);
+done:
+  sweep_plan_free(&p);
+  return rc;
+}
+
 int main(int argc, char **argv) {
   if (argc < 2) {
     usage();
@@ -799,6 +1029,7 @@ int main(int argc, char **argv) {
   if (!strcmp(cmd, "trade")) return cmd_trade(argc, argv);
   if (!strcmp(cmd, "animate")) return cmd_animate(argc, argv);
   if (!strcmp(cmd, "plot")) return cmd_plot(argc, argv);
+  if (!strcmp(cmd, "sweep")) return cmd_sweep(argc, argv);
   if (strcmp(cmd, "check") && strcmp(cmd, "compile") && strcmp(cmd, "run") && strcmp(cmd, "modes") &&
       strcmp(cmd, "bench")) {
     fprintf(stderr, "mbcc: error: unknown command '%s'\n", cmd);

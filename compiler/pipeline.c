@@ -7,6 +7,8 @@
 #include "diag.h"
 #include "params.h"
 #include "unit.h"
+#include "scene.h"
+#include <stdlib.h>
 
 /* FNV-1a 64 step over n bytes */
 static uint64_t fnv1a(uint64_t h, const unsigned char *b, size_t n) {
@@ -17,23 +19,45 @@ static uint64_t fnv1a(uint64_t h, const unsigned char *b, size_t n) {
   return h;
 }
 
-/* the input hash (unit.h); 0 after reporting if the file cannot be read */
-static int hash_input(mbc_unit *u) {
-  FILE *f = fopen(u->path, "rb");
+/* folds the bytes of file 'path' into *h; 2 after reporting */
+static int hash_file(const char *path, uint64_t *h) {
+  FILE *f = fopen(path, "rb");
   if (!f) {
-    diag_error(u->path, (ir_loc){0, 0}, "cannot read the model file again to hash it");
+    diag_error(path, (ir_loc){0, 0}, "cannot read the model file again to hash it");
     return 2;
   }
-  uint64_t h = 0xcbf29ce484222325ULL;
   unsigned char buf[8192];
   size_t n;
-  while ((n = fread(buf, 1, sizeof buf, f)) > 0) h = fnv1a(h, buf, n);
+  while ((n = fread(buf, 1, sizeof buf, f)) > 0) *h = fnv1a(*h, buf, n);
   int bad = ferror(f);
   fclose(f);
   if (bad) {
-    diag_error(u->path, (ir_loc){0, 0}, "cannot read the model file again to hash it");
+    diag_error(path, (ir_loc){0, 0}, "cannot read the model file again to hash it");
     return 2;
   }
+  return 0;
+}
+
+/* a scene's modal changes drop the outputs of modes gone (scene.c); 2 when out of memory */
+static int drop_modal_outputs(ir_model *ir, const flex_product *flex) {
+  if (!ir->scene) return 0;
+  int *modes = calloc((size_t)ir->nbodies + 1, sizeof *modes);
+  if (!modes) return 2;
+  for (int b = 0; b < ir->nbodies; b++)
+    modes[b] = ir->bodies[b].kind == BODY_FLEXIBLE ? flex->data[b].flex.nm : 0;
+  scene_drop_modal_outputs(ir, modes);
+  free(modes);
+  return 0;
+}
+
+/* the input hash (unit.h); 0 after reporting if the file cannot be read */
+static int hash_input(mbc_unit *u) {
+  uint64_t h = 0xcbf29ce484222325ULL;
+  if (hash_file(u->path, &h)) return 2;
+  /* included files, and the recorded motion of a rig, after the model's
+     own bytes (a model without them hashes as before) */
+  for (int i = 0; i < u->ir->nincluded; i++)
+    if (hash_file(u->ir->included[i], &h)) return 2;
   h = fnv1a(h, (const unsigned char *)"", 1);
   if (u->scene) h = fnv1a(h, (const unsigned char *)u->scene, strlen(u->scene));
   u->input_hash = h;
@@ -108,7 +132,7 @@ static int bind_runtime(mbc_unit *u) {
   ir_model *B = ir_read(u->path, u->scene);
   flex_product flexB;
   memset(&flexB, 0, sizeof flexB);
-  lmodel *LB = B && !flex_reduce(B, &flexB) ? lower_model(B, &flexB) : NULL;
+  lmodel *LB = B && !flex_reduce(B, &flexB) && !drop_modal_outputs(B, &flexB) ? lower_model(B, &flexB) : NULL;
   diag_mute(0);
   params_set_overrides(NULL, NULL, 0);
   int rc = 0;
@@ -153,7 +177,7 @@ static int bind_runtime(mbc_unit *u) {
     if (pool == BIND_PRM) u->lowered->prm_runtime[index] = 1;
   }
   for (int i = 0; i < A->nuses; i++)
-    if (A->uses[i].uses_runtime && !bound[i] && !same(A->uses[i].value, B->uses[i].value)) {
+    if (A->uses[i].uses_runtime && !A->uses[i].pruned && !bound[i] && !same(A->uses[i].value, B->uses[i].value)) {
       diag_error(u->path, A->uses[i].loc,
                  "this value depends on run-time parameter '%s', but the generated code fixes it at compile "
                  "time (run-time parameters can set force-element constants: stiffness, damping, preload, free "
@@ -186,6 +210,7 @@ done:
 
 int mbc_unit_finish(mbc_unit *u, int verbose) {
   if (flex_reduce(u->ir, &u->flex)) return 2;
+  if (drop_modal_outputs(u->ir, &u->flex)) return 2;
   u->lowered = lower_model(u->ir, &u->flex);
   if (!u->lowered) {
     if (!diag_errors()) diag_error(u->path, (ir_loc){0, 0}, "out of memory while lowering");

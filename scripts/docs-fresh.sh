@@ -16,7 +16,9 @@ cd "$(dirname "$0")/.." || exit 2
 table='docs/results.md|results|scripts/results.sh compiler runtime templates models/pendulum.yaml models/slider_crank.yaml models/slider_crank_flexible.yaml
 docs/benchmarks.md|bench|scripts/bench.sh compiler runtime templates models
 docs/trade.md|trade|scripts/trade.sh compiler runtime templates models/slider_crank_flexible.yaml
-docs/stability.md|extremes|tests/extremes compiler runtime templates'
+docs/stability.md|extremes|tests/extremes compiler runtime templates
+docs/vehicle.md|vehicle|scripts/vehicle.sh compiler runtime templates models/sports_car.yaml models/sports_car_chassis.fe.yaml
+docs/sweeps.md|sweeps|scripts/sweeps.sh compiler/tools/sweep.c runtime models/quarter_car.yaml'
 
 stale=0
 while IFS='|' read -r doc target sources; do

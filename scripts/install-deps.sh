@@ -48,6 +48,10 @@ present() {
     pkgconf)            command -v pkg-config ;;
     libclang-rt-14-dev) [ -e "$(clang -print-file-name=libclang_rt.fuzzer-x86_64.a)" ] ;; # make fuzz
     time)               [ -x /usr/bin/time ] ;;
+    python3)            command -v python3 ;;
+    parallel)           parallel --version | grep -q 'GNU parallel' ;;
+    openssh-server)     [ -x /usr/sbin/sshd ] ;;
+    openssh-client)     command -v ssh && command -v ssh-keygen ;;
     *)                  false ;;
   esac >/dev/null 2>&1
 }
@@ -59,10 +63,15 @@ present() {
 # compiler, newlib (libm) and qemu (tests/test_embedded.sh): 97 MB to download,
 # 924 MB installed, about 2 minutes of apt (measured).  pkgconf (pkg-config)
 # for tests/test_install.sh; libclang-rt-14-dev (libFuzzer) for make fuzz;
-# time (/usr/bin/time, peak memory) for make scaling.
+# time (/usr/bin/time, peak memory) for make scaling; python3 (the standard
+# library only) for make chassis and tests/test_chassis.sh; GNU parallel runs
+# the variants of mbcc sweep (tests/test_sweep.sh), which also runs them over
+# ssh to a private sshd on localhost (openssh-server, openssh-client; the
+# service itself is not needed).
 packages=(build-essential libyaml-dev libsuitesparse-dev liblapack-dev libblas-dev
           libcmocka-dev libsundials-dev libarpack2-dev gnuplot-nox clang nodejs npm chromium
-          gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm pkgconf libclang-rt-14-dev time)
+          gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm pkgconf libclang-rt-14-dev time python3
+          parallel openssh-server openssh-client)
 missing=()
 for p in "${packages[@]}"; do
   present "$p" || missing+=("$p")

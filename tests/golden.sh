@@ -50,7 +50,7 @@ emit() {
 
 for f in models/*.yaml tests/models/*.yaml tests/extremes/models/*.yaml; do
   base=$(basename "$f" .yaml)
-  case $base in _*) continue ;; esac
+  case $base in _*|*.fe) continue ;; esac  # examples; FE files (fe_file)
   for sc in base $(scenes_of "$f"); do
     # reader_example's base scene does not assemble (a reader fixture)
     [ "$base" = reader_example ] && [ "$sc" = base ] && continue

@@ -15,7 +15,7 @@ cd "$(dirname "$0")/.." || exit 1
 CC=${CC:-cc}
 n=0
 for f in "$root"/models/*.yaml "$root"/tests/models/*.yaml; do
-  case $(basename "$f") in _*) continue ;; esac
+  case $(basename "$f") in _*|*.fe.yaml) continue ;; esac  # examples; FE files (fe_file)
   scenes=$(awk '/^scenes:/ { s = 1; next } s && /^[^ #]/ { s = 0 } s && /^  [a-z0-9_]+:/ { sub(/:.*/, ""); print $1 }' "$f")
   for sc in base $scenes; do
     [ "$(basename "$f")" = reader_example.yaml ] && [ "$sc" = base ] && continue

@@ -3,12 +3,20 @@
  * dF1/dd and dF1/d(dd) with linear, power and table laws, and the field's 6x6
  * derivatives of marker 1's wrench with respect to its displacement, rotation,
  * velocity and angular velocity, at a large relative rotation (the inverse
- * left Jacobian of the rotation vector) and at a tiny one (its series). */
+ * left Jacobian of the rotation vector) and at a tiny one (its series).
+ * Then the assembled tangent of a whole model (mb_model_force_tangent: what
+ * generalized-alpha adds to its iteration matrix) against central differences
+ * of the model's generalized applied forces over every body column: springs,
+ * bushings and a beam on rigid bodies and on FE nodes of a flexible body. */
+// models: tangent_forces
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "support.h"
 #include "mb_model.h"
+#include "tangent_forces.h"
 
 /* R <- exp(a~) R (Rodrigues) */
 static void rotate_left(const double a[3], double R[9]) {
@@ -119,10 +127,119 @@ static void test_field_tangent(void **state) {
   check_field((const double[3]){0, 0, 0});
 }
 
+/* the force elements' generalized forces at (q, v): the generic evaluation
+ * with them minus the one without them (gravity, gyroscopic and elastic
+ * terms cancel) */
+static void element_forces(const mb_model *m, const double *q, const double *v, double *f) {
+  mb_model with = *m, without = *m;
+  without.nforce = 0;
+  double *Kx = calloc((size_t)m->nnz + 1, sizeof(double)), *r0 = calloc((size_t)m->n + 1, sizeof(double));
+  double *r1 = calloc((size_t)m->n + 1, sizeof(double)), *phi = calloc((size_t)m->nc + 1, sizeof(double));
+  double *nu = calloc((size_t)m->nc + 1, sizeof(double));
+  void *work = malloc(mb_model_worksize(m) + 16);
+  assert_non_null(work);
+  mb_generic_eval(&with, 0, q, v, Kx, r1, phi, nu, work);
+  mb_generic_eval(&without, 0, q, v, Kx, r0, phi, nu, work);
+  for (int i = 0; i < m->nv; i++) f[i] = r1[i] - r0[i];
+  free(Kx); free(r0); free(r1); free(phi); free(nu); free(work);
+}
+
+/* the dense nv x nv of kfac (-df/dq) + cfac (-df/dv) from the slots, and
+ * which entries the pattern has */
+static void assembled(const mb_model *m, const double *q, const double *v, double kfac, double cfac,
+                      double *T, char *has) {
+  double *Kx = calloc((size_t)m->nnz + 1, sizeof(double));
+  void *work = malloc(mb_model_worksize(m) + 16);
+  assert_non_null(work);
+  mb_model_force_tangent(m, 0, q, v, kfac, cfac, Kx, work);
+  int nv = m->nv;
+  memset(T, 0, sizeof(double) * (size_t)nv * (size_t)nv);
+  memset(has, 0, (size_t)nv * (size_t)nv);
+  for (int j = 0; j < nv; j++)
+    for (int p = m->Kp[j]; p < m->Kp[j + 1]; p++)
+      if (m->Ki[p] < nv) {
+        T[m->Ki[p] * nv + j] = Kx[p];
+        has[m->Ki[p] * nv + j] = 1;
+      }
+  free(Kx);
+  free(work);
+}
+
+/* central differences of -f over q (velocity space, q (+) e_j h) or over v;
+ * returns the relative Frobenius difference from T and checks that every
+ * nonzero difference quotient lies on the pattern */
+static double compare_fd(const mb_model *m, const double *q, const double *v, int over_v,
+                         const double *T, const char *has) {
+  int nv = m->nv;
+  double *fp = calloc((size_t)nv + 1, sizeof(double)), *fm = calloc((size_t)nv + 1, sizeof(double));
+  double *qq = malloc(sizeof(double) * ((size_t)m->nq + 1)), *vv = malloc(sizeof(double) * ((size_t)nv + 1));
+  double *dv = calloc((size_t)nv + 1, sizeof(double)), *D = calloc((size_t)nv * (size_t)nv + 1, sizeof(double));
+  const double h = 1e-6;
+  for (int j = 0; j < nv; j++)
+    for (int sgn = -1; sgn <= 1; sgn += 2) {
+      memcpy(qq, q, sizeof(double) * (size_t)m->nq);
+      memcpy(vv, v, sizeof(double) * (size_t)nv);
+      if (over_v) {
+        vv[j] += sgn * h;
+      } else {
+        memset(dv, 0, sizeof(double) * (size_t)nv);
+        dv[j] = sgn * h;
+        mb_model_qincrement(m, qq, dv);
+      }
+      element_forces(m, qq, vv, sgn > 0 ? fp : fm);
+      if (sgn > 0)
+        for (int i = 0; i < nv; i++) D[i * nv + j] = -(fp[i] - fm[i]) / (2 * h);
+    }
+  double num = 0, den = 0, scale = 0;
+  for (int k = 0; k < nv * nv; k++) scale = fmax(scale, fabs(D[k]));
+  for (int k = 0; k < nv * nv; k++) {
+    num += (T[k] - D[k]) * (T[k] - D[k]);
+    den += D[k] * D[k];
+    if (fabs(D[k]) > 1e-7 * scale && !has[k])
+      fail_msg("entry (%d, %d) = %g of the force tangent is not on the pattern", k / nv, k % nv, D[k]);
+  }
+  free(fp); free(fm); free(qq); free(vv); free(dv); free(D);
+  return sqrt(num / fmax(den, 1e-300));
+}
+
+/* Unstressed (t = 0 positions, no velocity: every element's force is zero)
+ * the omitted geometric terms, of order |force|, vanish and the stiffness
+ * must match to the differences' accuracy; the damping tangent is exact at
+ * any velocity (the forces are linear in it).  Loaded (positions moved by
+ * about 1e-3 of the elements' lengths) the geometric terms are about that
+ * fraction of the stiffness: 2e-3 bounds it. */
+static void test_model_tangent(void **state) {
+  (void)state;
+  const mb_model *m = &tangent_forces_model;
+  assert_non_null(m->force_tslot); /* the model asks for genalpha */
+  int nv = m->nv;
+  double *T = calloc((size_t)nv * (size_t)nv + 1, sizeof(double));
+  char *has = calloc((size_t)nv * (size_t)nv + 1, 1);
+  double *q = malloc(sizeof(double) * ((size_t)m->nq + 1)), *v = calloc((size_t)nv + 1, sizeof(double));
+  double *dv = calloc((size_t)nv + 1, sizeof(double));
+  memcpy(q, m->q0, sizeof(double) * (size_t)m->nq);
+  assembled(m, q, v, 1, 0, T, has);
+  double e_k0 = compare_fd(m, q, v, 0, T, has);
+  for (int i = 0; i < nv; i++) v[i] = urand(-1, 1);
+  assembled(m, q, v, 0, 1, T, has);
+  double e_c = compare_fd(m, q, v, 1, T, has);
+  for (int i = 0; i < nv; i++) { dv[i] = urand(-3e-4, 3e-4); v[i] = 0; }
+  mb_model_qincrement(m, q, dv);
+  assembled(m, q, v, 1, 0, T, has);
+  double e_k1 = compare_fd(m, q, v, 0, T, has);
+  printf("  relative difference from central differences: stiffness unstressed %.2e, damping %.2e, "
+         "stiffness loaded %.2e\n", e_k0, e_c, e_k1);
+  assert_true(e_k0 < 1e-6);
+  assert_true(e_c < 1e-6);
+  assert_true(e_k1 < 2e-3);
+  free(T); free(has); free(q); free(v); free(dv);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_spring_tangent),
       cmocka_unit_test(test_field_tangent),
+      cmocka_unit_test(test_model_tangent),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

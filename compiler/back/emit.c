@@ -49,8 +49,10 @@ static const char *comment_text(const char *s) {
 /* file:line:col of a YAML element, the file named in its own directory (as
  * mbc_unit's file_name): the comment does not depend on how the path was typed */
 static void loc_comment(FILE *f, const lmodel *L, ir_loc loc) {
-  const char *slash = strrchr(L->ir->path, '/');
-  fprintf(f, "%s:%d:%d", comment_text(slash ? slash + 1 : L->ir->path), loc.line, loc.col);
+  const char *file = diag_loc_file(loc, L->ir->path); /* an included file's element: that file */
+  const char *slash = strrchr(file, '/');
+  loc = diag_loc_in_file(loc);
+  fprintf(f, "%s:%d:%d", comment_text(slash ? slash + 1 : file), loc.line, loc.col);
 }
 
 static void emit_flex_tables(emit_ctx *cx, int b);
@@ -125,6 +127,10 @@ static const char *output_kind_name(mb_output_kind kind) {
   case MB_OUT_MODAL: return "MB_OUT_MODAL";
   case MB_OUT_MOMENTUM: return "MB_OUT_MOMENTUM";
   case MB_OUT_SECTION: return "MB_OUT_SECTION";
+  case MB_OUT_FORCE: return "MB_OUT_FORCE";
+  case MB_OUT_RELATIVE: return "MB_OUT_RELATIVE";
+  case MB_OUT_JOINT: return "MB_OUT_JOINT";
+  case MB_OUT_CENTER_OF_MASS: return "MB_OUT_CENTER_OF_MASS";
   case MB_OUT_TYRE: return "MB_OUT_TYRE";
   }
   return "0";
@@ -151,7 +157,7 @@ static int runtime_count(const mbc_unit *u) {
 }
 
 static void limit_literal(FILE *f, double x) {
-  if (isinf(x)) fputs(x < 0 ? "-HUGE_VAL" : "HUGE_VAL", f);
+  if (isinf(x)) fputs(x < 0 ? "(mb_real)-HUGE_VAL" : "(mb_real)HUGE_VAL", f); /* explicit: no narrowing in C++ */
   else num(f, x);
 }
 
@@ -267,6 +273,10 @@ static void emit_tables(emit_ctx *cx) {
       emit_flex_contract(cx, b);
     }
   if (L->nmodal_slot) int_array(f, "modal_slot", L->modal_slot, L->nmodal_slot);
+  if (L->force_tslot) { /* force tangents for the implicit method (mb_model_force_tangent) */
+    int_array(f, "force_tslot", L->force_tslot, m->nforce);
+    int_array(f, "tangent_slot", L->tangent_slot, L->ntangent_slot);
+  }
   for (int k = 0; k < m->nprofile; k++) {
     const mb_profile *p = &L->profile[k];
     if (p->kind != MB_PROFILE_TABLE) continue;
@@ -384,6 +394,13 @@ static void emit_tables(emit_ctx *cx) {
       if (o->driver_rotation) fputs(", .driver_rotation = 1", f);
       fprintf(f, ", .node = %d, .chord = {%d, %d}, .scale = ", o->node, o->chord[0], o->chord[1]);
       num(f, o->scale);
+      if (o->kind >= MB_OUT_FORCE && o->kind != MB_OUT_TYRE) { /* the fields of the newer kinds (zero for the others) */
+        fprintf(f, ",\n   .element = %d, .quantity = %d, .body2 = %d, .node2 = %d, .s2 = ", o->element,
+                o->quantity, o->body2, o->node2);
+        vec(f, o->s2, 3);
+        fprintf(f, ", .frame = %d, .jmarker = {%d, %d}, .joint_dofs = %d", o->frame, o->jmarker[0],
+                o->jmarker[1], o->joint_dofs);
+      }
       fprintf(f, ", .ncols = %d, .col = %d},\n", o->ncols, o->col);
     }
     fputs("};\n", f);
@@ -875,6 +892,8 @@ static void emit_source(emit_ctx *cx) {
     fprintf(f, "  .nparam = %d, .param_name = param_names, .param_value = param_values,\n"
                "  .param_min = param_min, .param_max = param_max, .set_params = set_params,\n", n);
   }
+  if (L->force_tslot)
+    fputs("  .force_tslot = force_tslot, .tangent_slot = tangent_slot,\n", f);
   fputs("};\n", f);
 }
 
@@ -896,6 +915,7 @@ static void settings_block(FILE *f, const ir_sim *s) {
   fprintf(f, "  s.stabilization = %s;",
           s->stabilization == STAB_PROJECTION ? "MB_STAB_PROJECTION"
           : s->stabilization == STAB_BAUMGARTE ? "MB_STAB_BAUMGARTE" : "MB_STAB_NONE");
+  if (s->equilibrium) fputs("\n  s.equilibrium = 1;", f); /* only when asked: other mains unchanged */
 }
 
 const char *emit_root_dir(void) {

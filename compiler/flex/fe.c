@@ -25,6 +25,8 @@
  *     (= rho A L^3/78 for Euler-Bernoulli) plus, for Timoshenko, half the
  *     section rotary inertia rho I L/2; torsion rho Ip L/2.  In body axes the
  *     node's rotary inertia is a full 3x3 block.
+ * A non-structural mass per length (nsm) adds to rho A in the translational
+ * and bending terms, not to the section rotary inertia or the torsion.
  * Point masses add m to the three translational diagonal terms of their node
  * and their 3x3 inertia to its rotational block, in either mass formulation. */
 #define _POSIX_C_SOURCE 200809L
@@ -133,6 +135,8 @@ static int beam_frame(const ir_flex *fx, int e, beam_el *el, fe_ctx *c) {
       {"Young's modulus E", b->E}, {"shear modulus G", b->G}, {"density rho", b->rho},
       {"area A", b->A}, {"second moment Iy", b->Iy}, {"second moment Iz", b->Iz},
       {"torsion constant J", b->J}};
+  if (!isfinite(b->nsm) || b->nsm < 0)
+    return fail_at(c, b->loc, "beam %d: the non-structural mass must be >= 0 (got %g)", e, b->nsm);
   /* an imported deck may have rods (no bending), no torsion or massless bars:
      a mechanism or a DOF without mass is then reported by the eigen-analysis */
   for (size_t i = 0; i < sizeof props / sizeof props[0]; i++)
@@ -218,7 +222,9 @@ static void beam_local(const ir_beam *b, beam_el *el) {
   memset(el->K, 0, sizeof el->K);
   memset(el->M, 0, sizeof el->M);
   int timo = b->theory == BEAM_TIMOSHENKO;
-  double rhoA = b->rho * b->A, Ip = b->Iy + b->Iz;
+  /* mass per length: the section's and the non-structural mass (on the axis:
+     no section rotary inertia, no torsion inertia) */
+  double rhoA = b->rho * b->A + b->nsm, Ip = b->Iy + b->Iz;
 #define KL(i, j) el->K[(j) * 12 + (i)]
 #define ML(i, j) el->M[(j) * 12 + (i)]
   /* axial (0, 6) and torsion (3, 9) */

@@ -3,6 +3,8 @@
 
 #include <stdbool.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
 static int error_count;
 static int warning_count;
@@ -24,11 +26,38 @@ static unsigned long long line_hash(const char *s) {
 
 static bool muted;
 void diag_mute(int on) { muted = on != 0; }
+static char *registered[DIAG_MAX_FILES + 1];
+static int nregistered;
+
+int diag_register_file(const char *path) {
+  for (int k = 1; k <= nregistered; k++)
+    if (strcmp(registered[k], path) == 0) return k;
+  if (nregistered == DIAG_MAX_FILES) return 0;
+  size_t length = strlen(path);
+  char *copy = malloc(length + 1);
+  if (copy == NULL) return 0;
+  memcpy(copy, path, length + 1);
+  registered[++nregistered] = copy;
+  return nregistered;
+}
+
+const char *diag_loc_file(ir_loc loc, const char *file) {
+  int k = loc.line > 0 ? loc.line / DIAG_FILE_LINES : 0;
+  return k >= 1 && k <= nregistered ? registered[k] : file;
+}
+
+ir_loc diag_loc_in_file(ir_loc loc) {
+  int k = loc.line > 0 ? loc.line / DIAG_FILE_LINES : 0;
+  if (k >= 1 && k <= nregistered) loc.line -= k * DIAG_FILE_LINES;
+  return loc;
+}
 
 static void print(const char *file, ir_loc loc, const char *severity,
                   const char *fmt, va_list ap) {
   if (muted) return;
   char line[2048];
+  file = diag_loc_file(loc, file);
+  loc = diag_loc_in_file(loc);
   int n = snprintf(line, sizeof line, "%s", file == NULL ? "mbcc" : file);
   if (loc.line > 0 && n >= 0 && (size_t)n < sizeof line)
     n += snprintf(line + n, sizeof line - (size_t)n, ":%d:%d", loc.line, loc.col > 0 ? loc.col : 1);

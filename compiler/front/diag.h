@@ -29,6 +29,20 @@ void diag_verror(const char *file, ir_loc loc, const char *fmt, va_list ap) DIAG
 void diag_vwarning(const char *file, ir_loc loc, const char *fmt, va_list ap) DIAG_PRINTF(3, 0);
 void diag_vnote(const char *file, ir_loc loc, const char *fmt, va_list ap) DIAG_PRINTF(3, 0);
 
+/* Elements of included files (include:) keep their file in the line number:
+ * line = DIAG_FILE_LINES * k + line for the k-th registered file, so that an
+ * ir_loc stays two ints.  A file is at most LIMIT_INPUT_BYTES long (fewer
+ * lines than DIAG_FILE_LINES); up to DIAG_MAX_FILES files. */
+#define DIAG_FILE_LINES (1 << 24)
+#define DIAG_MAX_FILES 100
+/* the number k of 'path' (registered once; a copy is kept), or 0 when the
+ * table is full */
+int diag_register_file(const char *path);
+/* the file a location is in ('file' for the model's own lines), and the
+ * location within that file */
+const char *diag_loc_file(ir_loc loc, const char *file);
+ir_loc diag_loc_in_file(ir_loc loc);
+
 int diag_errors(void);   /* errors reported so far (shown or not) */
 int diag_warnings(void); /* warnings reported so far */
 void diag_reset(void);

@@ -54,6 +54,8 @@ typedef struct {
   double A, Iy, Iz, J;     /* section: area, second moments about local y and z, torsion constant */
   double shear_y, shear_z; /* Timoshenko shear area ratios (A_s = ratio * A); 0 for Euler-Bernoulli */
   double yaxis[3];         /* unit local y of the section (perpendicular to the element), body axes */
+  double nsm;              /* non-structural mass per length, kg/m: lumped like rho A (translation and
+                              bending rotary inertia), none in torsion (it sits on the beam's axis) */
   ir_loc loc;
 } ir_beam;
 
@@ -110,6 +112,11 @@ typedef struct ir_flex {
   ir_rigid_link *links;    /* RBE2 */
   int nlinks;
   ir_fe_matrix *K_given, *M_given; /* Matrix Market: the whole K and M (instead of beams) */
+  char *fe_source;         /* a YAML FE file (fe_file: X.fe.yaml): the file the locations of nodes,
+                              beams and point masses refer to; NULL: the model file */
+  char **node_names;       /* named nodes (node_names: {J1: 16}): usable wherever a node number is */
+  int *node_name_index;
+  int nnode_names;
   double *w0, *wd0;        /* initial modal coordinates and rates (n0, nd0 of them), or NULL */
   int nw0, nwd0;
   ir_loc w0_loc, wd0_loc;
@@ -294,9 +301,16 @@ typedef enum {
   OUT_MOMENTUM,             /* system: linear and angular momentum (about the origin): 6 */
   OUT_SECTION,              /* flexible body: a beam's section forces at one end (6 or 1), or the
                                normal stress at a point of the section (1) */
+  OUT_FORCE,                /* force element: force and torque on its body 1 at its point: 6 or 1 */
+  OUT_RELATIVE,             /* motion of a marker relative to another, in a body's axes: 3 or 1 */
+  OUT_JOINT,                /* joint angle and/or travel from t = 0: 1 or 2 */
+  OUT_CENTER_OF_MASS,       /* system (or a subset of bodies): 3 or 1 */
   OUT_TYRE                  /* tyre force element: Fx Fy Fz Mx My Mz slip slip_angle camber
                                deflection (10 or 1) */
 } ir_output_kind;
+
+/* OUT_RELATIVE and OUT_CENTER_OF_MASS: what is measured */
+typedef enum { QUANTITY_POSITION, QUANTITY_VELOCITY, QUANTITY_ACCELERATION } ir_quantity;
 
 typedef struct {
   char *name;
@@ -316,7 +330,15 @@ typedef struct {
   int element, end;  /* SECTION: the beam (index into the body's beams) and its end (0: A, 1: B) */
   bool has_fiber;    /* SECTION: the stress at fiber (y, z) of the section, element axes */
   double fiber[2];
-  int force;         /* TYRE: index into ir_model.forces */
+  int force;         /* FORCE, TYRE: index into ir_model.forces; FORCE: component 6 is the tension */
+  ir_quantity quantity; /* RELATIVE, CENTER_OF_MASS */
+  int rel_body;      /* RELATIVE: the marker measured from ('relative_to'; 0: ground) */
+  int rel_node;      /*   its FE node, or -1 */
+  bool rel_has_point;
+  double rel_point[3]; /* its global point at t = 0 */
+  int frame_body;    /* RELATIVE: the body whose axes resolve the result; 0: global */
+  int *cm_bodies;    /* CENTER_OF_MASS: the bodies (indices into bodies), or NULL for all */
+  int ncm_bodies;
 } ir_output;
 
 /* --- simulation settings --------------------------------------------------------------- */
@@ -340,6 +362,7 @@ typedef struct {
   double baumgarte_alpha, baumgarte_beta; /* defaults 10, 10 */
   double rho_inf;            /* generalized-alpha; default 0.8 */
   ir_jof joints_on_flexible; /* default direct */
+  bool equilibrium;          /* static equilibrium before the run; default false */
 } ir_sim;
 
 /* --- parameters and expressions (compiler/front/params.c) ------------------------------ */
@@ -380,6 +403,7 @@ typedef struct {
   ir_expr *expr;
   double value;
   bool uses_runtime;
+  bool pruned;        /* in a body, joint, driver or force that the scene removed */
 } ir_expr_use;
 
 /* --- the model ------------------------------------------------------------------------- */
@@ -405,6 +429,9 @@ typedef struct {
   int nparams;
   ir_expr_use *uses;    /* fields given by expressions over parameters, in reading order */
   int nuses, cap_uses;
+  char **included;   /* files read through 'include:' (the input hash covers them) */
+  char *pruned;      /* what the scene removed, one line each ("body 'x'"), or NULL */
+  int nincluded;
 } ir_model;
 
 /* Read and validate a model, applying scene 'scene' (NULL: the base model).

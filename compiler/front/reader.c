@@ -28,6 +28,7 @@
 #include "quantities.h"
 #include "reader.h"
 #include "scene.h"
+#include "compose.h"
 #include "sim.h"
 #include "element.h"
 #include "yaml_map.h"
@@ -41,10 +42,30 @@ static bool is_null_scalar(const yaml_node_t *n) {
 }
 
 /* node index 'n' on flexible body b (checked against its node count when known) */
+/* a scalar that reads as a name (a letter or '_' first), not a number */
+static bool looks_like_name(const yaml_node_t *n) {
+  if (n->type != YAML_SCALAR_NODE || scalar_length(n) == 0) return false;
+  unsigned char c = (unsigned char)scalar_text(n)[0];
+  return isalpha(c) || c == '_';
+}
+
+/* the node that fx names n (node_names), or -1 after an error at n */
+static int named_node(reader *r, const yaml_node_t *n, const ir_flex *fx, const char *label) {
+  for (int i = 0; fx && i < fx->nnode_names; i++)
+    if (scalar_equals(n, fx->node_names[i])) return fx->node_name_index[i];
+  name_list l;
+  memset(&l, 0, sizeof l);
+  for (int i = 0; fx && i < fx->nnode_names; i++) name_list_add(&l, fx->node_names[i]);
+  error_at(r, loc_of(n), "%s: no node is named %s (%s%s)", label, show_node(r, n),
+           l.count ? "named nodes: " : "the FE model names no nodes: see 'node_names'", l.text);
+  return -1;
+}
+
 static int to_fe_node(reader *r, yaml_node_t *n, const ir_body *b) {
   double v;
   char label[SHOWN_SIZE];
   snprintf(label, sizeof label, "FE node of body '%s'", b->name);
+  if (b->flex && looks_like_name(n)) return named_node(r, n, b->flex, label);
   if (!to_number(r, n, label, &v)) return -1;
   if (b->flex && b->flex->node_ids) { /* an imported FE model: nodes by their ids */
     int k = v == floor(v) && fabs(v) < 1e15 ? fe_node_index(b->flex, (long)v) : -1;
@@ -237,8 +258,10 @@ static void parse_virtual_body(mapping *m, ir_body *b) {
   parse_shape(m, b);
 }
 
-/* A list of node indices, each < nnodes (nnodes < 0: not checked yet). */
-static int *to_node_list(reader *r, yaml_node_t *n, const char *label, int nnodes, int *count) {
+/* A list of node indices, each < nnodes (nnodes < 0: not checked yet), or
+ * names of nodes of fx (when fx is not NULL). */
+static int *to_node_list(reader *r, yaml_node_t *n, const char *label, const ir_flex *fx, int nnodes,
+                         int *count) {
   *count = 0;
   if (n->type != YAML_SEQUENCE_NODE) {
     error_at(r, loc_of(n), "%s: expected a list of node numbers, got %s", label, show_node(r, n));
@@ -251,6 +274,11 @@ static int *to_node_list(reader *r, yaml_node_t *n, const char *label, int nnode
     yaml_node_t *item = seq_item(r, n, i);
     char item_label[SHOWN_SIZE];
     snprintf(item_label, sizeof item_label, "item %d of %s", i + 1, label);
+    if (fx && looks_like_name(item)) {
+      int k = named_node(r, item, fx, item_label);
+      if (k >= 0) out[(*count)++] = k;
+      continue;
+    }
     if (!to_number(r, item, item_label, &v)) continue;
     if (v != floor(v) || v < 0 || (nnodes >= 0 && v >= nnodes) || v > LIMIT_COUNT) {
       error_at(r, loc_of(item), "%s: node %g does not exist (nodes are numbered 0 to %d)", label, v,
@@ -266,48 +294,162 @@ const char *const theory_names[] = {"euler_bernoulli", "timoshenko", NULL};
 static const char *const mass_kind_names[] = {"lumped", "consistent", NULL};
 static const char *const coupling_names[] = {"full", "partial", "constant", "rigid", NULL};
 
-/* section and material of a beam (fields of ir_beam other than the nodes) */
-void parse_beam_properties(reader *r, mapping *body, ir_beam *proto) {
-  yaml_node_t *n = map_require(body, "section", true, "a mapping {area, Iy, Iz, J, ...}");
-  if (n != NULL) {
-    mapping m;
-    if (map_open(&m, r, n, loc_of(n), "'section' of %s", body->what)) {
-      static const char *const keys[] = {"area", "Iy", "Iz", "J", "shear_y", "shear_z", "yaxis", NULL};
-      map_check_keys(&m, keys);
-      get_positive(&m, "area", true, &proto->A);
+/* A beam section: explicit A, Iy, Iz, J, or a shape that gives them, and
+ * the local axes: 'yaxis', 'zaxis' (FE models only) or the default rule. */
+typedef struct {
+  double A, Iy, Iz, J, shear_y, shear_z;
+  int axes;       /* 0: the default rule, 1: 'yaxis' given, 2: 'zaxis' given */
+  double axis[3]; /* the yaxis or zaxis given (global) */
+  bool ok;
+} section_def;
+
+typedef struct {
+  double E, G, rho;
+  bool ok;
+} material_def;
+
+static const char *const shape_names[] = {"box", "tube", NULL};
+
+/* Closed forms of the thin- and thick-walled sections (h along the local z
+ * axis): a rectangular box h x b with wall t, a circular tube of outer
+ * diameter d and wall t.  Torsion: Bredt's thin-walled closed section
+ * J = 4 Am^2 t / perimeter_m = 2 t hm^2 bm^2 / (hm + bm) on the wall's mid-line
+ * (hm = h - t, bm = b - t); a tube J = Iy + Iz (exact for a circular ring). */
+static void box_section(double h, double b, double t, section_def *s) {
+  double hi = h - 2 * t, bi = b - 2 * t, hm = h - t, bm = b - t;
+  s->A = h * b - hi * bi;
+  s->Iy = (b * h * h * h - bi * hi * hi * hi) / 12;
+  s->Iz = (h * b * b * b - hi * bi * bi * bi) / 12;
+  s->J = 2 * t * hm * hm * bm * bm / (hm + bm);
+}
+
+static void tube_section(double d, double t, section_def *s) {
+  double ro = d / 2, ri = d / 2 - t;
+  s->A = PI * (ro * ro - ri * ri);
+  s->Iy = s->Iz = PI * (ro * ro * ro * ro - ri * ri * ri * ri) / 4;
+  s->J = 2 * s->Iy;
+}
+
+static void parse_section(reader *r, yaml_node_t *n, const char *what, ir_beam_theory theory,
+                          bool allow_zaxis, section_def *s) {
+  memset(s, 0, sizeof *s);
+  mapping m;
+  if (map_open(&m, r, n, loc_of(n), "%s", what)) {
+    static const char *const keys[] = {"area", "Iy", "Iz", "J", "shear_y", "shear_z", "yaxis", "zaxis",
+                                       "shape", "h", "b", "t", "d", NULL};
+    map_check_keys(&m, keys);
+    if (!allow_zaxis) map_reject(&m, "zaxis", "%s: a beam force element takes 'yaxis'", what);
+    int shape = -1;
+    int errors = diag_errors();
+    if (get_choice(&m, "shape", "section shape", shape_names, false, &shape)) {
+      static const char *const explicit_keys[] = {"area", "Iy", "Iz", "J", NULL};
+      for (int i = 0; explicit_keys[i]; i++)
+        map_reject(&m, explicit_keys[i], "%s: '%s' comes from the 'shape' (give one or the other)", what,
+                   explicit_keys[i]);
+      double h = 0, b = 0, t = 0, d = 0;
+      get_positive(&m, "t", true, &t);
+      if (shape == 0) {
+        map_reject(&m, "d", "%s: a box has 'h', 'b' and 't'", what);
+        get_positive(&m, "h", true, &h);
+        get_positive(&m, "b", true, &b);
+        if (diag_errors() == errors && !(2 * t < fmin(h, b)))
+          error_at(r, m.loc, "%s: the wall t = %g must be less than half of h = %g and of b = %g", what, t, h, b);
+        else if (diag_errors() == errors)
+          box_section(h, b, t, s);
+      } else if (shape == 1) {
+        map_reject(&m, "h", "%s: a tube has 'd' and 't'", what);
+        map_reject(&m, "b", "%s: a tube has 'd' and 't'", what);
+        get_positive(&m, "d", true, &d);
+        if (diag_errors() == errors && !(2 * t < d))
+          error_at(r, m.loc, "%s: the wall t = %g must be less than half of d = %g", what, t, d);
+        else if (diag_errors() == errors)
+          tube_section(d, t, s);
+      }
+    } else {
+      static const char *const shape_keys[] = {"h", "b", "t", "d", NULL};
+      for (int i = 0; shape_keys[i]; i++)
+        map_reject(&m, shape_keys[i], "%s: '%s' belongs to a 'shape' (box: h, b, t; tube: d, t)", what,
+                   shape_keys[i]);
+      get_positive(&m, "area", true, &s->A);
       /* defaults: a solid circular section of that area */
-      proto->Iy = proto->Iz = proto->A * proto->A / (4 * PI);
-      proto->J = 2 * proto->Iy;
-      get_positive(&m, "Iy", false, &proto->Iy);
-      get_positive(&m, "Iz", false, &proto->Iz);
-      get_positive(&m, "J", false, &proto->J);
-      if (proto->theory == BEAM_TIMOSHENKO) proto->shear_y = proto->shear_z = 5.0 / 6.0;
-      get_positive(&m, "shear_y", false, &proto->shear_y);
-      get_positive(&m, "shear_z", false, &proto->shear_z);
-      if (proto->theory == BEAM_EULER_BERNOULLI) proto->shear_y = proto->shear_z = 0;
-      get_axis(&m, "yaxis", false, proto->yaxis);
+      s->Iy = s->Iz = s->A * s->A / (4 * PI);
+      s->J = 2 * s->Iy;
+      get_positive(&m, "Iy", false, &s->Iy);
+      get_positive(&m, "Iz", false, &s->Iz);
+      get_positive(&m, "J", false, &s->J);
     }
-    map_close(&m);
+    if (theory == BEAM_TIMOSHENKO) s->shear_y = s->shear_z = 5.0 / 6.0;
+    get_positive(&m, "shear_y", false, &s->shear_y);
+    get_positive(&m, "shear_z", false, &s->shear_z);
+    if (theory == BEAM_EULER_BERNOULLI) s->shear_y = s->shear_z = 0;
+    if (map_has(&m, "yaxis") && map_has(&m, "zaxis"))
+      error_at(r, m.loc, "%s: give either 'yaxis' or 'zaxis', not both", what);
+    else if (get_axis(&m, "yaxis", false, s->axis))
+      s->axes = 1;
+    else if (get_axis(&m, "zaxis", false, s->axis))
+      s->axes = 2;
+    s->ok = diag_errors() == errors;
+  }
+  map_close(&m);
+}
+
+static void parse_material(reader *r, yaml_node_t *n, const char *what, material_def *mt) {
+  memset(mt, 0, sizeof *mt);
+  mapping m;
+  if (map_open(&m, r, n, loc_of(n), "%s", what)) {
+    int errors = diag_errors();
+    static const char *const keys[] = {"E", "G", "nu", "density", NULL};
+    map_check_keys(&m, keys);
+    get_positive(&m, "E", true, &mt->E);
+    get_positive(&m, "density", true, &mt->rho);
+    double nu = 0.3;
+    bool has_nu = get_number(&m, "nu", false, &nu);
+    if (has_nu && !(nu > -1 && nu < 0.5))
+      error_at(r, m.last_loc, "'nu' must lie between -1 and 0.5 (got %g)", nu);
+    mt->G = mt->E / (2 * (1 + nu));
+    if (map_has(&m, "G")) {
+      if (has_nu) error_at(r, m.loc, "give either 'G' or 'nu', not both");
+      get_positive(&m, "G", false, &mt->G);
+    }
+    mt->ok = diag_errors() == errors;
+  }
+  map_close(&m);
+}
+
+static void apply_section(ir_beam *bm, const section_def *s) {
+  bm->A = s->A;
+  bm->Iy = s->Iy;
+  bm->Iz = s->Iz;
+  bm->J = s->J;
+  bm->shear_y = s->shear_y;
+  bm->shear_z = s->shear_z;
+}
+
+static void apply_material(ir_beam *bm, const material_def *mt) {
+  bm->E = mt->E;
+  bm->G = mt->G;
+  bm->rho = mt->rho;
+}
+
+/* section and material of a beam force element (fields of ir_beam other
+ * than the nodes; proto->theory set) */
+void parse_beam_properties(reader *r, mapping *body, ir_beam *proto) {
+  yaml_node_t *n = map_require(body, "section", true, "a mapping {area, Iy, Iz, J, ...} or {shape, ...}");
+  if (n != NULL) {
+    section_def s;
+    char what[200];
+    snprintf(what, sizeof what, "'section' of %s", body->what);
+    parse_section(r, n, what, proto->theory, false, &s);
+    apply_section(proto, &s);
+    if (s.axes == 1) memcpy(proto->yaxis, s.axis, sizeof s.axis);
   }
   n = map_require(body, "material", true, "a mapping {E, nu or G, density}");
   if (n != NULL) {
-    mapping m;
-    if (map_open(&m, r, n, loc_of(n), "'material' of %s", body->what)) {
-      static const char *const keys[] = {"E", "G", "nu", "density", NULL};
-      map_check_keys(&m, keys);
-      get_positive(&m, "E", true, &proto->E);
-      get_positive(&m, "density", true, &proto->rho);
-      double nu = 0.3;
-      bool has_nu = get_number(&m, "nu", false, &nu);
-      if (has_nu && !(nu > -1 && nu < 0.5))
-        error_at(r, m.last_loc, "'nu' must lie between -1 and 0.5 (got %g)", nu);
-      proto->G = proto->E / (2 * (1 + nu));
-      if (map_has(&m, "G")) {
-        if (has_nu) error_at(r, m.loc, "give either 'G' or 'nu', not both");
-        get_positive(&m, "G", false, &proto->G);
-      }
-    }
-    map_close(&m);
+    material_def mt;
+    char what[200];
+    snprintf(what, sizeof what, "'material' of %s", body->what);
+    parse_material(r, n, what, &mt);
+    apply_material(proto, &mt);
   }
 }
 
@@ -354,7 +496,7 @@ void parse_modal_settings(mapping *m, ir_flex *fx) {
         yaml_node_t *l = map_get(&mm, "list");
         if (l != NULL) {
           fx->select = MODES_LIST;
-          fx->list = to_node_list(r, l, "'list' of modes", -1, &fx->nlist);
+          fx->list = to_node_list(r, l, "'list' of modes", NULL, -1, &fx->nlist);
           for (int i = 0; i < fx->nlist; i++)
             if (fx->list[i] < 1) error_at(r, loc_of(l), "mode numbers start at 1");
         }
@@ -386,37 +528,110 @@ void parse_modal_settings(mapping *m, ir_flex *fx) {
   }
 }
 
-/* a file name given in the model, relative to the model file's directory */
+/* a file name given in the model, relative to the directory of the file
+ * that names it (the model file or an included one) */
 char *model_relative_path(reader *r, const yaml_node_t *n) {
-  const char *slash = strrchr(r->path, '/');
+  const char *base = diag_loc_file(loc_of(n), r->path);
+  const char *slash = strrchr(base, '/');
   const char *fname = scalar_text(n);
-  size_t dl = (slash && fname[0] != '/') ? (size_t)(slash - r->path + 1) : 0;
+  size_t dl = (slash && fname[0] != '/') ? (size_t)(slash - base + 1) : 0;
   char *path = xcalloc(dl + scalar_length(n) + 1, 1);
-  memcpy(path, r->path, dl);
+  memcpy(path, base, dl);
   memcpy(path + dl, fname, scalar_length(n));
   return path;
 }
 
 /* 'fe_file': a Nastran deck, or Matrix Market matrices with their DOF map
  * and nodes (compiler/flex/fe_import.h); the node positions, global */
+static char *read_file(const char *path, size_t *size, double limit);
+static void report_yaml_error(const char *path, const yaml_parser_t *parser, const char *data, size_t size);
+static double *parse_fe_model(mapping *m, ir_flex *fx);
+
+/* a file name that ends in .yaml or .yml */
+static bool is_yaml_name(const char *path) {
+  size_t n = strlen(path);
+  return (n > 5 && !strcmp(path + n - 5, ".yaml")) || (n > 4 && !strcmp(path + n - 4, ".yml"));
+}
+
+/* 'fe_file: X.fe.yaml': the FE beam model in a YAML file of its own, with the
+ * keys of an inline one; errors are located in that file.  Returns the node
+ * positions (global), or NULL after an error. */
+static double *parse_fe_yaml(reader *r, ir_body *b, ir_flex *fx, char *path) {
+  size_t size = 0;
+  double max_input = limit_value("MBCC_MAX_INPUT", LIMIT_INPUT_BYTES);
+  char *data = read_file(path, &size, max_input);
+  ir_loc nowhere = {0, 0};
+  if (data == NULL) {
+    diag_error(path, nowhere, "cannot read the FE file: %s", errno == EFBIG ? "larger than MBCC_MAX_INPUT" : strerror(errno));
+    free(path);
+    return NULL;
+  }
+  double *global = NULL;
+  yaml_parser_t parser;
+  if (!yaml_parser_initialize(&parser)) out_of_memory();
+  yaml_parser_set_input_string(&parser, (const unsigned char *)data, size);
+  yaml_document_t doc;
+  if (!yaml_parser_load(&parser, &doc)) {
+    report_yaml_error(path, &parser, data, size);
+  } else {
+    yaml_node_t *root = yaml_document_get_root_node(&doc);
+    reader fr; /* the FE file's own reader: its diagnostics name that file */
+    memset(&fr, 0, sizeof fr);
+    fr.path = path;
+    fr.doc = &doc;
+    fr.model = r->model;
+    mapping fm;
+    if (root == NULL) {
+      diag_error(path, file_start, "empty FE file (expected a mapping with 'nodes' and 'beams')");
+    } else if (map_open(&fm, &fr, root, loc_of(root), "the FE model of flexible body '%s'", b->name)) {
+      static const char *const keys[] = {"description", "line", "nodes", "beams", "section", "material",
+                                         "sections", "materials", "theory", "mass", "nonstructural_mass",
+                                         "point_masses", "node_names", NULL};
+      map_check_keys(&fm, keys);
+      map_get(&fm, "description");
+      int errors = diag_errors();
+      global = parse_fe_model(&fm, fx);
+      map_close(&fm);
+      if (diag_errors() > errors) {
+        free(global);
+        global = NULL;
+      }
+    } else {
+      map_close(&fm);
+    }
+    yaml_document_delete(&doc);
+  }
+  yaml_parser_delete(&parser);
+  free(data);
+  if (global) fx->fe_source = path;
+  else free(path);
+  return global;
+}
+
 static double *parse_fe_file(mapping *m, ir_body *b, ir_flex *fx) {
   reader *r = m->r;
   static const char *const fe_inline[] = {"line", "nodes", "beams", "section", "material", "theory",
-                                          "point_masses", "modal_file", NULL};
+                                          "point_masses", "modal_file", "sections", "materials",
+                                          "nonstructural_mass", "node_names", NULL};
   for (int i = 0; fe_inline[i]; i++)
     map_reject(m, fe_inline[i], "flexible body '%s': '%s' does not go with 'fe_file' (the FE file holds "
                "the model)", b->name, fe_inline[i]);
   yaml_node_t *n = map_get(m, "fe_file");
   double *global = NULL;
   int rc = 0;
-  if (n->type == YAML_SCALAR_NODE) {
+  if (n->type == YAML_SCALAR_NODE && is_yaml_name(scalar_text(n))) {
+    map_reject(m, "mass", "flexible body '%s': 'mass' goes in its FE file %s", b->name, scalar_text(n));
+    int errors = diag_errors();
+    global = parse_fe_yaml(r, b, fx, model_relative_path(r, n));
+    rc = diag_errors() > errors;
+  } else if (n->type == YAML_SCALAR_NODE) {
     char *path = model_relative_path(r, n);
     const char *dot = strrchr(path, '.');
     char ext[8] = "";
     for (size_t i = 0; dot && dot[i] && i + 1 < sizeof ext; i++) ext[i] = (char)tolower((unsigned char)dot[i]);
     if (strcmp(ext, ".bdf") && strcmp(ext, ".dat") && strcmp(ext, ".nas")) {
-      error_at(r, loc_of(n), "'fe_file': a Nastran deck ends in .bdf, .dat or .nas (got '%s'); Matrix "
-               "Market files are given as {stiffness, mass, dofs, nodes}", scalar_text(n));
+      error_at(r, loc_of(n), "'fe_file': a YAML FE model ends in .yaml or .yml, a Nastran deck in .bdf, .dat "
+               "or .nas (got '%s'); Matrix Market files are given as {stiffness, mass, dofs, nodes}", scalar_text(n));
       free(path);
       return NULL;
     }
@@ -451,8 +666,8 @@ static double *parse_fe_file(mapping *m, ir_body *b, ir_flex *fx) {
 /* node numbers of fx (imported: the file's node ids) */
 static int *to_flex_node_list(reader *r, yaml_node_t *n, const char *label, const ir_flex *fx, int nnodes,
                               int *count) {
-  if (!fx->node_ids) return to_node_list(r, n, label, nnodes, count);
-  int *out = to_node_list(r, n, label, -1, count);
+  if (!fx->node_ids) return to_node_list(r, n, label, fx, nnodes, count);
+  int *out = to_node_list(r, n, label, NULL, -1, count);
   for (int i = 0; out && i < *count; i++) {
     int k = fe_node_index(fx, out[i]);
     if (k < 0)
@@ -555,6 +770,379 @@ static void parse_initial_modes(mapping *m, ir_flex *fx) {
   }
 }
 
+/* the local y axis of an element p0 -> p1 (global) by its section's rule:
+ * 'yaxis' as given; 'zaxis': local z = zaxis made perpendicular to the
+ * element, or, for an element within ~18 degrees of it (|cos| > 0.95), the
+ * global axis least aligned with zaxis (x first), and y = z x x; default:
+ * global y, or global z for an element within ~26 degrees of y. */
+static void section_yaxis(const section_def *s, const double *p0, const double *p1, double y[3]) {
+  double d[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+  double len = norm3(d);
+  if (s->axes == 1) {
+    memcpy(y, s->axis, 3 * sizeof *y);
+    return;
+  }
+  if (s->axes == 2) {
+    double z[3];
+    memcpy(z, s->axis, sizeof z);
+    if (!(len > 0)) {
+      y[0] = 0, y[1] = 1, y[2] = 0;
+      return;
+    }
+    if (fabs(dot3(d, z)) > 0.95 * len) {
+      int k = 0;
+      for (int i = 1; i < 3; i++)
+        if (fabs(s->axis[i]) < fabs(s->axis[k])) k = i;
+      z[0] = z[1] = z[2] = 0;
+      z[k] = 1;
+    }
+    double c[3] = {z[1] * d[2] - z[2] * d[1], z[2] * d[0] - z[0] * d[2], z[0] * d[1] - z[1] * d[0]};
+    double n = norm3(c);
+    for (int i = 0; i < 3; i++) y[i] = c[i] / n;
+    return;
+  }
+  y[0] = 0, y[1] = 1, y[2] = 0;
+  if (len > 0 && fabs(d[1]) > 0.9 * len) y[1] = 0, y[2] = 1;
+}
+
+/* named sections or materials: 'sections: {NAME: {...}}' */
+typedef struct {
+  int n;
+  yaml_node_t **key;
+  section_def *sec;
+  material_def *mat;
+} named_defs;
+
+static void parse_named_defs(reader *r, mapping *m, const char *key, ir_beam_theory theory, named_defs *out) {
+  memset(out, 0, sizeof *out);
+  yaml_node_t *n = map_get(m, key);
+  if (n == NULL) return;
+  mapping dm;
+  if (map_open(&dm, r, n, loc_of(n), "'%s' of %s", key, m->what)) {
+    out->key = xcalloc((size_t)dm.npairs + 1, sizeof *out->key);
+    if (key[0] == 's') out->sec = xcalloc((size_t)dm.npairs + 1, sizeof *out->sec);
+    else out->mat = xcalloc((size_t)dm.npairs + 1, sizeof *out->mat);
+    for (int i = 0; i < dm.npairs; i++) {
+      yaml_node_t *k = map_key_node(&dm, i), *v = map_value_node(&dm, i);
+      if (dm.handled[i]) continue; /* a duplicate, reported */
+      if (k->type != YAML_SCALAR_NODE || !looks_like_name(k)) {
+        error_at(r, loc_of(k), "'%s': a name starts with a letter or '_' (got %s)", key, show_node(r, k));
+        continue;
+      }
+      char what[SHOWN_SIZE + 32];
+      snprintf(what, sizeof what, "%s '%s'", key[0] == 's' ? "section" : "material", show_node(r, k));
+      out->key[out->n] = k;
+      if (out->sec) parse_section(r, v, what, theory, true, &out->sec[out->n]);
+      else parse_material(r, v, what, &out->mat[out->n]);
+      out->n++;
+      dm.handled[i] = true;
+    }
+  }
+  map_close(&dm);
+}
+
+static int find_named_def(const named_defs *d, const yaml_node_t *name) {
+  for (int i = 0; i < d->n; i++)
+    if (name->type == YAML_SCALAR_NODE && scalar_length(name) == scalar_length(d->key[i]) &&
+        memcmp(scalar_text(name), scalar_text(d->key[i]), scalar_length(name)) == 0)
+      return i;
+  return -1;
+}
+
+static void free_named_defs(named_defs *d) {
+  free(d->key);
+  free(d->sec);
+  free(d->mat);
+}
+
+/* 'node_names: {J1: 16, ...}': names of nodes (numbers < nnodes) */
+static void parse_node_names(reader *r, mapping *m, ir_flex *fx) {
+  yaml_node_t *n = map_get(m, "node_names");
+  if (n == NULL) return;
+  mapping nm;
+  if (map_open(&nm, r, n, loc_of(n), "'node_names' of %s", m->what)) {
+    fx->node_names = xcalloc((size_t)nm.npairs + 1, sizeof *fx->node_names);
+    fx->node_name_index = xcalloc((size_t)nm.npairs + 1, sizeof *fx->node_name_index);
+    for (int i = 0; i < nm.npairs; i++) {
+      yaml_node_t *k = map_key_node(&nm, i), *v = map_value_node(&nm, i);
+      if (nm.handled[i]) continue;
+      nm.handled[i] = true;
+      if (k->type != YAML_SCALAR_NODE || !looks_like_name(k)) {
+        error_at(r, loc_of(k), "'node_names': a node's name starts with a letter or '_' (got %s)",
+                 show_node(r, k));
+        continue;
+      }
+      double v_num;
+      char label[SHOWN_SIZE + 32];
+      snprintf(label, sizeof label, "node '%s'", show_node(r, k));
+      if (!to_number(r, v, label, &v_num)) continue;
+      if (v_num != floor(v_num) || v_num < 0 || v_num >= fx->nnodes) {
+        error_at(r, loc_of(v), "%s: node %g does not exist (nodes are numbered 0 to %d)", label, v_num,
+                 fx->nnodes - 1);
+        continue;
+      }
+      fx->node_names[fx->nnode_names] = xstrndup(scalar_text(k), scalar_length(k));
+      fx->node_name_index[fx->nnode_names++] = (int)v_num;
+    }
+  }
+  map_close(&nm);
+}
+
+/* a beam's section or material: the one it names (its index), -1: none
+ * named (the default), -2: an unknown name (reported) */
+static int beam_def(reader *r, mapping *bm, const char *key, const named_defs *named, const char *label) {
+  yaml_node_t *n = map_get(bm, key);
+  if (n == NULL) return -1;
+  int k = find_named_def(named, n);
+  if (k < 0) {
+    name_list l;
+    memset(&l, 0, sizeof l);
+    for (int i = 0; i < named->n; i++) name_list_add(&l, scalar_text(named->key[i]));
+    error_at(r, loc_of(n), "%s: no %s is named %s (%s%s)", label, key, show_node(r, n),
+             l.count ? "expected one of: " : "there are no ", l.count ? l.text : key[0] == 's' ? "'sections'" : "'materials'");
+    return -2;
+  }
+  return k;
+}
+
+/* An FE beam model from mapping m (a flexible body's keys, or a YAML FE
+ * file's): nodes ('line' generator or 'nodes'), named nodes, beams with
+ * their sections and materials, point masses.  Returns the node positions
+ * (global), or NULL. */
+static double *parse_fe_model(mapping *m, ir_flex *fx) {
+  reader *r = m->r;
+  double *global = NULL;
+  yaml_node_t *line = map_get(m, "line"), *nodes = map_get(m, "nodes");
+  ir_beam_theory theory = BEAM_EULER_BERNOULLI;
+  int th = 0;
+  if (get_choice(m, "theory", "beam theory", theory_names, false, &th)) theory = (ir_beam_theory)th;
+  int mk = 0;
+  if (get_choice(m, "mass", "mass matrix", mass_kind_names, false, &mk)) fx->mass = (ir_mass_kind)mk;
+  if (line != NULL && nodes != NULL) {
+    error_at(r, loc_of(nodes), "give either 'line' or 'nodes', not both");
+    return NULL;
+  }
+  if (line == NULL && nodes == NULL) {
+    error_at(r, m->loc, "%s needs an FE model ('line' or 'nodes' and 'beams')", m->what);
+    return NULL;
+  }
+  /* the sections and materials: defaults and named ones */
+  section_def dsec;
+  material_def dmat;
+  memset(&dsec, 0, sizeof dsec);
+  memset(&dmat, 0, sizeof dmat);
+  named_defs secs, mats;
+  parse_named_defs(r, m, "sections", theory, &secs);
+  parse_named_defs(r, m, "materials", theory, &mats);
+  /* the defaults: a mapping, or the name of a named one */
+  char label[200];
+  snprintf(label, sizeof label, "the default of %s", m->what);
+  yaml_node_t *n = map_get(m, "section");
+  bool has_dsec = n != NULL, has_dmat;
+  if (n && n->type == YAML_SCALAR_NODE) {
+    int k = beam_def(r, m, "section", &secs, label);
+    if (k >= 0) dsec = secs.sec[k];
+  } else if (n) {
+    char what[200];
+    snprintf(what, sizeof what, "'section' of %s", m->what);
+    parse_section(r, n, what, theory, true, &dsec);
+  }
+  n = map_get(m, "material");
+  has_dmat = n != NULL;
+  if (n && n->type == YAML_SCALAR_NODE) {
+    int k = beam_def(r, m, "material", &mats, label);
+    if (k >= 0) dmat = mats.mat[k];
+  } else if (n) {
+    char what[200];
+    snprintf(what, sizeof what, "'material' of %s", m->what);
+    parse_material(r, n, what, &dmat);
+  }
+  double dnsm = 0;
+  get_nonnegative(m, "nonstructural_mass", false, &dnsm);
+
+  if (line != NULL) {
+    mapping lm;
+    if (map_open(&lm, r, line, loc_of(line), "'line' of %s", m->what)) {
+      static const char *const lkeys[] = {"from", "to", "elements", NULL};
+      map_check_keys(&lm, lkeys);
+      double p0[3], p1[3], ne = 0;
+      bool ok = get_vector(&lm, "from", 3, true, p0);
+      ok = get_vector(&lm, "to", 3, true, p1) && ok;
+      ok = get_positive(&lm, "elements", true, &ne) && ok;
+      if (ok && (ne != floor(ne) || ne > 100000)) {
+        error_at(r, lm.last_loc, "'elements' must be a whole number (got %g)", ne);
+        ok = false;
+      }
+      if (ok && distance3(p0, p1) <= ZERO_LENGTH) {
+        error_at(r, loc_of(line), "'line' has zero length");
+        ok = false;
+      }
+      if (ok) {
+        int ne_ = (int)ne;
+        fx->nnodes = ne_ + 1;
+        global = xcalloc(3 * (size_t)(ne_ + 1), sizeof *global);
+        fx->node_loc = xcalloc((size_t)ne_ + 1, sizeof *fx->node_loc);
+        for (int k = 0; k <= ne_; k++) {
+          for (int i = 0; i < 3; i++) global[3 * k + i] = p0[i] + (p1[i] - p0[i]) * k / ne_;
+          fx->node_loc[k] = loc_of(line);
+        }
+        fx->nbeams = ne_;
+        fx->beams = xcalloc((size_t)ne_, sizeof *fx->beams);
+        for (int e = 0; e < ne_; e++) {
+          fx->beams[e].node[0] = e;
+          fx->beams[e].node[1] = e + 1;
+          fx->beams[e].loc = loc_of(line);
+        }
+      }
+    }
+    map_close(&lm);
+    map_reject(m, "beams", "'beams' does not go with 'line' (the line makes its own elements)");
+  } else {
+    int nn = nodes->type == YAML_SEQUENCE_NODE ? seq_length(nodes) : 0;
+    if (nn < 2) {
+      error_at(r, loc_of(nodes), "'nodes': expected a list of at least 2 points [x, y, z]");
+    } else {
+      fx->nnodes = nn;
+      global = xcalloc(3 * (size_t)nn, sizeof *global);
+      fx->node_loc = xcalloc((size_t)nn, sizeof *fx->node_loc);
+      for (int k = 0; k < nn; k++) {
+        char label[64];
+        snprintf(label, sizeof label, "node %d", k);
+        yaml_node_t *item = seq_item(r, nodes, k);
+        to_vector(r, item, label, 3, global + 3 * k);
+        fx->node_loc[k] = loc_of(item);
+      }
+    }
+  }
+  parse_node_names(r, m, fx);
+
+  /* the beams: [i, j] or {nodes: [i, j], section, material, nonstructural_mass} */
+  int *sec_of = NULL, *mat_of = NULL; /* per beam: the named one, -1 the default, -2 none */
+  yaml_node_t *beams = map_get(m, "beams");
+  if (nodes != NULL && global != NULL) {
+    int nn = fx->nnodes;
+    if (beams == NULL) { /* consecutive nodes */
+      fx->nbeams = nn - 1;
+      fx->beams = xcalloc((size_t)nn, sizeof *fx->beams);
+      for (int e = 0; e < nn - 1; e++) {
+        fx->beams[e].node[0] = e;
+        fx->beams[e].node[1] = e + 1;
+        fx->beams[e].loc = loc_of(nodes);
+      }
+    } else if (beams->type != YAML_SEQUENCE_NODE || seq_length(beams) < 1) {
+      error_at(r, loc_of(beams), "'beams': expected a list of node pairs [i, j] or {nodes: [i, j], ...}");
+    } else {
+      int ne = seq_length(beams);
+      fx->beams = xcalloc((size_t)ne, sizeof *fx->beams);
+      sec_of = xcalloc((size_t)ne, sizeof *sec_of);
+      mat_of = xcalloc((size_t)ne, sizeof *mat_of);
+      for (int e = 0; e < ne; e++) {
+        yaml_node_t *item = seq_item(r, beams, e), *pair_node = item;
+        char label[64];
+        snprintf(label, sizeof label, "beam %d", e + 1);
+        ir_beam *bm = &fx->beams[fx->nbeams];
+        bm->nsm = dnsm;
+        int si = -1, mi = -1;
+        mapping bmm;
+        bool is_map = item->type == YAML_MAPPING_NODE;
+        if (is_map) {
+          if (!map_open(&bmm, r, item, loc_of(item), "%s of %s", label, m->what)) continue;
+          static const char *const bkeys[] = {"nodes", "section", "material", "nonstructural_mass", NULL};
+          map_check_keys(&bmm, bkeys);
+          pair_node = map_require(&bmm, "nodes", true, "[i, j]");
+          si = beam_def(r, &bmm, "section", &secs, label);
+          mi = beam_def(r, &bmm, "material", &mats, label);
+          get_nonnegative(&bmm, "nonstructural_mass", false, &bm->nsm);
+        }
+        if (pair_node != NULL) {
+          int cnt = 0;
+          int *pair = to_node_list(r, pair_node, label, fx, nn, &cnt);
+          if (cnt == 2 && pair[0] != pair[1] && seq_length(pair_node) == 2) {
+            bm->node[0] = pair[0];
+            bm->node[1] = pair[1];
+            bm->loc = loc_of(item);
+            sec_of[fx->nbeams] = si;
+            mat_of[fx->nbeams] = mi;
+            fx->nbeams++;
+          } else if (pair_node->type == YAML_SEQUENCE_NODE && cnt == seq_length(pair_node)) {
+            error_at(r, loc_of(pair_node), "%s: expected two different nodes [i, j]", label);
+          }
+          free(pair);
+        }
+        if (is_map) map_close(&bmm);
+      }
+    }
+  }
+  /* the defaults are required when a beam names no section or material */
+  bool default_sec = !sec_of && fx->nbeams > 0, default_mat = default_sec;
+  for (int e = 0; sec_of && e < fx->nbeams; e++) {
+    default_sec |= sec_of[e] == -1;
+    default_mat |= mat_of[e] == -1;
+  }
+  if (default_sec && !has_dsec)
+    map_require(m, "section", true, "a mapping {area, Iy, Iz, J, ...} or {shape, ...}, for the beams that name none");
+  if (default_mat && !has_dmat)
+    map_require(m, "material", true, "a mapping {E, nu or G, density}, for the beams that name none");
+  /* the beams' properties and local axes */
+  for (int e = 0; global && e < fx->nbeams; e++) {
+    ir_beam *bm = &fx->beams[e];
+    int si = sec_of ? sec_of[e] : -1, mi = mat_of ? mat_of[e] : -1;
+    if (si == -2 || mi == -2) continue; /* reported */
+    const section_def *sd = si >= 0 ? &secs.sec[si] : &dsec;
+    const material_def *md = mi >= 0 ? &mats.mat[mi] : &dmat;
+    bm->theory = theory;
+    if (!sec_of) bm->nsm = dnsm;
+    apply_section(bm, sd);
+    apply_material(bm, md);
+    section_yaxis(sd, global + 3 * bm->node[0], global + 3 * bm->node[1], bm->yaxis);
+  }
+  free(sec_of);
+  free(mat_of);
+  free_named_defs(&secs);
+  free_named_defs(&mats);
+
+  yaml_node_t *pm = map_get(m, "point_masses");
+  if (pm != NULL && global != NULL) {
+    if (pm->type != YAML_SEQUENCE_NODE) {
+      error_at(r, loc_of(pm), "'point_masses': expected a list of {node, mass, inertia}");
+    } else {
+      int np = seq_length(pm);
+      fx->point_masses = xcalloc((size_t)np + 1, sizeof *fx->point_masses);
+      for (int i = 0; i < np; i++) {
+        yaml_node_t *item = seq_item(r, pm, i);
+        mapping pmm;
+        if (map_open(&pmm, r, item, loc_of(item), "point mass %d of %s", i + 1, m->what)) {
+          static const char *const pkeys[] = {"node", "mass", "inertia", NULL};
+          map_check_keys(&pmm, pkeys);
+          ir_point_mass *p = &fx->point_masses[fx->npoint_masses];
+          p->loc = loc_of(item);
+          yaml_node_t *nd = map_require(&pmm, "node", true, "a node number or name");
+          if (nd != NULL) {
+            char label[64];
+            snprintf(label, sizeof label, "point mass %d", i + 1);
+            double v = -1;
+            if (looks_like_name(nd)) {
+              int k = named_node(r, nd, fx, label);
+              p->node = k < 0 ? 0 : k;
+            } else if (to_number(r, nd, label, &v)) {
+              if (v != floor(v) || v < 0 || v >= fx->nnodes)
+                error_at(r, loc_of(nd), "node %g does not exist (nodes are numbered 0 to %d)", v, fx->nnodes - 1);
+              else
+                p->node = (int)v;
+            }
+          }
+          get_nonnegative(&pmm, "mass", true, &p->mass);
+          yaml_node_t *in = map_get(&pmm, "inertia");
+          if (in != NULL) parse_inertia(r, in, p->inertia);
+          fx->npoint_masses++;
+        }
+        map_close(&pmm);
+      }
+    }
+  }
+  return global;
+}
+
 static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
   reader *r = m->r;
   (void)type_loc;
@@ -562,7 +1150,8 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
       "type",    "position",  "orientation", "velocity", "angular_velocity", "line",
       "nodes",   "beams",     "section",     "material", "theory",           "mass",
       "point_masses", "reference", "interface", "modes", "damping", "coupling", "modal_file",
-      "fe_file", "initial_modes", "initial_mode_rates", "eigensolver", NULL};
+      "fe_file", "initial_modes", "initial_mode_rates", "eigensolver", "sections", "materials",
+      "nonstructural_mass", "node_names", NULL};
   map_reject(m, "inertia", "flexible body '%s': its inertia comes from its FE model", b->name);
   map_check_keys(m, keys);
   ir_flex *fx = xcalloc(1, sizeof *fx);
@@ -580,7 +1169,8 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
   double *global = NULL; /* node positions, global */
   if (modal_file != NULL) {
     static const char *const fe_only[] = {"line", "nodes", "beams", "section", "material",
-                                          "theory", "mass", "point_masses", "interface", NULL};
+                                          "theory", "mass", "point_masses", "interface", "sections",
+                                          "materials", "nonstructural_mass", "node_names", NULL};
     for (int i = 0; fe_only[i]; i++)
       map_reject(m, fe_only[i], "flexible body '%s': '%s' does not go with 'modal_file'", b->name, fe_only[i]);
     if (modal_file->type != YAML_SCALAR_NODE) {
@@ -601,156 +1191,7 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
   } else if (line == NULL && nodes == NULL) {
     error_at(r, m->loc, "flexible body '%s' needs an FE model ('line' or 'nodes' and 'beams') or a 'modal_file'", b->name);
   } else {
-    ir_beam proto;
-    memset(&proto, 0, sizeof proto);
-    int th = 0;
-    if (get_choice(m, "theory", "beam theory", theory_names, false, &th)) proto.theory = (ir_beam_theory)th;
-    int mk = 0;
-    if (get_choice(m, "mass", "mass matrix", mass_kind_names, false, &mk)) fx->mass = (ir_mass_kind)mk;
-    if (line != NULL) {
-      mapping lm;
-      if (map_open(&lm, r, line, loc_of(line), "'line' of %s", m->what)) {
-        static const char *const lkeys[] = {"from", "to", "elements", NULL};
-        map_check_keys(&lm, lkeys);
-        double p0[3], p1[3], ne = 0;
-        bool ok = get_vector(&lm, "from", 3, true, p0);
-        ok = get_vector(&lm, "to", 3, true, p1) && ok;
-        ok = get_positive(&lm, "elements", true, &ne) && ok;
-        if (ok && (ne != floor(ne) || ne > 100000)) {
-          error_at(r, lm.last_loc, "'elements' must be a whole number (got %g)", ne);
-          ok = false;
-        }
-        if (ok && distance3(p0, p1) <= ZERO_LENGTH) {
-          error_at(r, loc_of(line), "'line' has zero length");
-          ok = false;
-        }
-        if (ok) {
-          int n = (int)ne;
-          fx->nnodes = n + 1;
-          global = xcalloc(3 * (size_t)(n + 1), sizeof *global);
-          fx->node_loc = xcalloc((size_t)n + 1, sizeof *fx->node_loc);
-          for (int k = 0; k <= n; k++) {
-            for (int i = 0; i < 3; i++) global[3 * k + i] = p0[i] + (p1[i] - p0[i]) * k / n;
-            fx->node_loc[k] = loc_of(line);
-          }
-          fx->nbeams = n;
-          fx->beams = xcalloc((size_t)n, sizeof *fx->beams);
-          for (int e = 0; e < n; e++) {
-            fx->beams[e].node[0] = e;
-            fx->beams[e].node[1] = e + 1;
-            fx->beams[e].loc = loc_of(line);
-          }
-        }
-      }
-      map_close(&lm);
-      map_reject(m, "beams", "'beams' does not go with 'line' (the line makes its own elements)");
-    } else {
-      int n = nodes->type == YAML_SEQUENCE_NODE ? seq_length(nodes) : 0;
-      if (n < 2) {
-        error_at(r, loc_of(nodes), "'nodes': expected a list of at least 2 points [x, y, z]");
-      } else {
-        fx->nnodes = n;
-        global = xcalloc(3 * (size_t)n, sizeof *global);
-        fx->node_loc = xcalloc((size_t)n, sizeof *fx->node_loc);
-        for (int k = 0; k < n; k++) {
-          char label[64];
-          snprintf(label, sizeof label, "node %d", k);
-          yaml_node_t *item = seq_item(r, nodes, k);
-          to_vector(r, item, label, 3, global + 3 * k);
-          fx->node_loc[k] = loc_of(item);
-        }
-        yaml_node_t *beams = map_get(m, "beams");
-        if (beams == NULL) { /* consecutive nodes */
-          fx->nbeams = n - 1;
-          fx->beams = xcalloc((size_t)n, sizeof *fx->beams);
-          for (int e = 0; e < n - 1; e++) {
-            fx->beams[e].node[0] = e;
-            fx->beams[e].node[1] = e + 1;
-            fx->beams[e].loc = loc_of(nodes);
-          }
-        } else if (beams->type != YAML_SEQUENCE_NODE || seq_length(beams) < 1) {
-          error_at(r, loc_of(beams), "'beams': expected a list of node pairs [i, j]");
-        } else {
-          int ne = seq_length(beams);
-          fx->beams = xcalloc((size_t)ne, sizeof *fx->beams);
-          for (int e = 0; e < ne; e++) {
-            yaml_node_t *item = seq_item(r, beams, e);
-            char label[64];
-            snprintf(label, sizeof label, "beam %d", e + 1);
-            int cnt = 0;
-            int *pair = to_node_list(r, item, label, n, &cnt);
-            if (cnt == 2 && pair[0] != pair[1] && seq_length(item) == 2) {
-              fx->beams[fx->nbeams].node[0] = pair[0];
-              fx->beams[fx->nbeams].node[1] = pair[1];
-              fx->beams[fx->nbeams].loc = loc_of(item);
-              fx->nbeams++;
-            } else if (cnt == seq_length(item)) {
-              error_at(r, loc_of(item), "%s: expected two different node numbers [i, j]", label);
-            }
-            free(pair);
-          }
-        }
-      }
-    }
-    /* section and material: common to all beams */
-    proto.yaxis[1] = 1; /* default: global y, unless along the element (fixed below) */
-    bool yaxis_given = false;
-    {
-      yaml_node_t *sec = map_get(m, "section");
-      if (sec != NULL && sec->type == YAML_MAPPING_NODE) {
-        mapping probe;
-        if (map_open(&probe, r, sec, loc_of(sec), "'section'")) yaxis_given = map_has(&probe, "yaxis");
-        /* map_close of a probe would report nothing: keys are checked below */
-        free(probe.handled);
-      }
-    }
-    parse_beam_properties(r, m, &proto);
-    for (int e = 0; e < fx->nbeams; e++) {
-      ir_beam *bm = &fx->beams[e];
-      int nd[2] = {bm->node[0], bm->node[1]};
-      ir_loc loc = bm->loc;
-      *bm = proto;
-      bm->node[0] = nd[0];
-      bm->node[1] = nd[1];
-      bm->loc = loc;
-      if (global && !yaxis_given) {
-        /* a y axis across the element: global y, or global z for elements along y */
-        double d[3];
-        for (int i = 0; i < 3; i++) d[i] = global[3 * nd[1] + i] - global[3 * nd[0] + i];
-        double len = norm3(d);
-        if (len > 0 && fabs(d[1]) > 0.9 * len) { bm->yaxis[0] = bm->yaxis[1] = 0; bm->yaxis[2] = 1; }
-      }
-    }
-    yaml_node_t *pm = map_get(m, "point_masses");
-    if (pm != NULL) {
-      if (pm->type != YAML_SEQUENCE_NODE) {
-        error_at(r, loc_of(pm), "'point_masses': expected a list of {node, mass, inertia}");
-      } else {
-        int np = seq_length(pm);
-        fx->point_masses = xcalloc((size_t)np + 1, sizeof *fx->point_masses);
-        for (int i = 0; i < np; i++) {
-          yaml_node_t *item = seq_item(r, pm, i);
-          mapping pmm;
-          if (map_open(&pmm, r, item, loc_of(item), "point mass %d of %s", i + 1, m->what)) {
-            static const char *const pkeys[] = {"node", "mass", "inertia", NULL};
-            map_check_keys(&pmm, pkeys);
-            ir_point_mass *p = &fx->point_masses[fx->npoint_masses];
-            double node = -1;
-            p->loc = loc_of(item);
-            if (get_number(&pmm, "node", true, &node) &&
-                (node != floor(node) || node < 0 || node >= fx->nnodes))
-              error_at(r, pmm.last_loc, "node %g does not exist (nodes are numbered 0 to %d)", node, fx->nnodes - 1);
-            else
-              p->node = (int)node;
-            get_nonnegative(&pmm, "mass", true, &p->mass);
-            yaml_node_t *in = map_get(&pmm, "inertia");
-            if (in != NULL) parse_inertia(r, in, p->inertia);
-            fx->npoint_masses++;
-          }
-          map_close(&pmm);
-        }
-      }
-    }
+    global = parse_fe_model(m, fx);
   }
 
   /* reference conditions and Craig-Bampton interface */
@@ -1234,8 +1675,108 @@ static void parse_force(reader *r, yaml_node_t *key, yaml_node_t *value) {
 static const char *const output_type_names[] = {
     "position",     "orientation",          "angle",    "velocity",       "angular_velocity",
     "acceleration", "angular_acceleration", "reaction", "effort",         "kinetic_energy",
-    "potential_energy", "total_energy",     "deflection", "modal", "momentum", "section", "tyre", NULL};
+    "potential_energy", "total_energy",     "deflection", "modal", "momentum", "section",
+    "force", "relative", "joint", "center_of_mass", "tyre", NULL};
 static const char *const component_names[] = {"x", "y", "z", NULL};
+static const char *const force_component_names[] = {"fx", "fy", "fz", "tx", "ty", "tz", "tension", NULL};
+
+/* A marker of a relative output: 'body' with an optional 'point' (global at
+ * t = 0) or FE 'node' (flexible bodies), in mapping m. */
+static void get_output_marker(reader *r, mapping *m, bool required, int *body, bool *has_point,
+                              double point[3], int *node) {
+  if (!get_ref(m, "body", NAME_BODY, required, body, NULL)) return;
+  *has_point = get_vector(m, "point", 3, false, point);
+  yaml_node_t *nd = map_get(m, "node");
+  if (nd == NULL) return;
+  const ir_body *b = &r->model->bodies[*body];
+  if (b->kind != BODY_FLEXIBLE)
+    error_at(r, loc_of(nd), "'node' needs a flexible body ('%s' is not)", b->name);
+  else if (*has_point)
+    error_at(r, loc_of(nd), "give either 'point' or 'node', not both");
+  else
+    *node = to_fe_node(r, nd, b);
+}
+
+/* the keys and values of the output types that measure elements and markers
+ * (force, relative, joint, center_of_mass) */
+static void parse_output_measure(reader *r, mapping *m, ir_output *o) {
+  static const char *const displacement_names[] = {"displacement", "velocity", "acceleration", NULL};
+  static const char *const cm_quantity_names[] = {"position", "velocity", "acceleration", NULL};
+  static const char *const force_keys[] = {"name", "type", "element", "component", "scale", NULL};
+  static const char *const relative_keys[] = {"name", "type", "quantity", "body", "point", "node",
+                                              "relative_to", "frame", "component", "scale", NULL};
+  static const char *const joint_keys[] = {"name", "type", "joint", "scale", NULL};
+  static const char *const cm_keys[] = {"name", "type", "quantity", "bodies", "component", "scale", NULL};
+  int choice = 0;
+  switch (o->kind) {
+  case OUT_FORCE:
+    map_check_keys(m, force_keys);
+    get_ref(m, "element", NAME_FORCE, true, &o->force, NULL);
+    get_choice(m, "component", "component", force_component_names, false, &o->component);
+    if (o->component == 6 && o->force >= 0 && r->model->forces[o->force].kind != FORCE_SPRING_DAMPER)
+      error_at(r, m->last_loc, "component 'tension' needs a spring_damper ('%s' is not)",
+               r->model->forces[o->force].name);
+    break;
+  case OUT_RELATIVE: {
+    map_check_keys(m, relative_keys);
+    if (get_choice(m, "quantity", "quantity", displacement_names, false, &choice))
+      o->quantity = (ir_quantity)choice;
+    get_output_marker(r, m, true, &o->body, &o->has_point, o->point, &o->node);
+    yaml_node_t *rel = map_get(m, "relative_to");
+    if (rel != NULL) {
+      static const char *const marker_keys[] = {"body", "point", "node", NULL};
+      mapping sub;
+      if (map_open(&sub, r, rel, loc_of(rel), "'relative_to' of output '%s'", o->name ? o->name : "?")) {
+        map_check_keys(&sub, marker_keys);
+        get_output_marker(r, &sub, true, &o->rel_body, &o->rel_has_point, o->rel_point, &o->rel_node);
+      }
+      map_close(&sub);
+    }
+    yaml_node_t *fr = map_get(m, "frame");
+    if (fr != NULL && !(fr->type == YAML_SCALAR_NODE && scalar_equals(fr, "global"))) {
+      int b = resolve_name(r, fr, NAME_BODY, "frame");
+      if (b >= 0) o->frame_body = b;
+    }
+    get_choice(m, "component", "component", component_names, false, &o->component);
+    break;
+  }
+  case OUT_JOINT:
+    map_check_keys(m, joint_keys);
+    if (get_ref(m, "joint", NAME_JOINT, true, &o->joint, NULL)) {
+      ir_joint_kind jk = r->model->joints[o->joint].kind;
+      if (jk != JOINT_REVOLUTE && jk != JOINT_PRISMATIC && jk != JOINT_CYLINDRICAL)
+        error_at(r, m->last_loc, "joint output '%s' needs a revolute, prismatic or cylindrical joint ('%s' is not)",
+                 o->name ? o->name : "?", r->model->joints[o->joint].name);
+    }
+    break;
+  case OUT_CENTER_OF_MASS: {
+    map_check_keys(m, cm_keys);
+    if (get_choice(m, "quantity", "quantity", cm_quantity_names, false, &choice))
+      o->quantity = (ir_quantity)choice;
+    get_choice(m, "component", "component", component_names, false, &o->component);
+    yaml_node_t *list = map_get(m, "bodies");
+    if (list == NULL) break;
+    int n = list->type == YAML_SEQUENCE_NODE ? seq_length(list) : 0;
+    if (n == 0) {
+      error_at(r, loc_of(list), "'bodies' must be a list of body names (got %s)", show_node(r, list));
+      break;
+    }
+    o->cm_bodies = xcalloc((size_t)n, sizeof *o->cm_bodies);
+    for (int i = 0; i < n; i++) {
+      yaml_node_t *item = seq_item(r, list, i);
+      int b = resolve_name(r, item, NAME_BODY, "bodies");
+      if (b == 0) error_at(r, loc_of(item), "'bodies': the ground has no centre of mass");
+      for (int j = 0; j < o->ncm_bodies && b > 0; j++)
+        if (o->cm_bodies[j] == b) error_at(r, loc_of(item), "'bodies': '%s' is listed twice", r->model->bodies[b].name);
+      if (b > 0) o->cm_bodies[o->ncm_bodies++] = b;
+    }
+    break;
+  }
+  default:
+    break;
+  }
+  get_number(m, "scale", false, &o->scale);
+}
 /* the columns of a tyre output, in the order of mb_model_outputs */
 const char *const tyre_component_names[] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz", "slip",
                                             "slip_angle", "camber", "deflection", NULL};
@@ -1248,6 +1789,8 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
   o->mode = -1;
   o->component = -1;
   o->scale = 1;
+  o->force = o->rel_node = -1;
+  o->rel_body = o->frame_body = 0; /* the ground, global axes */
 
   mapping m;
   if (!map_open(&m, r, n, o->loc, "output %d", item + 1))
@@ -1269,6 +1812,11 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
   map_describe(&m, "%s output '%s'", output_type_names[type], o->name ? o->name : "?");
 
   ir_output_kind k = o->kind;
+  if (k >= OUT_FORCE && k != OUT_TYRE) {
+    parse_output_measure(r, &m, o);
+    map_close(&m);
+    return;
+  }
   bool of_body = k <= OUT_ANGULAR_ACCELERATION || k == OUT_DEFLECTION || k == OUT_MODAL || k == OUT_SECTION;
   bool has_point = k == OUT_POSITION || k == OUT_VELOCITY || k == OUT_ACCELERATION;
   bool has_component = of_body && k != OUT_ORIENTATION && k != OUT_ANGLE && k != OUT_MODAL;
@@ -1280,7 +1828,7 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
     keys[nkeys++] = "body";
   if (has_point)
     keys[nkeys++] = "point";
-  if (k == OUT_POSITION || k == OUT_VELOCITY)
+  if (k == OUT_POSITION || k == OUT_VELOCITY || k == OUT_ACCELERATION)
     keys[nkeys++] = "node";
   if (k == OUT_ANGLE)
     keys[nkeys++] = "axis";
@@ -1313,7 +1861,7 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
     get_ref(&m, "body", NAME_BODY, true, &o->body, NULL);
   if (has_point)
     o->has_point = get_vector(&m, "point", 3, false, o->point);
-  if ((k == OUT_POSITION || k == OUT_VELOCITY) && map_has(&m, "node") && o->body >= 0) {
+  if (has_point && map_has(&m, "node") && o->body >= 0) {
     const ir_body *b = &r->model->bodies[o->body];
     yaml_node_t *nd = map_get(&m, "node");
     if (b->kind != BODY_FLEXIBLE)
@@ -1410,8 +1958,10 @@ void parse_outputs(reader *r, yaml_node_t *n, name_table *scene_outputs,
 }
 
 void free_outputs(ir_output *outputs, int count) {
-  for (int i = 0; i < count; i++)
+  for (int i = 0; i < count; i++) {
     free(outputs[i].name);
+    free(outputs[i].cm_bodies);
+  }
   free(outputs);
 }
 
@@ -1447,8 +1997,8 @@ static void parse_model(reader *r, yaml_node_t *root, const char *chosen_scene_n
   mapping top;
   map_open(&top, r, root, file_start, "the model");
   static const char *const keys[] = {"name",    "gravity", "bodies",     "joints", "drivers",
-                                     "forces",  "outputs", "simulation", "scenes", "parameters", "roads",
-                                     NULL};
+                                     "forces",  "outputs", "simulation", "scenes", "parameters",
+                                     "include", "templates", "roads", NULL};
   map_check_keys(&top, keys);
   /* first: every numeric field may name parameters */
   parse_parameters(r, map_get(&top, "parameters"));
@@ -1528,6 +2078,7 @@ static void parse_model(reader *r, yaml_node_t *root, const char *chosen_scene_n
   yaml_node_t *jof_list = r->scene.found ? r->scene.jof_list : base_sim.jof_list;
   if (r->scene.found)
     apply_scene(model, &r->scene);
+  scene_mark_pruned_uses(r, root);
   check_drivers(r);
   mark_virtual_joints(r, jof_list);
 }
@@ -1662,12 +2213,22 @@ static ir_model *read_model(const char *path, const char *scene) {
       }
       model = xcalloc(1, sizeof *model);
       model->path = xstrdup(path);
+      compose_files files;
+      bool composed = compose_document(path, &doc, &files);
+      if (files.count > 0) {
+        model->included = xcalloc((size_t)files.count, sizeof *model->included);
+        for (int i = 0; i < files.count; i++) model->included[i] = xstrdup(files.path[i]);
+        model->nincluded = files.count;
+      }
+      compose_files_free(&files);
+      root = yaml_document_get_root_node(&doc);
       reader r;
       memset(&r, 0, sizeof r);
       r.path = path;
       r.doc = &doc;
       r.model = model;
-      parse_model(&r, root, scene);
+      if (composed)
+        parse_model(&r, root, scene);
       table_free(&r.names);
       free_chosen_scene(&r.scene, model->nbodies);
       free(r.param_nodes);
@@ -1699,7 +2260,7 @@ ir_model *ir_read(const char *path, const char *scene) {
   return model;
 }
 
-static void free_flex(ir_flex *fx) {
+void free_flex(ir_flex *fx) {
   if (fx == NULL)
     return;
   free(fx->nodes);
@@ -1709,6 +2270,10 @@ static void free_flex(ir_flex *fx) {
   free(fx->reference);
   free(fx->interface);
   free(fx->modal_file);
+  free(fx->fe_source);
+  for (int i = 0; i < fx->nnode_names; i++) free(fx->node_names[i]);
+  free(fx->node_names);
+  free(fx->node_name_index);
   free(fx->list);
   free(fx->ratios);
   fe_import_free(fx);
@@ -1719,6 +2284,10 @@ void ir_free(ir_model *m) {
   if (m == NULL)
     return;
   free(m->path);
+  for (int i = 0; i < m->nincluded; i++)
+    free(m->included[i]);
+  free(m->included);
+  free(m->pruned);
   free(m->name);
   free(m->scene);
   for (int i = 0; i < m->nbodies; i++) {

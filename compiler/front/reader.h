@@ -31,5 +31,6 @@ void parse_modal_settings(mapping *m, ir_flex *fx);
 void parse_outputs(reader *r, yaml_node_t *n, name_table *scene_outputs,
                    ir_output **outputs, int *count);
 void free_outputs(ir_output *outputs, int count);
+void free_flex(ir_flex *fx);
 
 #endif

@@ -11,6 +11,9 @@ void parse_scenes(reader *r, yaml_node_t *n, const sim_settings *base_sim,
 void report_unknown_scene(reader *r, yaml_node_t *scenes, const char *chosen);
 void mark_virtual_joints(reader *r, yaml_node_t *list);
 void apply_scene(ir_model *model, chosen_scene *s);
+/* after the flexible bodies are reduced: modes_of_body[b] modes of IR body b */
+void scene_drop_modal_outputs(ir_model *model, const int *modes_of_body);
+void scene_mark_pruned_uses(reader *r, yaml_node_t *root);
 void free_chosen_scene(chosen_scene *s, int nbodies);
 
 #endif

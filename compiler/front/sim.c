@@ -14,12 +14,13 @@
 static const char *const sim_keys[SIM_FIELDS] = {
     "end_time", "output_step", "step",       "rtol",          "atol",
     "min_step", "max_step",    "alpha",      "beta",          "rho_inf",   "integrator",
-    "solver",   "stabilization", "joints_on_flexible"};
+    "solver",   "stabilization", "joints_on_flexible", "equilibrium"};
 
 static const char *const integrator_names[] = {"rk4", "dopri5", "genalpha", "auto", NULL};
 static const char *const solver_names[] = {"klu", "dense", "ldl", NULL};
 static const char *const stabilization_names[] = {"projection", "baumgarte", "none", NULL};
 static const char *const jof_names[] = {"direct", "virtual", NULL};
+static const char *const flag_names[] = {"false", "true", NULL};
 
 void sim_defaults(sim_settings *s) {
   memset(s, 0, sizeof *s);
@@ -52,7 +53,7 @@ void parse_sim(reader *r, yaml_node_t *n, const char *what, sim_source source,
                                      "rtol",      "atol",        "min_step",
                                      "max_step",  "integrator",  "solver",
                                      "stabilization", "baumgarte", "joints_on_flexible",
-                                     "rho_inf", NULL};
+                                     "rho_inf", "equilibrium", NULL};
   map_check_keys(&m, keys);
   for (int field = SIM_END_TIME; field <= SIM_MAX_STEP; field++) {
     double value;
@@ -82,7 +83,7 @@ void parse_sim(reader *r, yaml_node_t *n, const char *what, sim_source source,
     map_close(&b);
   }
   static const char *const *const choices[] = {integrator_names, solver_names,
-                                               stabilization_names, jof_names};
+                                               stabilization_names, jof_names, flag_names};
   yaml_node_t *jof = map_get(&m, "joints_on_flexible");
   if (jof != NULL && jof->type == YAML_SEQUENCE_NODE) {
     s->jof_list = jof;
@@ -143,6 +144,7 @@ bool sim_finish(reader *r, sim_settings *s, bool is_scene, ir_sim *out) {
   out->solver = (ir_solver)(int)v[SIM_SOLVER];
   out->stabilization = (ir_stab)(int)v[SIM_STABILIZATION];
   out->joints_on_flexible = (ir_jof)(int)v[SIM_JOINTS_ON_FLEXIBLE];
+  out->equilibrium = v[SIM_EQUILIBRIUM] != 0;
   return ok;
 }
 

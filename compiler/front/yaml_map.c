@@ -216,9 +216,15 @@ bool map_open(mapping *m, reader *r, yaml_node_t *node, ir_loc loc, const char *
     while (k < nkeys && keys[k].length == keys[first].length &&
            memcmp(keys[k].text, keys[first].text, keys[k].length) == 0) {
       yaml_node_t *dup = map_key_node(m, keys[k].pair);
-      error_at(r, loc_of(dup), "duplicate key '%s' (first at line %d)",
-               show_text(r, keys[k].text, keys[k].length),
-               loc_of(map_key_node(m, keys[first].pair)).line);
+      ir_loc first_loc = loc_of(map_key_node(m, keys[first].pair));
+      const char *first_file = diag_loc_file(first_loc, NULL);
+      if (first_file == diag_loc_file(loc_of(dup), NULL))
+        error_at(r, loc_of(dup), "duplicate key '%s' (first at line %d)",
+                 show_text(r, keys[k].text, keys[k].length), diag_loc_in_file(first_loc).line);
+      else
+        error_at(r, loc_of(dup), "duplicate key '%s' (first at %s:%d)",
+                 show_text(r, keys[k].text, keys[k].length),
+                 first_file ? first_file : r->path, diag_loc_in_file(first_loc).line);
       m->handled[keys[k].pair] = true;
       k++;
     }

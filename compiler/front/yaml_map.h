@@ -43,7 +43,26 @@ typedef struct {
   ir_sim sim;
   yaml_node_t *jof_list;
   ir_flex **flex;   /* per body: the scene's modal settings, or NULL */
+  bool *body_removed; /* per body: 'remove' or not kept by 'rig' */
+  bool rig;           /* 'rig': joints to removed bodies become joints to the ground */
+  double **motion;    /* rig with a recorded motion: per removed body its rows
+                         t, x, y, z, e0, e1, e2, e3 (NULL: not recorded) */
+  int nmotion_rows;
+  char *gone;         /* "section name\n" of each body, joint, driver, force pruned */
+  int nbodies;        /* the model's bodies when the scene was read (the
+                         per-body arrays' length; pruning changes the model's) */
+  char *motion_path;
+  ir_loc motion_loc;
+  struct scene_replacement *replace; /* 'replace': joints made bushings */
+  int nreplace;
 } chosen_scene;
+
+/* a joint replaced by a bushing at its point, in its axes (z = the axis) */
+typedef struct scene_replacement {
+  int joint;
+  double k6[6], c6[6];
+  ir_loc loc;
+} scene_replacement;
 
 typedef struct reader {
   const char *path;

@@ -246,11 +246,13 @@ static void joint_rows(lmodel *L, int j, int m0, int m1) {
   }
 }
 
-static int output_columns(const ir_output *o) {
+static int output_columns(const ir_model *ir, const ir_output *o) {
   switch (o->kind) {
   case OUT_POSITION: case OUT_VELOCITY: case OUT_ANGULAR_VELOCITY: case OUT_ACCELERATION:
-  case OUT_ANGULAR_ACCELERATION: case OUT_DEFLECTION:
+  case OUT_ANGULAR_ACCELERATION: case OUT_DEFLECTION: case OUT_RELATIVE: case OUT_CENTER_OF_MASS:
     return o->component >= 0 ? 1 : 3;
+  case OUT_FORCE: return o->component >= 0 ? 1 : 6;
+  case OUT_JOINT: return o->joint >= 0 && ir->joints[o->joint].kind == JOINT_CYLINDRICAL ? 2 : 1;
   case OUT_ORIENTATION: return 4;
   case OUT_REACTION: case OUT_MOMENTUM: return 6;
   case OUT_SECTION: return o->component >= 0 || o->has_fiber ? 1 : 6;
@@ -267,8 +269,81 @@ static const mb_output_kind out_kind_map[] = {
     [OUT_EFFORT] = MB_OUT_EFFORT, [OUT_KINETIC_ENERGY] = MB_OUT_KINETIC_ENERGY,
     [OUT_POTENTIAL_ENERGY] = MB_OUT_POTENTIAL_ENERGY, [OUT_TOTAL_ENERGY] = MB_OUT_TOTAL_ENERGY,
     [OUT_DEFLECTION] = MB_OUT_DEFLECTION, [OUT_MODAL] = MB_OUT_MODAL,
-    [OUT_MOMENTUM] = MB_OUT_MOMENTUM, [OUT_SECTION] = MB_OUT_SECTION,
-    [OUT_TYRE] = MB_OUT_TYRE};
+    [OUT_MOMENTUM] = MB_OUT_MOMENTUM, [OUT_SECTION] = MB_OUT_SECTION, [OUT_FORCE] = MB_OUT_FORCE,
+    [OUT_RELATIVE] = MB_OUT_RELATIVE, [OUT_JOINT] = MB_OUT_JOINT,
+    [OUT_CENTER_OF_MASS] = MB_OUT_CENTER_OF_MASS, [OUT_TYRE] = MB_OUT_TYRE};
+
+/* the fields of the output kinds that measure elements and markers (force,
+ * relative, joint, center_of_mass); 0, or -1 after reporting an error */
+static int lower_measure_output(lmodel *L, const ir_output *o, const int *jm0, const int *jm1,
+                                mb_outputdef *d) {
+  const ir_model *ir = L->ir;
+  mb_model *m = &L->m;
+  d->frame = d->body2 = d->node2 = d->element = -1;
+  d->jmarker[0] = d->jmarker[1] = -1;
+  d->quantity = (int)o->quantity;
+  switch (o->kind) {
+  case OUT_FORCE:
+    for (int k = 0; k < m->nforce; k++)
+      if (L->force_ir[k] == o->force) d->element = k;
+    if (d->element < 0) {
+      diag_error(ir->path, o->loc, "output '%s': force '%s' is not active", o->name, ir->forces[o->force].name);
+      return -1;
+    }
+    return 0;
+  case OUT_RELATIVE: {
+    if (d->body < 0 && o->has_point) memcpy(d->s, o->point, sizeof d->s);
+    d->node = o->node;
+    d->body2 = o->rel_body - 1;
+    d->node2 = o->rel_node;
+    if (o->rel_has_point && d->body2 < 0) {
+      memcpy(d->s2, o->rel_point, sizeof d->s2);
+    } else if (o->rel_has_point) {
+      const ir_body *B = &ir->bodies[o->rel_body];
+      double A[9], rel[3];
+      mb_euler_to_A(B->orientation, A);
+      for (int j = 0; j < 3; j++) rel[j] = o->rel_point[j] - B->position[j];
+      mb_mul3t(A, rel, d->s2);
+    }
+    d->frame = o->frame_body - 1;
+    return 0;
+  }
+  case OUT_JOINT: {
+    const ir_joint *J = &ir->joints[o->joint];
+    if (jm0[o->joint] < 0) {
+      diag_error(ir->path, o->loc, "output '%s': joint '%s' is not active", o->name, J->name);
+      return -1;
+    }
+    d->jmarker[0] = jm0[o->joint];
+    d->jmarker[1] = jm1[o->joint];
+    d->joint_dofs = J->kind == JOINT_REVOLUTE ? 1 : J->kind == JOINT_PRISMATIC ? 2 : 3;
+    return 0;
+  }
+  case OUT_CENTER_OF_MASS: {
+    double total = 0;
+    d->node = -1;
+    if (o->cm_bodies) { /* the subset's weights in output_coef */
+      double *c = realloc(L->output_coef, sizeof(double) * (size_t)(L->noutput_coef + m->nbody + 1));
+      if (!c) return -1;
+      L->output_coef = c;
+      d->node = L->noutput_coef;
+      for (int b = 0; b < m->nbody; b++) c[d->node + b] = 0;
+      for (int i = 0; i < o->ncm_bodies; i++) c[d->node + o->cm_bodies[i] - 1] = 1;
+      L->noutput_coef += m->nbody;
+    }
+    for (int b = 0; b < m->nbody; b++)
+      if (d->node < 0 || L->output_coef[d->node + b] != 0)
+        total += L->body[b].kind == MB_BODY_FLEXIBLE ? L->body[b].flex->mass : L->body[b].mass;
+    if (!(total > 0)) {
+      diag_error(ir->path, o->loc, "output '%s': the bodies have no mass", o->name);
+      return -1;
+    }
+    return 0;
+  }
+  default:
+    return 0;
+  }
+}
 
 /* a SECTION output's rows of coefficients on w, appended to L->output_coef */
 static int section_coefficients(lmodel *L, const ir_output *o, mb_outputdef *d) {
@@ -347,7 +422,7 @@ lmodel *lower_model(const ir_model *ir, const flex_product *flex) {
   L->output = calloc((size_t)ir->noutputs + 1, sizeof *L->output);
   L->joint_name = calloc((size_t)ir->njoints + 1, sizeof(char *));
   int ncols = 0;
-  for (int k = 0; k < ir->noutputs; k++) ncols += output_columns(&ir->outputs[k]);
+  for (int k = 0; k < ir->noutputs; k++) ncols += output_columns(ir, &ir->outputs[k]);
   L->col_name = calloc((size_t)ncols + 1, sizeof(char *));
   if (!L->body || !L->marker || !L->marker_desc || !L->row || !L->row_desc || !L->row_loc ||
       !L->force || !L->force_ir || !L->force_prm || !L->force_law || !L->profile || !L->profile_driver || !L->profile_force ||
@@ -466,6 +541,16 @@ lmodel *lower_model(const ir_model *ir, const flex_product *flex) {
         for (int i = 0; i < 9; i++) Cg[i] = A[i];
         memcpy(L->q0 + d->qadr, P, sizeof P);
         memcpy(L->q0 + d->qadr + 3, qb + 3, sizeof(double) * 4);
+        /* it starts moving with the frame at the node (v + w x r; the same
+           body-axis angular velocity): at rest, the assembly's minimum-norm
+           velocity correction would slow the whole system down */
+        const double *vb = L->v0 + L->body[b].vadr;
+        double wg[3], r[3], wxr[3];
+        mb_mul3(A, vb + 3, wg);
+        for (int i = 0; i < 3; i++) r[i] = P[i] - qb[i];
+        mb_cross3(wg, r, wxr);
+        for (int i = 0; i < 3; i++) L->v0[d->vadr + i] = vb[i] + wxr[i];
+        memcpy(L->v0 + d->vadr + 3, vb + 3, sizeof(double) * 3);
         int mn = add_marker(L, b, node, P, Cg,
                             xstrdup_printf("node of body '%s' under virtual body '%s'%s",
                                            L->body[b].name, name, ""), J->body_loc[s]);
@@ -536,7 +621,7 @@ lmodel *lower_model(const ir_model *ir, const flex_product *flex) {
     d->driver_marker = -1;
     d->node = -1;
     d->chord[0] = d->chord[1] = -1;
-    d->ncols = output_columns(o);
+    d->ncols = output_columns(ir, o);
     d->col = col;
     if (d->body >= 0) {
       const ir_body *B = &ir->bodies[o->body];
@@ -566,7 +651,13 @@ lmodel *lower_model(const ir_model *ir, const flex_product *flex) {
       lower_free(L);
       return NULL;
     }
-    if (o->kind == OUT_POSITION || o->kind == OUT_VELOCITY) d->node = o->node;
+    if (o->kind == OUT_POSITION || o->kind == OUT_VELOCITY || o->kind == OUT_ACCELERATION) d->node = o->node;
+    if (o->kind >= OUT_FORCE && o->kind != OUT_TYRE && lower_measure_output(L, o, jm0, jm1, d)) {
+      free(jm0);
+      free(jm1);
+      lower_free(L);
+      return NULL;
+    }
     if ((o->kind == OUT_DEFLECTION || o->kind == OUT_MODAL || o->kind == OUT_SECTION) &&
         (d->body < 0 || L->body[d->body].kind != MB_BODY_FLEXIBLE ||
          (o->kind == OUT_MODAL && o->mode >= L->body[d->body].nm))) {
@@ -610,6 +701,7 @@ lmodel *lower_model(const ir_model *ir, const flex_product *flex) {
       else if (d->ncols == 4) suffix = e4[j];
       else if (d->ncols == 6) suffix = o->kind == OUT_MOMENTUM ? pm[j] : o->kind == OUT_SECTION ? sf[j] : rc[j];
       else if (d->ncols == 10) suffix = ty[j];
+      else if (d->ncols == 2 && o->kind == OUT_JOINT) suffix = j ? "travel" : "angle";
       L->col_name[col + j] = suffix ? xstrdup_printf("%s.%s%s", o->name, suffix, "")
                                     : strdup(o->name);
     }
@@ -737,11 +829,42 @@ static int find_slot(const int *Kp, const int *Ki, int row, int col) {
   return -1;
 }
 
+/* does the model ask for an implicit method (genalpha, or auto, which may
+ * choose it)?  Then the pattern carries the force elements' tangent blocks */
+static int wants_tangents(const lmodel *L) {
+  return L->ir && (L->ir->sim.integrator == INTEGRATOR_GENALPHA ||
+                   L->ir->sim.integrator == INTEGRATOR_AUTO);
+}
+
+/* the entries of force e's tangent blocks: the columns of each side's body
+ * against each other's (E NULL: count them) */
+static size_t tangent_entries(const lmodel *L, int e, entry *E) {
+  const mb_forcedef *d = &L->force[e];
+  size_t ne = 0;
+  for (int s = 0; s < 2; s++)
+    for (int u = 0; u < 2; u++) {
+      int ns = mb_force_tangent_side_cols(L->body, L->marker, d, s);
+      int nu = mb_force_tangent_side_cols(L->body, L->marker, d, u);
+      if (!ns || !nu) continue;
+      int rs = L->body[L->marker[s ? d->m1 : d->m0].body].vadr;
+      int cu = L->body[L->marker[u ? d->m1 : d->m0].body].vadr;
+      for (int i = 0; i < ns; i++)
+        for (int j = 0; j < nu; j++) {
+          if (E) E[ne] = (entry){rs + i, cu + j};
+          ne++;
+        }
+    }
+  return ne;
+}
+
 int lower_pattern(lmodel *L) {
   mb_model *m = &L->m;
   m->nc = m->nrow;
   m->n = m->nv + m->nc;
+  int tangents = wants_tangents(L);
   size_t cap = 24 * (size_t)m->nrow + 1;
+  if (tangents)
+    for (int e = 0; e < m->nforce; e++) cap += tangent_entries(L, e, NULL);
   for (int b = 0; b < m->nbody; b++) cap += (size_t)(6 + L->body[b].nm) * (size_t)(6 + L->body[b].nm) + 12;
   for (int r = 0; r < m->nrow; r++)
     for (int s = 0; s < 2; s++) {
@@ -784,6 +907,8 @@ int lower_pattern(lmodel *L) {
         }
     }
   }
+  if (tangents)
+    for (int e = 0; e < m->nforce; e++) ne += tangent_entries(L, e, E + ne);
   qsort(E, ne, sizeof *E, entry_cmp);
   free(L->Kp);
   free(L->Ki);
@@ -824,6 +949,32 @@ int lower_pattern(lmodel *L) {
     for (int i = 0; i < 3; i++)
       for (int j = 0; j < 3; j++)
         B->mslot[3 + 3 * i + j] = find_slot(L->Kp, L->Ki, B->vadr + 3 + i, B->vadr + 3 + j);
+  }
+  /* force tangents: each element's blocks in the order of tangent_entries */
+  free(L->force_tslot);
+  free(L->tangent_slot);
+  L->force_tslot = NULL;
+  L->tangent_slot = NULL;
+  L->ntangent_slot = 0;
+  m->force_tslot = m->tangent_slot = NULL;
+  if (tangents) {
+    size_t nts = 0;
+    for (int e = 0; e < m->nforce; e++) nts += tangent_entries(L, e, NULL);
+    entry *T = malloc((nts + 1) * sizeof *T);
+    L->force_tslot = malloc(((size_t)m->nforce + 1) * sizeof(int));
+    L->tangent_slot = malloc((nts + 1) * sizeof(int));
+    if (!T || !L->force_tslot || !L->tangent_slot) { free(T); return -1; }
+    nts = 0;
+    for (int e = 0; e < m->nforce; e++) {
+      size_t k = tangent_entries(L, e, T + nts);
+      L->force_tslot[e] = k ? (int)nts : -1;
+      for (size_t i = nts; i < nts + k; i++) L->tangent_slot[i] = find_slot(L->Kp, L->Ki, T[i].row, T[i].col);
+      nts += k;
+    }
+    free(T);
+    L->ntangent_slot = (int)nts;
+    m->force_tslot = L->force_tslot;
+    m->tangent_slot = L->tangent_slot;
   }
   /* modal columns of rows on node markers: nm slots, then nm transposed slots */
   size_t nms = 0;
@@ -922,5 +1073,6 @@ void lower_free(lmodel *L) {
   }
   free(L->name);
   free(L->mslotf); free(L->body_name); free(L->modal_slot);
+  free(L->force_tslot); free(L->tangent_slot);
   free(L);
 }

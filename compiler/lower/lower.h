@@ -44,6 +44,11 @@ typedef struct {
   int **mslotf;
   int *modal_slot;           /* slots of constraint rows' modal columns */
   int nmodal_slot;
+  /* force-element tangents (an implicit method asked for; else NULL, 0):
+   * m.force_tslot and m.tangent_slot, see mb_model.h */
+  int *force_tslot;
+  int *tangent_slot;
+  int ntangent_slot;
   int nvirtual;              /* virtual bodies inserted for joints on flexible nodes */
   char **body_name;          /* owned names of inserted bodies */
   char *name;                /* model name, with the scene's appended: <model>_<scene> */

@@ -8,6 +8,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 #ifdef __linux__
 #include <sys/prctl.h>
@@ -37,7 +38,9 @@ static void pass_on(int sig) {
   if (running > 0) kill(running, sig);
 }
 
-int proc_run(char *const argv[]) {
+int proc_run(char *const argv[]) { return proc_run_watch(argv, NULL, NULL); }
+
+int proc_run_watch(char *const argv[], void (*tick)(void *), void *user) {
   fflush(stdout);
   fflush(stderr);
   static const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
@@ -72,7 +75,17 @@ int proc_run(char *const argv[]) {
   int status = 0, rc;
   if (pid < 0) rc = -1;
   else {
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
+    if (tick) {
+      /* poll, calling tick about four times a second until the child ends */
+      for (;;) {
+        pid_t w = waitpid(pid, &status, WNOHANG);
+        if (w == pid || (w < 0 && errno != EINTR)) break;
+        tick(user);
+        struct timespec ts = {0, 250000000L};
+        nanosleep(&ts, NULL);
+      }
+    } else
+      while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
     rc = WIFEXITED(status) ? WEXITSTATUS(status) : WIFSIGNALED(status) ? 128 + WTERMSIG(status) : 128;
   }
   running = 0;

@@ -9,6 +9,8 @@
  * removes the registered temporary files and dies of the same signal.  On
  * Linux the child also gets SIGTERM if mbcc is killed outright. */
 int proc_run(char *const argv[]);
+/* the same, calling tick(user) about four times a second while the child runs */
+int proc_run_watch(char *const argv[], void (*tick)(void *), void *user);
 
 /* Temporary files removed if mbcc is killed while a child runs (at most 8). */
 void proc_cleanup_add(const char *path);

@@ -84,8 +84,12 @@ typedef enum {
   MB_OUT_POSITION = 1, MB_OUT_ORIENTATION, MB_OUT_ANGLE, MB_OUT_VELOCITY, MB_OUT_ANGULAR_VELOCITY,
   MB_OUT_ACCELERATION, MB_OUT_ANGULAR_ACCELERATION, MB_OUT_REACTION, MB_OUT_EFFORT,
   MB_OUT_KINETIC_ENERGY, MB_OUT_POTENTIAL_ENERGY, MB_OUT_TOTAL_ENERGY, MB_OUT_DEFLECTION,
-  MB_OUT_MODAL, MB_OUT_MOMENTUM, MB_OUT_SECTION, MB_OUT_TYRE
+  MB_OUT_MODAL, MB_OUT_MOMENTUM, MB_OUT_SECTION, MB_OUT_FORCE, MB_OUT_RELATIVE, MB_OUT_JOINT,
+  MB_OUT_CENTER_OF_MASS, MB_OUT_TYRE
 } mb_output_kind;
+
+/* what a RELATIVE or CENTER_OF_MASS output measures */
+enum { MB_QUANTITY_POSITION = 0, MB_QUANTITY_VELOCITY = 1, MB_QUANTITY_ACCELERATION = 2 };
 
 typedef struct {
   mb_output_kind kind;
@@ -108,6 +112,20 @@ typedef struct {
                         the output is output_coef rows times w */
   int chord[2];      /* DEFLECTION: minus the chord between these nodes' deflections, or -1 */
   mb_real scale;
+  /* FORCE, RELATIVE, JOINT, CENTER_OF_MASS (the fields below are zero for other kinds):
+   * FORCE: 'element' is the force element; component 0..5 picks one of fx..tz, 6 the
+   * tension of a spring.  RELATIVE: the marker (body, s, node) relative to (body2,
+   * s2, node2; body2 = -1: the ground, s2 global), resolved in the axes of body 'frame'
+   * (-1: global).  JOINT: the joint's markers jmarker[0], jmarker[1] and joint_dofs
+   * (1: rotation, 2: translation, 3: both, angle first).  CENTER_OF_MASS: with node
+   * >= 0, output_coef + node holds nbody weights (1: in the subset, 0: not); -1: all. */
+  int element;
+  int quantity;      /* RELATIVE, CENTER_OF_MASS: MB_QUANTITY_* */
+  int body2, node2;
+  mb_real s2[3];
+  int frame;
+  int jmarker[2];
+  int joint_dofs;
   int ncols, col;    /* columns in the output vector and the first of them */
 } mb_outputdef;
 
@@ -169,7 +187,34 @@ typedef struct mb_model {
   const char *const *param_name;
   const mb_real *param_value, *param_min, *param_max;
   void (*set_params)(const struct mb_model *m, const mb_real *p);
+  /* force-element tangents on the pattern (models compiled for an implicit
+   * method; NULL otherwise): force_tslot[e] is the first of force e's slots
+   * in tangent_slot, or -1 when it has none.  Its slots are four blocks of
+   * body columns, sides (0,0), (0,1), (1,0), (1,1), each row-major with
+   * mb_force_tangent_cols(m, e, s) rows and columns (docs/formulation.md). */
+  const int *force_tslot;
+  const int *tangent_slot;
 } mb_model;
+
+/* How many velocity columns side s (0, 1) of force element d has in the
+ * force tangent: 0 on the ground or a virtual body (its columns are
+ * eliminated by the solver's compile-time plan), 6 + nm on a flexible node
+ * marker (the field's side 0: 6, its reaction acts through the body frame at
+ * marker 1's point), else 6.  Only springs and fields have tangents. */
+static inline int mb_force_tangent_side_cols(const mb_body *body, const mb_markerdef *marker,
+                                             const mb_forcedef *d, int s) {
+  if (d->kind != MB_FORCE_SPRING && d->kind != MB_FORCE_FIELD) return 0;
+  if (d->m0 < 0 || d->m1 < 0) return 0;
+  const mb_markerdef *md = &marker[s ? d->m1 : d->m0];
+  if (md->body < 0) return 0;
+  const mb_body *B = &body[md->body];
+  if (B->kind == MB_BODY_VIRTUAL) return 0;
+  if (d->kind == MB_FORCE_FIELD && s == 0) return 6;
+  return md->node >= 0 ? 6 + B->nm : 6;
+}
+static inline int mb_force_tangent_cols(const struct mb_model *m, int e, int s) {
+  return mb_force_tangent_side_cols(m->body, m->marker, &m->force[e], s);
+}
 
 /* triplets (row, column, value) of K from the general generic path */
 typedef struct {
@@ -218,6 +263,19 @@ void mb_model_track_angles(const struct mb_model *m, const mb_real *q, const mb_
  * at most a quarter turn at its present angular velocity (INFINITY without
  * angle outputs): beyond it unwrapping would be ambiguous. */
 double mb_model_angle_step(const struct mb_model *m, const mb_real *q, const mb_real *v, void *work);
+/* The force F and torque T (global) that force element k applies on its body 1
+ * (the second body; for one-body elements, its body), about its attachment point
+ * (that body's marker point).  'work' as for mb_model_outputs. */
+void mb_force_wrench(const mb_model *m, int k, mb_real t, const mb_real *q, const mb_real *v,
+                     mb_real F[3], mb_real T[3], void *work);
+/* Add the force elements' tangents into Kx at their slots (m->force_tslot;
+ * nothing when NULL): kfac (-df/dq) + cfac (-df/dv) over the body columns each
+ * element connects, f the generalized applied force.  The material part of
+ * each kernel's tangent (elements/, I5) mapped through the markers' velocity
+ * Jacobians; the geometric terms of order |force| (turning lever arms and
+ * axes) are left out.  Used by generalized-alpha for both drivers. */
+void mb_model_force_tangent(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
+                            mb_real kfac, mb_real cfac, mb_real *Kx, void *work);
 /* kinetic and potential energy (gravity and force elements) */
 void mb_model_energy(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
                      mb_real *kinetic, mb_real *potential, void *work);

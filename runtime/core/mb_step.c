@@ -239,6 +239,8 @@ static int step_genalpha(mb_stepper *s, mb_real h) {
           if (slot >= 0) s->Kmod[slot] += B->flex->stiffness[j] / bp + gp / bp * B->flex->damping[j];
         }
       }
+      /* and the force elements' stiffness and damping (models compiled for genalpha) */
+      mb_model_force_tangent(m, s->t + h, s->q1, s->v1, 1 / bp, gp / bp, s->Kmod, s->frames);
       if (m->ldl_factor(m, s->Kmod, s->ldl)) return MB_ERR_SINGULAR;
     }
     int st = solve(s, s->Kmod, s->dv);

@@ -209,6 +209,81 @@ void mb_generic_init(const mb_model *m, mb_real *Kx) {
   }
 }
 
+
+/* the velocity Jacobian of side s of force element d, as d rows (the wrench
+ * components the kernel's tangent is of: 3 forces for a spring, force and
+ * torque for a field) over the side's nc body columns: row k is the body
+ * columns of a unit wrench component k (J^T e_k) at the side's point */
+static int tangent_jacobian(const mb_model *m, const mb_frame *F, const mb_marker *MK,
+                            const mb_forcedef *d, int s, int dim, mb_real *A) {
+  static const mb_real zero[3] = {0, 0, 0};
+  int nc = mb_force_tangent_cols(m, (int)(d - m->force), s);
+  if (!nc) return 0;
+  int k = s ? d->m1 : d->m0;
+  for (int r = 0; r < dim; r++) {
+    mb_real e[3] = {0, 0, 0};
+    e[r % 3] = 1;
+    const mb_real *dV = r < 3 ? e : zero, *dW = r < 3 ? zero : e;
+    if (d->kind == MB_FORCE_FIELD && s == 0) /* the reaction at marker 1's point */
+      mb_rigid_cols(&F[m->marker[k].body], MK[d->m1].P, dV, dW, A + r * nc);
+    else
+      marker_cols(m, F, MK, k, 0, dV, dW, A + r * nc);
+  }
+  return nc;
+}
+
+void mb_model_force_tangent(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
+                            mb_real kfac, mb_real cfac, mb_real *Kx, void *work) {
+  (void)t; /* no force kernel with a tangent depends on time */
+  if (!m->force_tslot) return;
+  mb_frame *F = (mb_frame *)work;
+  mb_marker *MK = (mb_marker *)(F + m->nbody);
+  frames_and_markers(m, q, v, F, MK);
+  for (int e = 0; e < m->nforce; e++) {
+    const mb_forcedef *d = &m->force[e];
+    if (m->force_tslot[e] < 0) continue;
+    const int *slot = m->tangent_slot + m->force_tslot[e];
+    mb_real tan[72], F0[3], F1[3], T[3], S[36];
+    int dim;
+    if (d->kind == MB_FORCE_SPRING) {
+      mb_spring(&MK[d->m0], &MK[d->m1], m->force_prm + d->padr, m->force_law + d->ladr, F0, F1, tan);
+      dim = 3;
+      for (int i = 0; i < 9; i++) S[i] = kfac * tan[i] + cfac * tan[9 + i];
+    } else if (d->kind == MB_FORCE_FIELD) {
+      mb_field(&MK[d->m0], &MK[d->m1], m->force_prm + d->padr, F1, T, tan);
+      dim = 6;
+      for (int i = 0; i < 36; i++) S[i] = kfac * tan[i] + cfac * tan[36 + i];
+    } else {
+      continue;
+    }
+    /* the wrench W on side 1 depends on the relative motion A1 dq1 - A0 dq0
+       (side 0 gets -W through A0): -df_s/dq_t = -sg_s sg_t A_s^T S A_t */
+    mb_real A[2][6 * (6 + MB_MAX_MODES)], SA[6 * (6 + MB_MAX_MODES)];
+    int nc[2];
+    for (int s = 0; s < 2; s++) nc[s] = tangent_jacobian(m, F, MK, d, s, dim, A[s]);
+    for (int s = 0; s < 2; s++)
+      for (int u = 0; u < 2; u++) {
+        int ns = nc[s], nu = nc[u];
+        if (!ns || !nu) { slot += ns * nu; continue; }
+        mb_real sign = (s == u) ? -1 : 1;
+        for (int k = 0; k < dim; k++) /* SA = S A_u */
+          for (int j = 0; j < nu; j++) {
+            mb_real x = 0;
+            for (int l = 0; l < dim; l++) x += S[dim * k + l] * A[u][l * nu + j];
+            SA[k * nu + j] = x;
+          }
+        for (int i = 0; i < ns; i++)
+          for (int j = 0; j < nu; j++) {
+            mb_real x = 0;
+            for (int k = 0; k < dim; k++) x += A[s][k * ns + i] * SA[k * nu + j];
+            int sl = slot[i * nu + j];
+            if (sl >= 0) Kx[sl] += sign * x;
+          }
+        slot += ns * nu;
+      }
+  }
+}
+
 /* The evaluation of both generic variants: entries of K go to the fixed
  * pattern's slots (K written by the caller's init for constants), or, on
  * the general path, every entry of every element block goes to triplets. */
@@ -370,6 +445,210 @@ void mb_model_energy(const mb_model *m, mb_real t, const mb_real *q, const mb_re
   *potential = U;
 }
 
+/* force element k's force and torque on its body 1 about its marker point, from
+ * the markers: the same kernels and scaling as forces_eval */
+static void force_wrench_markers(const mb_model *m, int k, mb_real t, const mb_frame *F,
+                                 const mb_marker *MK, mb_real Fv[3], mb_real T[3]) {
+  const mb_forcedef *d = &m->force[k];
+  const mb_real *prm = m->force_prm + d->padr;
+  int b0 = m->marker[d->m0].body;
+  for (int j = 0; j < 3; j++) Fv[j] = T[j] = 0;
+  switch (d->kind) {
+  case MB_FORCE_POINT:
+  case MB_FORCE_TORQUE: {
+    mb_real s = 1, x[3];
+    if (d->profile >= 0) { mb_profile_eval(&m->profile[d->profile], t, x); s = x[0]; }
+    mb_point_vector(prm, s, d->local && b0 >= 0 ? F[b0].A : 0, d->kind == MB_FORCE_POINT ? Fv : T);
+    break;
+  }
+  case MB_FORCE_SPRING: {
+    mb_real F0[3];
+    mb_spring(&MK[d->m0], &MK[d->m1], prm, m->force_law + d->ladr, F0, Fv, 0);
+    break;
+  }
+  case MB_FORCE_FIELD:
+    mb_field(&MK[d->m0], &MK[d->m1], prm, Fv, T, 0);
+    break;
+  case MB_FORCE_TYRE: /* one marker, the wheel centre: force and torque on the wheel */
+    mb_tyre(&MK[d->m0], prm, Fv, T, 0, 0);
+    break;
+  }
+}
+
+void mb_force_wrench(const mb_model *m, int k, mb_real t, const mb_real *q, const mb_real *v,
+                     mb_real F[3], mb_real T[3], void *work) {
+  mb_frame *Fr = (mb_frame *)work;
+  mb_marker *MK = (mb_marker *)(Fr + m->nbody);
+  frames_and_markers(m, q, v, Fr, MK);
+  force_wrench_markers(m, k, t, Fr, MK, F, T);
+}
+
+/* position P, velocity V and (with vd) acceleration Acc, global, of a point of
+ * body b: s in body axes, or FE node 'node' of a flexible body; b = -1: the
+ * fixed global point s.  Builds the body's frame itself, so that it also
+ * serves at the initial state. */
+static void point_motion(const mb_model *m, int b, const mb_real s[3], int node, const mb_real *q,
+                         const mb_real *v, const mb_real *vd, mb_real P[3], mb_real V[3], mb_real Acc[3]) {
+  if (b < 0) {
+    for (int j = 0; j < 3; j++) { P[j] = s[j]; V[j] = Acc[j] = 0; }
+    return;
+  }
+  const mb_body *B = &m->body[b];
+  mb_frame f;
+  mb_frame_rigid(q + B->qadr, v + B->vadr, &f);
+  mb_real u[3], t1[3], t2[3], wd[3];
+  const mb_real *a = vd ? vd + B->vadr : 0;
+  if (a) mb_mul3(f.A, a + 3, wd);
+  if (node >= 0) {
+    static const mb_real I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const mb_flex *fx = B->flex;
+    const mb_real *w = q + B->qadr + 7;
+    mb_marker nk;
+    mb_marker_node(&f, fx, node, w, v + B->vadr + 6, I3, &nk);
+    for (int j = 0; j < 3; j++) { P[j] = nk.P[j]; V[j] = nk.V[j]; }
+    if (!a) return;
+    /* Acc = rdd + A (wd' x b + X wdd) + aP,  b = x_k + X_k w the node in body axes */
+    mb_real b3[3], Xa[3], l[3];
+    mb_modal3(fx->node_X + 3 * node * fx->nm, fx->nm, w, b3);
+    for (int j = 0; j < 3; j++) b3[j] += fx->node_x[3 * node + j];
+    mb_modal3(fx->node_X + 3 * node * fx->nm, fx->nm, a + 6, Xa);
+    mb_cross3(a + 3, b3, l);
+    for (int j = 0; j < 3; j++) l[j] += Xa[j];
+    mb_mul3(f.A, l, t1);
+    for (int j = 0; j < 3; j++) Acc[j] = a[j] + t1[j] + nk.aP[j];
+    return;
+  }
+  mb_mul3(f.A, s, u);
+  mb_cross3(f.w, u, t1);
+  for (int j = 0; j < 3; j++) { P[j] = f.r[j] + u[j]; V[j] = f.rd[j] + t1[j]; }
+  if (!a) return;
+  mb_cross3(wd, u, t1);
+  mb_wwa(f.w, u, t2);
+  for (int j = 0; j < 3; j++) Acc[j] = a[j] + t1[j] + t2[j];
+}
+
+/* RELATIVE: with r = P - P2 (global) and R the frame body's rotation, d = R^T r
+ * and its first and second time derivatives as seen in that body,
+ *   d' = R^T r' - w x d,  d'' = R^T r'' - wd x d - 2 w x d' - w x (w x d)
+ * (w, wd: the body's angular velocity and acceleration in its own axes); the
+ * displacement is d less its value at the initial state q0 (from_initial). */
+static void relative_motion(const mb_model *m, const mb_outputdef *o, const mb_real *q, const mb_real *v,
+                            const mb_real *vd, int from_initial, mb_real val[3]) {
+  mb_real P[3], V[3], Acc[3] = {0, 0, 0}, P2[3], V2[3], Acc2[3] = {0, 0, 0}, r[3], rd[3], rdd[3];
+  const mb_real *need_vd = o->quantity == MB_QUANTITY_ACCELERATION ? vd : 0;
+  point_motion(m, o->body, o->s, o->node, q, v, need_vd, P, V, Acc);
+  point_motion(m, o->body2, o->s2, o->node2, q, v, need_vd, P2, V2, Acc2);
+  for (int j = 0; j < 3; j++) { r[j] = P[j] - P2[j]; rd[j] = V[j] - V2[j]; rdd[j] = Acc[j] - Acc2[j]; }
+  if (o->frame < 0) {
+    const mb_real *x = o->quantity == MB_QUANTITY_POSITION ? r : o->quantity == MB_QUANTITY_VELOCITY ? rd : rdd;
+    for (int j = 0; j < 3; j++) val[j] = x[j];
+  } else {
+    const mb_body *B = &m->body[o->frame];
+    mb_frame f;
+    mb_frame_rigid(q + B->qadr, v + B->vadr, &f);
+    mb_real d[3], dd[3], t1[3], t2[3], t3[3];
+    mb_mul3t(f.A, r, d);
+    mb_mul3t(f.A, rd, dd);
+    mb_cross3(f.wl, d, t1);
+    for (int j = 0; j < 3; j++) dd[j] -= t1[j];
+    if (o->quantity == MB_QUANTITY_POSITION) for (int j = 0; j < 3; j++) val[j] = d[j];
+    else if (o->quantity == MB_QUANTITY_VELOCITY) for (int j = 0; j < 3; j++) val[j] = dd[j];
+    else {
+      mb_mul3t(f.A, rdd, val);
+      mb_cross3(vd + B->vadr + 3, d, t1);
+      mb_cross3(f.wl, dd, t2);
+      mb_wwa(f.wl, d, t3);
+      for (int j = 0; j < 3; j++) val[j] -= t1[j] + 2 * t2[j] + t3[j];
+    }
+  }
+  if (o->quantity == MB_QUANTITY_POSITION && from_initial) {
+    mb_real d0[3];
+    relative_motion(m, o, m->q0, m->v0, 0, 0, d0);
+    for (int j = 0; j < 3; j++) val[j] -= d0[j];
+  }
+}
+
+/* a marker of the table at (q, v), its body's frame built here */
+static void marker_at(const mb_model *m, int k, const mb_real *q, const mb_real *v, mb_marker *mk) {
+  const mb_markerdef *d = &m->marker[k];
+  if (d->body < 0) { mb_marker_ground(d->s, d->C, mk); return; }
+  const mb_body *B = &m->body[d->body];
+  mb_frame f;
+  mb_frame_rigid(q + B->qadr, v + B->vadr, &f);
+  if (d->node >= 0) mb_marker_node(&f, B->flex, d->node, q + B->qadr + 7, v + B->vadr + 6, d->C, mk);
+  else mb_marker_rigid(&f, d->s, d->C, mk);
+}
+
+/* JOINT: the rotation from marker 0's x axis to marker 1's about marker 0's z
+ * axis (as a rotation driver measures it) and the travel of marker 1's point
+ * along that axis, at (q, v), less their values at the initial state q0; the
+ * angle is the branch nearest 'ref' (unwrapped, radians) when it is given */
+static void joint_motion(const mb_model *m, const mb_outputdef *o, const mb_real *q, const mb_real *v,
+                         const mb_real *ref, mb_real *angle, mb_real *travel) {
+  mb_marker k0, k1, i0, i1;
+  mb_real x0[3], y0[3], z0[3], x1[3], d[3];
+  marker_at(m, o->jmarker[0], q, v, &k0);
+  marker_at(m, o->jmarker[1], q, v, &k1);
+  marker_at(m, o->jmarker[0], m->q0, m->v0, &i0);
+  marker_at(m, o->jmarker[1], m->q0, m->v0, &i1);
+  mb_real a = 0;
+  for (int s = 0; s < 2; s++) { /* now, then at q0 */
+    const mb_marker *A = s ? &i0 : &k0, *B = s ? &i1 : &k1;
+    mb_col3(A->R, 0, x0);
+    mb_col3(A->R, 1, y0);
+    mb_col3(A->R, 2, z0);
+    mb_col3(B->R, 0, x1);
+    for (int j = 0; j < 3; j++) d[j] = B->P[j] - A->P[j];
+    mb_real an = MB_ATAN2(mb_dot3(y0, x1), mb_dot3(x0, x1)), tr = mb_dot3(z0, d);
+    if (s) { a -= an; *travel -= tr; }
+    else { a = an; *travel = tr; }
+  }
+  if (ref && MB_ISFINITE(*ref)) a += 2 * MB_R(MB_PI) * MB_NEARBYINT((*ref - a) / (2 * MB_R(MB_PI)));
+  *angle = a;
+}
+
+/* CENTER_OF_MASS: the mass-weighted position, velocity or acceleration of the
+ * bodies (a flexible body with its deformation: m r + A S(w), S = S0 + S1 w) */
+static void center_of_mass(const mb_model *m, const mb_outputdef *o, const mb_real *q, const mb_real *v,
+                           const mb_real *vd, mb_real val[3]) {
+  mb_real total = 0, sum[3] = {0, 0, 0};
+  for (int b = 0; b < m->nbody; b++) {
+    const mb_body *B = &m->body[b];
+    if (o->node >= 0 && m->output_coef[o->node + b] == 0) continue;
+    mb_frame f;
+    mb_frame_rigid(q + B->qadr, v + B->vadr, &f);
+    const mb_real *a = vd ? vd + B->vadr : 0;
+    mb_real mass = B->mass, x[3] = {0, 0, 0}, l[3] = {0, 0, 0}, S[3], Sd[3], t1[3], t2[3], g[3];
+    if (B->kind == MB_BODY_FLEXIBLE) {
+      /* the first moment A S about the frame origin and its derivatives, body axes in l */
+      const mb_flex *fx = B->flex;
+      const mb_real *w = q + B->qadr + 7, *wd = v + B->vadr + 6;
+      mass = fx->mass;
+      mb_modal3(fx->S1, fx->nm, w, S);
+      for (int j = 0; j < 3; j++) S[j] += fx->S0[j];
+      mb_modal3(fx->S1, fx->nm, wd, Sd);
+      if (o->quantity == MB_QUANTITY_POSITION) {
+        for (int j = 0; j < 3; j++) l[j] = S[j];
+      } else if (o->quantity == MB_QUANTITY_VELOCITY) {
+        mb_cross3(f.wl, S, t1);
+        for (int j = 0; j < 3; j++) l[j] = t1[j] + Sd[j];
+      } else {
+        mb_real Sdd[3];
+        mb_modal3(fx->S1, fx->nm, a + 6, Sdd);
+        mb_cross3(a + 3, S, t1);
+        mb_wwa(f.wl, S, t2);
+        mb_cross3(f.wl, Sd, g);
+        for (int j = 0; j < 3; j++) l[j] = t1[j] + t2[j] + 2 * g[j] + Sdd[j];
+      }
+      mb_mul3(f.A, l, x);
+    }
+    const mb_real *c = o->quantity == MB_QUANTITY_POSITION ? f.r : o->quantity == MB_QUANTITY_VELOCITY ? f.rd : a;
+    for (int j = 0; j < 3; j++) sum[j] += mass * c[j] + x[j];
+    total += mass;
+  }
+  for (int j = 0; j < 3; j++) val[j] = total > 0 ? sum[j] / total : 0;
+}
+
 /* the angle of a body-fixed direction about a global axis, measured from its
  * initial direction, in radians; with a reference (the unwrapped angle a
  * moment ago, radians, less than pi away) the branch nearest to it.  Closed
@@ -383,10 +662,15 @@ static mb_real body_angle(const mb_outputdef *o, const mb_frame *f, const mb_rea
   return a;
 }
 
+/* a JOINT output with an angle column (to unwrap) */
+static int joint_angle_output(const mb_outputdef *o) {
+  return o->kind == MB_OUT_JOINT && (o->joint_dofs & 1);
+}
+
 void mb_model_track_angles(const mb_model *m, const mb_real *q, const mb_real *v, mb_real *ref,
                            int have_ref, void *work) {
   int any = 0;
-  for (int k = 0; k < m->noutput; k++) any |= m->output[k].kind == MB_OUT_ANGLE;
+  for (int k = 0; k < m->noutput; k++) any |= m->output[k].kind == MB_OUT_ANGLE || joint_angle_output(&m->output[k]);
   if (!any) return;
   mb_frame *F = (mb_frame *)work;
   mb_marker *MK = (mb_marker *)(F + m->nbody);
@@ -394,12 +678,16 @@ void mb_model_track_angles(const mb_model *m, const mb_real *q, const mb_real *v
   for (int k = 0; k < m->noutput; k++) {
     const mb_outputdef *o = &m->output[k];
     if (o->kind == MB_OUT_ANGLE) ref[o->col] = body_angle(o, &F[o->body], have_ref ? ref + o->col : 0);
+    if (joint_angle_output(o)) {
+      mb_real travel;
+      joint_motion(m, o, q, v, have_ref ? ref + o->col : 0, ref + o->col, &travel);
+    }
   }
 }
 
 double mb_model_angle_step(const mb_model *m, const mb_real *q, const mb_real *v, void *work) {
   int any = 0;
-  for (int k = 0; k < m->noutput; k++) any |= m->output[k].kind == MB_OUT_ANGLE;
+  for (int k = 0; k < m->noutput; k++) any |= m->output[k].kind == MB_OUT_ANGLE || joint_angle_output(&m->output[k]);
   if (!any) return INFINITY;
   mb_frame *F = (mb_frame *)work;
   mb_marker *MK = (mb_marker *)(F + m->nbody);
@@ -407,8 +695,14 @@ double mb_model_angle_step(const mb_model *m, const mb_real *q, const mb_real *v
   mb_real wmax = 0;
   for (int k = 0; k < m->noutput; k++) {
     const mb_outputdef *o = &m->output[k];
-    if (o->kind != MB_OUT_ANGLE) continue;
-    const mb_real *w = F[o->body].w;
+    mb_real w[3];
+    if (o->kind == MB_OUT_ANGLE) {
+      for (int j = 0; j < 3; j++) w[j] = F[o->body].w[j];
+    } else if (joint_angle_output(o)) { /* the joint's relative angular velocity */
+      for (int j = 0; j < 3; j++) w[j] = MK[o->jmarker[1]].W[j] - MK[o->jmarker[0]].W[j];
+    } else {
+      continue;
+    }
     wmax = MB_FMAX(wmax, MB_SQRT(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]));
   }
   /* a quarter turn at most between two unwrappings (pi would be ambiguous) */
@@ -434,8 +728,15 @@ void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_r
   for (int k = 0; k < m->noutput; k++) {
     const mb_outputdef *o = &m->output[k];
     const mb_frame *f = o->body >= 0 ? &F[o->body] : 0;
-    mb_real val[6] = {0, 0, 0, 0, 0, 0}, u[3], tmp[3], tmp2[3];
+    mb_real val[7] = {0, 0, 0, 0, 0, 0, 0}, u[3], tmp[3], tmp2[3];
     int nval = 3;
+    if (o->kind == MB_OUT_ACCELERATION && o->node >= 0) { /* a node of a flexible body */
+      mb_real P[3], V[3];
+      point_motion(m, o->body, o->s, o->node, q, v, vd, P, V, val);
+      if (o->component >= 0) out[o->col] = o->scale * val[o->component];
+      else for (int j = 0; j < 3; j++) out[o->col + j] = o->scale * val[j];
+      continue;
+    }
     if ((o->kind == MB_OUT_POSITION || o->kind == MB_OUT_VELOCITY) && o->node >= 0) {
       /* a node of a flexible body */
       const mb_body *B = &m->body[o->body];
@@ -587,11 +888,36 @@ void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_r
       else for (int j = 0; j < 10; j++) out[o->col + j] = o->scale * all[j];
       continue;
     }
+    case MB_OUT_FORCE: {
+      const mb_forcedef *d = &m->force[o->element];
+      force_wrench_markers(m, o->element, t, F, MK, val, val + 3);
+      nval = 6;
+      if (d->kind == MB_FORCE_SPRING) { /* tension: the pull along P1 - P0 (F1 = -T n) */
+        mb_real d1[3];
+        for (int j = 0; j < 3; j++) d1[j] = MK[d->m1].P[j] - MK[d->m0].P[j];
+        val[6] = -mb_dot3(val, d1) / MB_SQRT(mb_dot3(d1, d1));
+      }
+      break;
+    }
+    case MB_OUT_RELATIVE:
+      relative_motion(m, o, q, v, vd, 1, val);
+      break;
+    case MB_OUT_JOINT: {
+      mb_real angle, travel;
+      joint_motion(m, o, q, v, prev ? prev + o->col : 0, &angle, &travel);
+      nval = o->ncols;
+      if (o->joint_dofs == 2) val[0] = travel;
+      else { val[0] = angle; val[1] = travel; }
+      break;
+    }
+    case MB_OUT_CENTER_OF_MASS:
+      center_of_mass(m, o, q, v, vd, val);
+      break;
     case MB_OUT_KINETIC_ENERGY: val[0] = kin; nval = 1; break;
     case MB_OUT_POTENTIAL_ENERGY: val[0] = pot; nval = 1; break;
     case MB_OUT_TOTAL_ENERGY: val[0] = kin + pot; nval = 1; break;
     }
-    if (o->component >= 0 && nval == 3) {
+    if (o->component >= 0 && o->ncols == 1 && nval > 1) {
       out[o->col] = o->scale * val[o->component];
     } else {
       for (int j = 0; j < o->ncols; j++) out[o->col + j] = o->scale * val[j];

@@ -146,13 +146,17 @@ static double col_scale(const mb_model *m, const recorder *ref, int j) {
 }
 
 /* column j belongs to a configuration output: a position, orientation, angle,
- * deflection or modal coordinate (the quantities the agreement target is stated on) */
+ * deflection, modal coordinate, joint coordinate, relative displacement or centre
+ * of mass position (the quantities the agreement target is stated on) */
 static int is_position_col(const mb_model *m, int j) {
   for (int o = 0; o < m->noutput; o++) {
     const mb_outputdef *d = &m->output[o];
     if (j >= d->col && j < d->col + d->ncols)
       return d->kind == MB_OUT_POSITION || d->kind == MB_OUT_ORIENTATION ||
-             d->kind == MB_OUT_ANGLE || d->kind == MB_OUT_DEFLECTION || d->kind == MB_OUT_MODAL;
+             d->kind == MB_OUT_ANGLE || d->kind == MB_OUT_DEFLECTION || d->kind == MB_OUT_MODAL ||
+             d->kind == MB_OUT_JOINT ||
+             ((d->kind == MB_OUT_RELATIVE || d->kind == MB_OUT_CENTER_OF_MASS) &&
+              d->quantity == MB_QUANTITY_POSITION);
   }
   return 0;
 }

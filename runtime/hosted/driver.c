@@ -150,6 +150,12 @@ static const char *base_unit(const mb_outputdef *o, int k) {
     static const char *const unit[10] = {"N", "N", "N", "N m", "N m", "N m", "1", "rad", "rad", "m"};
     return unit[o->component >= 0 ? o->component : k - o->col];
   }
+  case MB_OUT_FORCE: /* one column: fx..tz or the tension */
+    if (o->ncols == 1) return o->component >= 3 && o->component < 6 ? "N m" : "N";
+    return first3 ? "N" : "N m";
+  case MB_OUT_RELATIVE: case MB_OUT_CENTER_OF_MASS:
+    return o->quantity == MB_QUANTITY_POSITION ? "m" : o->quantity == MB_QUANTITY_VELOCITY ? "m/s" : "m/s^2";
+  case MB_OUT_JOINT: return o->joint_dofs == 2 || k > o->col ? "m" : "rad";
   default: return "";
   }
 }
@@ -216,7 +222,8 @@ static void usage(const char *prog) {
           "usage: %s [-o results.csv] [--solver ldl|klu|dense] [--integrator rk4|dopri5|genalpha|auto]\n"
           "          [--end T] [--output-step H] [--step H] [--max-step H] [--rtol R] [--atol A]\n"
           "          [--rho-inf R] [--max-steps N]\n"
-          "          [--stabilization projection|baumgarte|none] [--precision N] [--set NAME=VALUE]... [--quiet]\n",
+          "          [--stabilization projection|baumgarte|none] [--precision N] [--set NAME=VALUE]... [--quiet]\n"
+          "          [--equilibrium]\n",
           prog);
 }
 
@@ -289,6 +296,7 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
     const char *a = argv[i], *val = (i + 1 < argc) ? argv[i + 1] : NULL;
     int takes = 1;
     if (!strcmp(a, "--quiet")) { quiet = 1; takes = 0; }
+    else if (!strcmp(a, "--equilibrium")) { set.equilibrium = 1; takes = 0; }
     else if (!val) { usage(argv[0]); return 2; }
     else if (!strcmp(a, "-o")) csv_path = val;
     else if (!strcmp(a, "--solver")) solver = val;
@@ -399,10 +407,39 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
     set.integrator = mb_integrator_auto(m, &set, why, sizeof why);
     if (!quiet) fprintf(stderr, "%s: integrator auto: %s\n", argv[0], why);
   }
+  if (set.integrator == MB_GENALPHA && !m->force_tslot && !quiet) {
+    int nstiff = 0;
+    for (int e = 0; e < m->nforce; e++)
+      nstiff += m->force[e].kind == MB_FORCE_SPRING || m->force[e].kind == MB_FORCE_FIELD;
+    if (nstiff)
+      fprintf(stderr, "%s: note: the model was compiled without its force elements' tangents "
+                      "(its integrator is not genalpha or auto): generalized-alpha's Newton sees "
+                      "only the masses and the modes, and stiff springs, bushings or beams force "
+                      "small steps\n", argv[0]);
+  }
   mb_sim sim;
   int st = mb_sim_init(&sim, m, ls, &set);
   sim.on_step = track_angles;
   sim.on_step_user = &w;
+  int equilibrium_failed = 0;
+  if (!st && set.equilibrium) {
+    mb_equilibrium_info eq;
+    st = mb_sim_equilibrium(&sim, &eq);
+    if (st) {
+      fprintf(stderr, "%s: error: static equilibrium: %s; no results written\n", argv[0], eq.why);
+      equilibrium_failed = 1;
+    } else if (!quiet) {
+      fprintf(stderr, "%s: static equilibrium in %d Newton iterations: force residual %.3g of %.6g N "
+              "(the weight or the largest applied force), constraint residual %.3g", argv[0],
+              eq.iterations, eq.force_residual, eq.force_scale, eq.constraint_residual);
+      if (eq.damped_steps > 0)
+        fprintf(stderr, "; %d damped steps past a turning point", eq.damped_steps);
+      if (eq.free_directions > 0)
+        fprintf(stderr, "; %d free direction%s without load left as given", eq.free_directions,
+                eq.free_directions > 1 ? "s" : "");
+      fprintf(stderr, "\n");
+    }
+  }
   if (!st) st = mb_sim_run(&sim, write_row, &w);
   if (w.progress && wall() - w.wall0 > 1.0) fprintf(stderr, "\n");
   int nonfinite_output = !st && w.nonfinite;
@@ -417,6 +454,9 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
     fprintf(stderr, "%s: error: cannot write '%s': %s; no results written\n", argv[0], csv_path,
             strerror(w.write_failed));
     rc = 2;
+  } else if (equilibrium_failed) {
+    unlink(tmp);
+    rc = 1;
   } else if (st || nonfinite_output) {
     unlink(tmp);
     if (nonfinite_output)

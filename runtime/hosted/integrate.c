@@ -37,6 +37,7 @@ void mb_settings_default(mb_settings *s) {
   s->rho_inf = 0.8;
   s->max_steps = 1e7;
   s->timers = 1;
+  s->equilibrium = 0;
 }
 
 int mb_sim_fail(mb_sim *s, double t, int status, const char *what) {
@@ -294,32 +295,110 @@ const char *mb_integrator_name(int integrator) {
   }
 }
 
+/* the largest |eigenvalue| of one spring-damper degree of freedom k, c
+ * on a mass m: c/2m + sqrt((c/2m)^2 + k/m) (omega when undamped, about c/m
+ * when overdamped) */
+static double dof_rate(double k, double c, double m) {
+  if (!(m > 0)) return 0;
+  double a = fmax(c, 0) / (2 * m);
+  return a + sqrt(a * a + fmax(k, 0) / m);
+}
+
+/* the mass (rot 0) or smallest principal-axis inertia bound (rot 1) a force
+ * element's side moves: 0 on the ground or a massless (virtual) body */
+static double side_inertia(const mb_model *m, int marker, int rot) {
+  int b = marker >= 0 ? m->marker[marker].body : -1;
+  if (b < 0) return 0;
+  const mb_body *B = &m->body[b];
+  if (!rot) return (double)B->mass;
+  return fmin((double)B->J[0], fmin((double)B->J[4], (double)B->J[8]));
+}
+
+/* the reduced mass of the two sides (one side on the ground: the other's) */
+static double reduced(double a, double b) {
+  if (a > 0 && b > 0) return a * b / (a + b);
+  return a > 0 ? a : b;
+}
+
+/* a law's largest slope: linear coefficient or table segment (power laws
+ * have no bound: not weighed) */
+static double law_slope(const mb_law *l) {
+  if (l->kind == MB_LAW_LINEAR) return fabs((double)l->coef);
+  if (l->kind != MB_LAW_TABLE) return 0;
+  double k = 0;
+  for (int i = 0; i + 1 < l->ntable; i++) {
+    double dx = (double)(l->table[2 * i + 2] - l->table[2 * i]);
+    if (dx > 0) k = fmax(k, fabs((double)(l->table[2 * i + 3] - l->table[2 * i + 1])) / dx);
+  }
+  return k;
+}
+
+/* the fastest rate of force element e, as one degree of freedom per
+ * direction: stiffness and damping on the diagonal of the element's
+ * matrices against the reduced mass (translations) or the smallest inertia
+ * (rotations) of the bodies it joins.  An estimate (lever arms and
+ * couplings between directions are left out), like the modes' sqrt(k). */
+static double force_rate(const mb_model *m, int e) {
+  const mb_forcedef *d = &m->force[e];
+  double mt = reduced(side_inertia(m, d->m0, 0), side_inertia(m, d->m1, 0));
+  double jr = reduced(side_inertia(m, d->m0, 1), side_inertia(m, d->m1, 1));
+  double rate = 0;
+  if (d->kind == MB_FORCE_SPRING) {
+    double k = law_slope(&m->force_law[d->ladr]);
+    double c = d->lnum > 1 ? law_slope(&m->force_law[d->ladr + 1]) : 0;
+    rate = dof_rate(k, c, mt);
+  } else if (d->kind == MB_FORCE_FIELD) {
+    const mb_real *K = m->force_prm + d->padr + MB_FIELD_K, *C = m->force_prm + d->padr + MB_FIELD_C;
+    for (int i = 0; i < 6; i++)
+      rate = fmax(rate, dof_rate((double)K[7 * i], (double)C[7 * i], i < 3 ? mt : jr));
+  }
+  return rate;
+}
+
 /* The stiffness an explicit method must resolve comes from the highest modal
- * frequency: Dormand-Prince is stable for |h lambda| up to about 3.3, so a
- * mode of angular frequency w caps its step at 3.3 / w.  When that cap is
- * below a tenth of the output step (the step the explicit method could
- * otherwise take), the implicit method is cheaper. */
+ * frequency and from the stiffest force element (force_rate): Dormand-Prince
+ * is stable for |h lambda| up to about 3.3, so a rate |lambda| caps its step
+ * at 3.3 / |lambda|.  When that cap is below a tenth of the output step (the
+ * step the explicit method could otherwise take), the implicit method is
+ * cheaper. */
 int mb_integrator_auto(const mb_model *m, const mb_settings *set, char *why, size_t nwhy) {
-  double wmax = 0;
+  double wmax = 0, fmax_rate = 0;
   const char *body = NULL;
+  int force = -1;
   for (int b = 0; b < m->nbody; b++) {
     const mb_body *B = &m->body[b];
     if (B->kind != MB_BODY_FLEXIBLE || !B->flex) continue;
     for (int j = 0; j < B->nm; j++)
       if (sqrt((double)B->flex->stiffness[j]) > wmax) { wmax = sqrt((double)B->flex->stiffness[j]); body = B->name; }
   }
-  double hstab = wmax > 0 ? 3.3 / wmax : INFINITY;
+  for (int e = 0; e < m->nforce; e++) {
+    double r = force_rate(m, e);
+    if (r > fmax_rate) { fmax_rate = r; force = e; }
+  }
+  double rate = fmax(wmax, fmax_rate);
+  double hstab = rate > 0 ? 3.3 / rate : INFINITY;
   double hwant = fmin(set->output_step, set->max_step);
   int implicit = hstab < 0.1 * hwant;
   if (why && nwhy) {
-    if (!body)
-      snprintf(why, nwhy, "dopri5: the model has no flexible modes, so nothing stiff for an explicit method");
-    else
+    if (!body && force < 0) {
+      snprintf(why, nwhy, "dopri5: the model has no flexible modes and no stiff force elements, so nothing stiff for an explicit method");
+    } else if (force >= 0 && fmax_rate >= wmax) {
+      const mb_forcedef *d = &m->force[force];
+      int b0 = m->marker[d->m0].body, b1 = d->m1 >= 0 ? m->marker[d->m1].body : -1;
+      snprintf(why, nwhy,
+               "%s: the stiffest force element (%s %d, between %s and %s, rate %.4g 1/s as "
+               "k/m and c/m of the bodies it joins) limits an explicit step to %.3g s for "
+               "stability, %s a tenth of the output step %.3g s",
+               implicit ? "genalpha" : "dopri5", d->kind == MB_FORCE_SPRING ? "spring" : "field",
+               force, b0 >= 0 ? m->body[b0].name : "ground", b1 >= 0 ? m->body[b1].name : "ground",
+               fmax_rate, hstab, implicit ? "below" : "above", hwant);
+    } else {
       snprintf(why, nwhy,
                "%s: the highest mode (%s, %.4g Hz) limits an explicit step to %.3g s for stability, "
                "%s a tenth of the output step %.3g s",
                implicit ? "genalpha" : "dopri5", body, wmax / (2 * MB_PI), hstab,
                implicit ? "below" : "above", hwant);
+    }
   }
   return implicit ? MB_GENALPHA : MB_DOPRI5;
 }

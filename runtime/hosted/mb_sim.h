@@ -22,6 +22,8 @@ typedef struct {
   double projection_tol;      /* max |phi| after projection */
   double rho_inf;             /* generalized-alpha: spectral radius at infinite step, 0..1 */
   double max_steps;           /* stop with MB_ERR_STEP_BUDGET beyond this many steps */
+  int equilibrium;            /* 1: move the positions to static equilibrium before the run
+                                 (mb_sim_equilibrium, equilibrium.c) */
   int timers;                 /* 1: clock each evaluation and factor/solve (the breakdown
                                  mbcc run prints); 0: only the whole run (mbcc bench) */
 } mb_settings;
@@ -70,6 +72,27 @@ int mb_sim_accel(mb_sim *s, double t, const mb_real *q, const mb_real *v, mb_rea
 /* project (q, v) onto the position and velocity constraints */
 int mb_sim_project(mb_sim *s, double t, mb_real *q, mb_real *v);
 void mb_sim_free(mb_sim *s);
+
+/* Static equilibrium (equilibrium.c): what mb_sim_equilibrium found */
+typedef struct {
+  int iterations;             /* Newton iterations */
+  double force_scale;         /* N: the weight, or the largest applied force if larger */
+  double force_residual;      /* max |f - D^T lambda| at v = 0, relative to force_scale */
+  double constraint_residual; /* max |phi| */
+  int free_directions;        /* unknowns the last tangent left free (no stiffness, no load) */
+  double smallest_damping;    /* the shortest line-search step taken (1: full Newton steps) */
+  int damped_steps;           /* pseudo-transient steps past a turning point, where the tangent
+                                 was singular along a loaded direction (a pendulum released
+                                 horizontally) */
+  char why[400];              /* the cause of a failure */
+} mb_equilibrium_info;
+/* Move s->q (from mb_sim_init: the model's initial state) to static
+ * equilibrium at t = 0: forces at zero velocity balanced by the constraint
+ * reactions, constraints satisfied, drivers at their t = 0 values.  The
+ * velocities s->v are kept, projected onto the velocity constraints.  MB_OK,
+ * or the status with info->why (MB_ERR_SINGULAR: a free direction under load;
+ * MB_ERR_NEWTON: no convergence). */
+int mb_sim_equilibrium(mb_sim *s, mb_equilibrium_info *info);
 
 /* The integrator 'auto' picks for this model and these settings, and why
  * (a sentence into why[0..nwhy)); never MB_AUTO. */

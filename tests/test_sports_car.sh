@@ -1,0 +1,177 @@
+#!/usr/bin/env bash
+# test_sports_car.sh: models/sports_car.yaml (the Stratos replica of seed 000,
+# rigid chassis) against the data and the acceptance checks of the vehicle
+# specification (/work/shared/reference/vehicle-model-spec.md, "spec §N").
+# Exit 0 = pass.  Every run takes the generic path (no C compile): seconds.
+#   1. mbcc check: the design pose closes without a Newton iteration (every
+#      joint is one global point shared by its bodies, spec §6.3: that the
+#      hardpoints are the spec's is checked by 4.), the two rear lower ball
+#      joints' x rows are found redundant (spec §3.3: rank 86 of 88), 16
+#      degrees of freedom;
+#   2. mass and centre of mass of all 17 bodies from the momentum output of
+#      uniform translations (p = M v, h = M r_cg x v): 980 kg, (-1.231, 0,
+#      0.420) (spec §4);
+#   3. released at design with gravity and the preloads, the car stays put
+#      (< 1 mm in 1 s, spec §12); the wheel loads carried by the tyre stand-ins
+#      sum to the weight (to 1e-4: the run is dynamic, the preloads rounded to
+#      0.1 N) and split by moment balance about the axles: 2092.8 /
+#      2714.1 N (spec §4);
+#   4. corner kinematics on a rig (chassis fixed, the lower arms driven):
+#      camber, spring length and half-track against the tables of spec §6.1,
+#      §6.2 at -80, -40, +40, +80 mm of wheel travel (a strong check of the
+#      hardpoints);
+#   5. ride: undamped free decay of the chassis guided in heave, then in
+#      pitch, against the bounce/pitch frequencies of the corner ride rates of
+#      spec §7 (1.60 Hz front, 1.75 Hz rear with 179.8 / 237.2 kg of sprung
+#      mass per corner), to 1.5 %.  Measured: heave +0.3 %, pitch -0.8 %; the
+#      ideal two-mass model leaves out the arms' and strut rods' inertia moving
+#      with the chassis and the rear's rising motion ratio under preload.
+set -u
+cd "$(dirname "$0")/.."
+. tests/shell_setup.sh
+model="$root/models/sports_car.yaml"
+
+run() { # run MODEL CSV: generic path, quiet; the log beside the CSV
+  "$MBCC" run "$1" --path generic -o "$2" --plot none --quiet > "$2.log" 2>&1 ||
+    { err "mbcc run $1 failed: $(tail -3 "$2.log")"; return 1; }
+}
+# the model up to its outputs (outputs, simulation and scenes come last)
+base() { sed -e '/^outputs:/,$d' "$model"; }
+
+# 1. assembly and redundancy
+if "$MBCC" check "$model" > check.log 2>&1; then
+  grep -q 'constraint rows   86 (2 redundant removed)' check.log || err "not 86 rows with 2 redundant removed: $(grep 'constraint rows' check.log)"
+  grep -q 'degrees of freedom 16' check.log || err "not 16 DOF: $(grep 'degrees of freedom' check.log)"
+  for j in j19_RL_lower_ball j20_RR_lower_ball; do
+    grep -q "redundant constraint removed: spherical '$j': coincident points, x" check.log || err "the x row of $j is not reported redundant"
+  done
+  [ "$(grep -c 'redundant constraint removed' check.log)" = 2 ] || err "other rows reported redundant: $(grep 'redundant' check.log)"
+  ! grep -q 'positions corrected' check.log || err "the design pose needed Newton iterations: $(grep 'positions corrected' check.log)"
+else
+  err "mbcc check failed: $(tail -3 check.log)"
+fi
+# 2. mass and centre of mass: every body translating at v; momentum p = M v,
+#    angular momentum about the origin h = M r_cg x v (no rotation)
+mass_run() { # mass_run NAME VELOCITY
+  base | sed -e "s/{type: rigid,/{type: rigid, velocity: $2,/" \
+             -e "/^    type: rigid\$/a\\    velocity: $2" > "$1.yaml"
+  printf 'outputs:\n  - {name: L, type: momentum}\nsimulation: {end_time: 0.001}\n' >> "$1.yaml"
+  run "$1.yaml" "$1.csv"
+}
+if mass_run up '[0, 0, 1]' && mass_run fwd '[1, 0, 0]'; then
+  # columns: t, px, py, pz, hx, hy, hz.  v = z: h = M (y, -x, 0); v = x: h = M (0, z, -y)
+  read -r M xg yg <<< "$(awk -F, 'NR == 2 { printf "%.9g %.9g %.9g", $4, -$6 / $4, $5 / $4 }' up.csv)"
+  zg=$(awk -F, 'NR == 2 { printf "%.9g", $6 / $2 }' fwd.csv)
+  echo "mass $M kg, centre of mass ($xg, $yg, $zg) m"
+  awk -v M="$M" -v x="$xg" -v y="$yg" -v z="$zg" 'BEGIN {
+    if ((M - 980) ^ 2 > 1e-12 || (x + 1.231) ^ 2 > 2.5e-7 || y ^ 2 > 1e-18 || (z - 0.420) ^ 2 > 2.5e-7) exit 1 }' ||
+    err "mass $M kg and centre of mass ($xg, $yg, $zg): spec §4 has 980 kg at (-1.231, 0, 0.420)"
+else
+  M=980 xg=-1.231
+fi
+
+# 3. released at design: stays put; wheel loads
+cp "$model" car.yaml
+if run car.yaml car.csv; then
+  # columns: t, chassis_z, chassis_x, chassis_az, pitch, roll, FL, FR, RL, RR wheel z
+  awk -F, 'NR == 2 { for (i = 2; i <= NF; i++) s[i] = $i; next }
+           NR > 2 { for (i = 2; i <= NF; i++) if (i != 4 && i != 5 && i != 6 && (d = ($i - s[i]) ^ 2) > m) { m = d; w = i } }
+           NR > 2 { for (i = 5; i <= 6; i++) if ((d = ($i * 1.3) ^ 2) > m) { m = d; w = i } }
+           END { printf "largest drift in 1 s: %.3g mm (column %d)\n", sqrt(m) * 1000, w; exit m > 1e-6 }' car.csv ||
+    err "the car released at design drifts by more than 1 mm in 1 s (spec §12)"
+  # wheel loads at t = 1: the stand-in's preload - k_z (z - z0) (at rest: no damping force)
+  pre() { grep -A3 "^  $1_tyre_standin:" "$model" | sed -n 's/.*preload: \[0, 0, \([0-9.]*\),.*/\1/p'; }
+  loads=$(awk -F, -v pfl="$(pre FL)" -v pfr="$(pre FR)" -v prl="$(pre RL)" -v prr="$(pre RR)" '
+    NR == 2 { for (i = 7; i <= 10; i++) z0[i] = $i } END {
+      p[7] = pfl; p[8] = pfr; p[9] = prl; p[10] = prr
+      for (i = 7; i <= 10; i++) printf "%.6f ", p[i] - 2.0e5 * ($i - z0[i]) }' car.csv)
+  echo "wheel loads FL FR RL RR: $loads N"
+  # truth: the weight M g, split by moment balance about the contact lines x = 0, -2.18
+  awk -v M="$M" -v x="$xg" -v L="$loads" 'BEGIN { split(L, f, " "); W = M * 9.81
+    front = W * (x + 2.18) / 2.18 / 2; rear = W / 2 - front
+    printf "from the mass distribution: %.2f N front, %.2f N rear per wheel\n", front, rear
+    bad = 0
+    if (((f[1] + f[2] + f[3] + f[4]) / W - 1) ^ 2 > 1e-8) { print "loads do not sum to the weight"; bad = 1 }
+    for (i = 1; i <= 2; i++) if ((f[i] / front - 1) ^ 2 > 1e-6 || (f[i + 2] / rear - 1) ^ 2 > 1e-6) { print "not the moment balance"; bad = 1 }
+    if ((front - 2092.8) ^ 2 > 0.04 || (rear - 2714.1) ^ 2 > 0.04) { print "not spec §4 (2092.8 / 2714.1 N)"; bad = 1 }
+    exit bad }' || err "static wheel loads: $loads"
+fi
+
+# 4. corner kinematics: chassis fixed, FL and RL lower arms turned by 0.26 sin(pi t / 2) rad
+base | sed '/^joints:/a\  rig_fix: {type: fixed, bodies: [ground, chassis], point: [-1.24, 0, 0.44]}' > rig.yaml
+cat >> rig.yaml <<'EOF'
+drivers:
+  FL_travel: {joint: j01_FL_lower_pivot, motion: {type: sine, amplitude: 0.26, frequency: 0.25}}
+  RL_travel: {joint: j10_RL_lower_pivot, motion: {type: sine, amplitude: 0.26, frequency: 0.25}}
+outputs:   # camber, SAE sign (top outward +): minus the rotation about +x on the left
+  - {name: FL_wz, type: position, body: FL_wheel, component: z}
+  - {name: FL_camber, type: angle, body: FL_upright, axis: [1, 0, 0], scale: -57.29577951308232}
+  - {name: FL_seat, type: position, body: FL_lower_wishbone, point: [0, 0.56, 0.165]}
+  - {name: FL_wy, type: position, body: FL_wheel, component: y}
+  - {name: RL_wz, type: position, body: RL_wheel, component: z}
+  - {name: RL_camber, type: angle, body: RL_strut_tube, axis: [1, 0, 0], scale: -57.29577951308232}
+  - {name: RL_top, type: position, body: RL_strut_rod, point: [-2.18, 0.60595, 0.660]}
+  - {name: RL_low, type: position, body: RL_strut_tube, point: [-2.18, 0.64162, 0.420]}
+  - {name: RL_wy, type: position, body: RL_wheel, component: y}
+simulation: {end_time: 3.0, output_step: 0.005}
+EOF
+if run rig.yaml rig.csv; then
+  # bump on the rise (t <= 1), rebound on the fall to -0.26 rad (2 <= t <= 3); the
+  # spec's tables: dz, FL camber [deg], spring length [mm], half-track [mm], then RL
+  awk -F, '
+    function put(k) { n[k]++; j = n[k]
+      z[k, j] = ($2 - 0.3108) * 1000; c[k, j, 1] = $3
+      c[k, j, 2] = sqrt($4 ^ 2 + ($5 - 0.48) ^ 2 + ($6 - 0.565) ^ 2) * 1000; c[k, j, 3] = $7 * 1000
+      zr[k, j] = ($8 - 0.3077) * 1000; r[k, j, 1] = $9
+      r[k, j, 2] = sqrt(($10 - $13) ^ 2 + ($11 - $14) ^ 2 + ($12 - $15) ^ 2) * 1000; r[k, j, 3] = $16 * 1000 }
+    NR > 1 && $1 <= 1.0 { put(1) }
+    NR > 1 && $1 >= 2.0 { put(2) }
+    function at(k, front, q, x,   j, a, b, w) {   # interpolate at wheel travel x
+      for (j = 1; j < n[k]; j++) {
+        a = front ? z[k, j] : zr[k, j]; b = front ? z[k, j + 1] : zr[k, j + 1]
+        if ((a - x) * (b - x) <= 0 && a != b) { w = (x - a) / (b - a)
+          return front ? c[k, j, q] + w * (c[k, j + 1, q] - c[k, j, q]) : r[k, j, q] + w * (r[k, j + 1, q] - r[k, j, q]) } }
+      return "none" }
+    BEGIN { tol[1] = 0.03; tol[2] = 0.3; tol[3] = 0.3; what[1] = "camber [deg]"; what[2] = "spring length [mm]"; what[3] = "half-track [mm]"
+      #        dz     FL camber, L, half-track   RL camber, L, half-track      (spec §6.1, §6.2)
+      T[1] = "-80  1.08 466.8 708.8   1.80 319.3 726.5"
+      T[2] = "-40  0.74 437.3 714.8   0.76 281.3 730.0"
+      T[3] = " 40 -1.14 378.5 709.6  -0.41 203.1 726.7"
+      T[4] = " 80 -2.74 348.9 698.5  -0.37 162.5 720.2" }
+    END { bad = 0
+      for (i = 1; i <= 4; i++) { split(T[i], e, " "); x = e[1]; k = x > 0 ? 1 : 2
+        for (q = 1; q <= 3; q++) {
+          f = at(k, 1, q, x); g = at(k, 0, q, x)
+          printf "dz %+d mm: FL %s %s (spec %s), RL %s (spec %s)\n", x, what[q], f, e[1 + q], g, e[4 + q]
+          if (f == "none" || g == "none" || (f - e[1 + q]) ^ 2 > tol[q] ^ 2 || (g - e[4 + q]) ^ 2 > tol[q] ^ 2) bad = 1 } }
+      exit bad }' rig.csv || err "corner kinematics differ from spec §6"
+fi
+
+# 5. ride frequencies: dampers removed, chassis guided in heave or in pitch about its CG
+ride_run() { # ride_run NAME JOINT-LINE CHASSIS-VELOCITY-LINE
+  base | sed -e "/^joints:/a\\$2" -e "/^    position: \[-1.240, 0, 0.440\]/a\\$3" -e '/_damper:/,/damping:/d' > "$1.yaml"
+  cat >> "$1.yaml" <<'EOF'
+outputs:
+  - {name: z, type: position, body: chassis, component: z}
+  - {name: pitch, type: angle, body: chassis, axis: [0, 1, 0]}
+simulation: {end_time: 4.0, output_step: 0.002, rtol: 1.0e-9, atol: 1.0e-11}
+EOF
+  run "$1.yaml" "$1.csv"
+}
+# frequency from the upward zero crossings of a column about its initial value
+freq() { awk -F, -v col="$2" 'NR == 2 { y0 = $col } NR > 2 { y = $col - y0
+  if (py < 0 && y >= 0) { t = pt - py * ($1 - pt) / (y - py); if (!n) t0 = t; t1 = t; n++ } py = y; pt = $1 }
+  END { if (n < 4) print "none"; else printf "%.5f", (n - 1) / (t1 - t0) }' "$1"; }
+if ride_run heave '  rig_heave: {type: prismatic, bodies: [ground, chassis], point: [-1.24, 0, 0.44], axis: [0, 0, 1]}' '    velocity: [0, 0, 0.05]' &&
+   ride_run pitch '  rig_pitch: {type: revolute, bodies: [ground, chassis], point: [-1.24, 0, 0.44], axis: [0, 1, 0]}' '    angular_velocity: [0, 0.05, 0]'; then
+  fh=$(freq heave.csv 2); fp=$(freq pitch.csv 3)
+  # truth: ride rate per corner k = m_corner (2 pi f)^2; heave 2 (kf + kr) / m, pitch 2 (kf a^2 + kr b^2) / Iyy
+  awk -v fh="$fh" -v fp="$fp" 'BEGIN { pi = 3.141592653589793
+    kf = 179.8 * (2 * pi * 1.60) ^ 2; kr = 237.2 * (2 * pi * 1.75) ^ 2; a = 1.24; b = 0.94
+    eh = sqrt(2 * (kf + kr) / 834) / (2 * pi); ep = sqrt(2 * (kf * a * a + kr * b * b) / 799.6) / (2 * pi)
+    printf "ride: heave %s Hz (from 1.60/1.75 Hz corners: %.4f), pitch %s Hz (%.4f)\n", fh, eh, fp, ep
+    exit fh == "none" || fp == "none" || (fh / eh - 1) ^ 2 > 2.25e-4 || (fp / ep - 1) ^ 2 > 2.25e-4 }' ||
+    err "ride frequencies are not those of 1.60 / 1.75 Hz corners (within 1.5 %)"
+fi
+
+exit $fail
