@@ -445,6 +445,7 @@ static void record_use(reader *r, const yaml_node_t *n, ir_expr *e, double value
     m->cap_uses = cap;
   }
   ir_expr_use *u = &m->uses[m->nuses++];
+  *u = (ir_expr_use){0}; /* every field, 'pruned' included, starts cleared */
   u->loc = loc_of(n);
   u->expr = xcalloc(1, sizeof *u->expr);
   *u->expr = *e;
