@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# test_sports_car.sh: models/sports_car.yaml (the Stratos replica of seed 000,
-# rigid chassis) against the data and the acceptance checks of the vehicle
-# specification (/work/shared/reference/vehicle-model-spec.md, "spec §N").
-# Exit 0 = pass.  Every run takes the generic path (no C compile): seconds.
+# test_sports_car.sh: models/sports_car.yaml (the Stratos replica of seed 000)
+# against the data and the acceptance checks of the vehicle specification
+# (/work/shared/reference/vehicle-model-spec.md, "spec §N").  Checks 1-5 take
+# the scene 'rigid' (the chassis rigid, spec §12 items 1-6), standing still on
+# the flat road; 6 runs the bump study.  Exit 0 = pass.  Every run takes the
+# generic path (no C compile): seconds.
 #   1. mbcc check: the design pose closes without a Newton iteration (every
 #      joint is one global point shared by its bodies, spec §6.3: that the
 #      hardpoints are the spec's is checked by 4.), the two rear lower ball
@@ -25,21 +27,35 @@
 #      spec §7 (1.60 Hz front, 1.75 Hz rear with 179.8 / 237.2 kg of sprung
 #      mass per corner), to 1.5 %.  Measured: heave +0.3 %, pitch -0.8 %; the
 #      ideal two-mass model leaves out the arms' and strut rods' inertia moving
-#      with the chassis and the rear's rising motion ratio under preload.
+#      with the chassis and the rear's rising motion ratio under preload;
+#   6. the bump at 60 km/h (spec §9), rigid and flexible chassis: the bands of
+#      spec §12 (a reduced-model estimate, not a target): CM vertical
+#      acceleration peaks, peak tyre loads, front-left bump travel; both left
+#      tyres leave the road after the crest; the flexible chassis adds to the
+#      rigid one's peak acceleration (seed Fig. 12); the speed holds but for
+#      rolling resistance and the bump; the joints through 8 virtual bodies
+#      (scene flexible_virtual) give the motion of the joints on the nodes.
 set -u
 cd "$(dirname "$0")/.."
 . tests/shell_setup.sh
 model="$root/models/sports_car.yaml"
 
-run() { # run MODEL CSV: generic path, quiet; the log beside the CSV
-  "$MBCC" run "$1" --path generic -o "$2" --plot none --quiet > "$2.log" 2>&1 ||
-    { err "mbcc run $1 failed: $(tail -3 "$2.log")"; return 1; }
+run() { # run MODEL CSV [ARGS]: generic path, quiet; the log beside the CSV
+  m=$1 csv=$2; shift 2
+  "$MBCC" run "$m" --path generic -o "$csv" --plot none --quiet "$@" > "$csv.log" 2>&1 ||
+    { err "mbcc run $m $* failed: $(tail -3 "$csv.log")"; return 1; }
 }
-# the model up to its outputs (outputs, simulation and scenes come last)
-base() { sed -e '/^outputs:/,$d' "$model"; }
+# the model without its outputs and simulation settings (a variant appends its
+# own), standing still on the flat road, its FE file named from anywhere
+base() {
+  awk '/^[A-Za-z_]/ { skip = ($0 ~ /^(outputs|simulation):/) } !skip' "$model" |
+    sed -e 's/angular_velocity: \[0, [0-9.]*, 0\]/angular_velocity: [0, 0, 0]/' \
+        -e 's/velocity: \[16.667, 0, 0\]/velocity: [0, 0, 0]/' -e 's/road: bump_road/road: flat_road/' \
+        -e "s|fe_file: sports_car_chassis.fe.yaml|fe_file: $root/models/sports_car_chassis.fe.yaml|"
+}
 
 # 1. assembly and redundancy
-if "$MBCC" check "$model" > check.log 2>&1; then
+if "$MBCC" check "$model" --scene rigid > check.log 2>&1; then
   grep -q 'constraint rows   86 (2 redundant removed)' check.log || err "not 86 rows with 2 redundant removed: $(grep 'constraint rows' check.log)"
   grep -q 'degrees of freedom 16' check.log || err "not 16 DOF: $(grep 'degrees of freedom' check.log)"
   for j in j19_RL_lower_ball j20_RR_lower_ball; do
@@ -53,10 +69,9 @@ fi
 # 2. mass and centre of mass: every body translating at v; momentum p = M v,
 #    angular momentum about the origin h = M r_cg x v (no rotation)
 mass_run() { # mass_run NAME VELOCITY
-  base | sed -e "s/{type: rigid,/{type: rigid, velocity: $2,/" \
-             -e "/^    type: rigid\$/a\\    velocity: $2" > "$1.yaml"
+  base | sed -e "s/\([^_]\)velocity: \[0, 0, 0\]/\1velocity: $2/" > "$1.yaml"
   printf 'outputs:\n  - {name: L, type: momentum}\nsimulation: {end_time: 0.001}\n' >> "$1.yaml"
-  run "$1.yaml" "$1.csv"
+  run "$1.yaml" "$1.csv" --scene rigid
 }
 if mass_run up '[0, 0, 1]' && mass_run fwd '[1, 0, 0]'; then
   # columns: t, px, py, pz, hx, hy, hz.  v = z: h = M (y, -x, 0); v = x: h = M (0, z, -y)
@@ -64,27 +79,38 @@ if mass_run up '[0, 0, 1]' && mass_run fwd '[1, 0, 0]'; then
   zg=$(awk -F, 'NR == 2 { printf "%.9g", $6 / $2 }' fwd.csv)
   echo "mass $M kg, centre of mass ($xg, $yg, $zg) m"
   awk -v M="$M" -v x="$xg" -v y="$yg" -v z="$zg" 'BEGIN {
-    if ((M - 980) ^ 2 > 1e-12 || (x + 1.231) ^ 2 > 2.5e-7 || y ^ 2 > 1e-18 || (z - 0.420) ^ 2 > 2.5e-7) exit 1 }' ||
+    if ((M - 980) ^ 2 > 1e-4 || (x + 1.231) ^ 2 > 2.5e-7 || y ^ 2 > 1e-18 || (z - 0.420) ^ 2 > 2.5e-7) exit 1 }' ||
     err "mass $M kg and centre of mass ($xg, $yg, $zg): spec §4 has 980 kg at (-1.231, 0, 0.420)"
 else
   M=980 xg=-1.231
 fi
 
-# 3. released at design: stays put; wheel loads
-cp "$model" car.yaml
-if run car.yaml car.csv; then
-  # columns: t, chassis_z, chassis_x, chassis_az, pitch, roll, FL, FR, RL, RR wheel z
-  awk -F, 'NR == 2 { for (i = 2; i <= NF; i++) s[i] = $i; next }
-           NR > 2 { for (i = 2; i <= NF; i++) if (i != 4 && i != 5 && i != 6 && (d = ($i - s[i]) ^ 2) > m) { m = d; w = i } }
-           NR > 2 { for (i = 5; i <= 6; i++) if ((d = ($i * 1.3) ^ 2) > m) { m = d; w = i } }
+# 3. released at design on the flat road: stays put; wheel loads
+base > car.yaml
+cat >> car.yaml <<'EOF'
+outputs:
+  - {name: chassis_z, type: position, body: chassis, component: z}
+  - {name: chassis_x, type: position, body: chassis, component: x}
+  - {name: FL_wheel_z, type: position, body: FL_wheel, component: z}
+  - {name: RR_wheel_z, type: position, body: RR_wheel, component: z}
+  - {name: pitch, type: angle, body: chassis, axis: [0, 1, 0]}
+  - {name: roll, type: angle, body: chassis, axis: [1, 0, 0]}
+  - {name: FL_Fz, type: tyre, element: tyre_FL, component: Fz}
+  - {name: FR_Fz, type: tyre, element: tyre_FR, component: Fz}
+  - {name: RL_Fz, type: tyre, element: tyre_RL, component: Fz}
+  - {name: RR_Fz, type: tyre, element: tyre_RR, component: Fz}
+simulation: {end_time: 2.0, output_step: 0.005}
+EOF
+if run car.yaml car.csv --scene rigid; then
+  # the largest displacement in the first second (angles times 1.3 m, about half the wheelbase)
+  awk -F, 'NR == 1 { next } NR == 2 { for (i = 2; i <= 5; i++) s[i] = $i; next } $1 > 1.0001 { exit }
+           { for (i = 2; i <= 5; i++) if ((d = ($i - s[i]) ^ 2) > m) { m = d; w = i }
+             for (i = 6; i <= 7; i++) if ((d = ($i * 1.3) ^ 2) > m) { m = d; w = i } }
            END { printf "largest drift in 1 s: %.3g mm (column %d)\n", sqrt(m) * 1000, w; exit m > 1e-6 }' car.csv ||
     err "the car released at design drifts by more than 1 mm in 1 s (spec §12)"
-  # wheel loads at t = 1: the stand-in's preload - k_z (z - z0) (at rest: no damping force)
-  pre() { grep -A3 "^  $1_tyre_standin:" "$model" | sed -n 's/.*preload: \[0, 0, \([0-9.]*\),.*/\1/p'; }
-  loads=$(awk -F, -v pfl="$(pre FL)" -v pfr="$(pre FR)" -v prl="$(pre RL)" -v prr="$(pre RR)" '
-    NR == 2 { for (i = 7; i <= 10; i++) z0[i] = $i } END {
-      p[7] = pfl; p[8] = pfr; p[9] = prl; p[10] = prr
-      for (i = 7; i <= 10; i++) printf "%.6f ", p[i] - 2.0e5 * ($i - z0[i]) }' car.csv)
+  # the tyres' normal loads at t = 2 (settled: the tyres' free radius puts the
+  # design pose 0.4 mm off their equilibrium, spec §5 rounds the wheel heights)
+  loads=$(awk -F, 'END { printf "%.6f %.6f %.6f %.6f", $8, $9, $10, $11 }' car.csv)
   echo "wheel loads FL FR RL RR: $loads N"
   # truth: the weight M g, split by moment balance about the contact lines x = 0, -2.18
   awk -v M="$M" -v x="$xg" -v L="$loads" 'BEGIN { split(L, f, " "); W = M * 9.81
@@ -98,7 +124,9 @@ if run car.yaml car.csv; then
 fi
 
 # 4. corner kinematics: chassis fixed, FL and RL lower arms turned by 0.26 sin(pi t / 2) rad
-base | sed '/^joints:/a\  rig_fix: {type: fixed, bodies: [ground, chassis], point: [-1.24, 0, 0.44]}' > rig.yaml
+# (the road 1 m down: no tyre touches it, so no tyre force steers the driven corners)
+base | sed -e '/^joints:/a\  rig_fix: {type: fixed, bodies: [ground, chassis], point: [-1.24, 0, 0.44]}' \
+           -e 's/flat_road: {type: flat}/flat_road: {type: flat, height: -1.0}/' > rig.yaml
 cat >> rig.yaml <<'EOF'
 drivers:
   FL_travel: {joint: j01_FL_lower_pivot, motion: {type: sine, amplitude: 0.26, frequency: 0.25}}
@@ -115,7 +143,7 @@ outputs:   # camber, SAE sign (top outward +): minus the rotation about +x on th
   - {name: RL_wy, type: position, body: RL_wheel, component: y}
 simulation: {end_time: 3.0, output_step: 0.005}
 EOF
-if run rig.yaml rig.csv; then
+if run rig.yaml rig.csv --scene rigid; then
   # bump on the rise (t <= 1), rebound on the fall to -0.26 rad (2 <= t <= 3); the
   # spec's tables: dz, FL camber [deg], spring length [mm], half-track [mm], then RL
   awk -F, '
@@ -147,23 +175,26 @@ if run rig.yaml rig.csv; then
       exit bad }' rig.csv || err "corner kinematics differ from spec §6"
 fi
 
-# 5. ride frequencies: dampers removed, chassis guided in heave or in pitch about its CG
+# 5. ride frequencies: dampers removed, chassis guided in heave or in pitch about
+#    its CG; the tyres radial springs only (at standstill their slip forces are
+#    stiff viscous dampers that hold the contact patches: not part of the ride rate)
 ride_run() { # ride_run NAME JOINT-LINE CHASSIS-VELOCITY-LINE
-  base | sed -e "/^joints:/a\\$2" -e "/^    position: \[-1.240, 0, 0.440\]/a\\$3" -e '/_damper:/,/damping:/d' > "$1.yaml"
+  base | sed -e "/^joints:/a\\$2" -e "s/^    velocity: \[0, 0, 0\].*/$3/" -e '/_damper:/,/damping:/d' \
+             -e 's/^    \(longitudinal\|cornering\|camber\)_stiffness: .*/    \1_stiffness: 0/' > "$1.yaml"
   cat >> "$1.yaml" <<'EOF'
 outputs:
   - {name: z, type: position, body: chassis, component: z}
   - {name: pitch, type: angle, body: chassis, axis: [0, 1, 0]}
 simulation: {end_time: 4.0, output_step: 0.002, rtol: 1.0e-9, atol: 1.0e-11}
 EOF
-  run "$1.yaml" "$1.csv"
+  run "$1.yaml" "$1.csv" --scene rigid
 }
 # frequency from the upward zero crossings of a column about its initial value
 freq() { awk -F, -v col="$2" 'NR == 2 { y0 = $col } NR > 2 { y = $col - y0
   if (py < 0 && y >= 0) { t = pt - py * ($1 - pt) / (y - py); if (!n) t0 = t; t1 = t; n++ } py = y; pt = $1 }
   END { if (n < 4) print "none"; else printf "%.5f", (n - 1) / (t1 - t0) }' "$1"; }
 if ride_run heave '  rig_heave: {type: prismatic, bodies: [ground, chassis], point: [-1.24, 0, 0.44], axis: [0, 0, 1]}' '    velocity: [0, 0, 0.05]' &&
-   ride_run pitch '  rig_pitch: {type: revolute, bodies: [ground, chassis], point: [-1.24, 0, 0.44], axis: [0, 1, 0]}' '    angular_velocity: [0, 0.05, 0]'; then
+   ride_run pitch '  rig_pitch: {type: revolute, bodies: [ground, chassis], point: [-1.24, 0, 0.44], axis: [0, 1, 0]}' '    velocity: [0, 0, 0]\n    angular_velocity: [0, 0.05, 0]'; then
   fh=$(freq heave.csv 2); fp=$(freq pitch.csv 3)
   # truth: ride rate per corner k = m_corner (2 pi f)^2; heave 2 (kf + kr) / m, pitch 2 (kf a^2 + kr b^2) / Iyy
   awk -v fh="$fh" -v fp="$fp" 'BEGIN { pi = 3.141592653589793
@@ -172,6 +203,50 @@ if ride_run heave '  rig_heave: {type: prismatic, bodies: [ground, chassis], poi
     printf "ride: heave %s Hz (from 1.60/1.75 Hz corners: %.4f), pitch %s Hz (%.4f)\n", fh, eh, fp, ep
     exit fh == "none" || fp == "none" || (fh / eh - 1) ^ 2 > 2.25e-4 || (fp / ep - 1) ^ 2 > 2.25e-4 }' ||
     err "ride frequencies are not those of 1.60 / 1.75 Hz corners (within 1.5 %)"
+fi
+
+# 6. the bump at 60 km/h: the model as it is, rigid and flexible chassis
+for sc in rigid flexible; do
+  run "$model" "bump_$sc.csv" --scene "$sc" || continue
+  # columns: t, chassis_az, chassis_z, chassis_x, chassis_vx, pitch, roll, FL FR RL RR Fz,
+  # FL wheel z, chassis z above it, RL wheel z, chassis z above it
+  awk -F, -v sc="$sc" 'NR == 1 { next } NR == 2 { tf0 = $12 - $13; v0 = $5 }
+    { if ($2 > amax) amax = $2; if ($2 < amin) amin = $2
+      if ($8 > fl) fl = $8; if ($10 > rl) rl = $10
+      if ((tr = ($12 - $13 - tf0) * 1000) > trmax) trmax = tr
+      if ($1 > 0.63 && $1 < 0.75 && $8 == 0) flair = 1; if ($1 > 0.76 && $1 < 0.9 && $10 == 0) rlair = 1
+      if ($1 <= 0.55) v55 = $5; v = $5 }
+    END {
+      printf "%s: CM a_z %+.2f / %+.2f m/s^2, peak tyre loads FL %.0f N, RL %.0f N, FL bump travel %.1f mm, speed %.3f -> %.3f (0.55 s) -> %.3f m/s\n", sc, amax, amin, fl, rl, trmax, v0, v55, v
+      bad = 0
+      # spec §12 (L_b = 1 m): +10.0..10.5 / -5.0..-5.1 m/s^2, 13.7 / 14.8 kN, 99-100 mm
+      if (amax < 7 || amax > 16 || amin < -9 || amin > -3.5) { print "CM acceleration outside the band"; bad = 1 }
+      if (fl < 11600 || fl > 15800 || rl < 12600 || rl > 17000) { print "peak tyre load outside 13.7 / 14.8 kN +-15 %"; bad = 1 }
+      if (trmax < 85 || trmax > 115) { print "FL bump travel outside 100 +-15 mm"; bad = 1 }
+      if (!flair || !rlair) { print "a left tyre does not leave the road after the crest"; bad = 1 }
+      # rolling resistance: C_rr F_z / R over the weight: 0.005 / 0.318 g = 0.154 m/s^2 before the bump
+      d = (v0 - v55) / 0.55; if (d < 0.10 || d > 0.20) { print "deceleration before the bump not the rolling loss 0.154 m/s^2"; bad = 1 }
+      exit bad }' "bump_$sc.csv" || err "bump run ($sc) outside the bands of spec §12"
+done
+if [ -s bump_rigid.csv ] && [ -s bump_flexible.csv ]; then
+  # seed Fig. 12: the flexible chassis adds high-frequency content to the CM
+  # acceleration; its peak is larger than the rigid chassis's
+  paste -d, bump_rigid.csv bump_flexible.csv | awk -F, 'NR > 1 { r = $2 > r ? $2 : r; f = $17 > f ? $17 : f }
+    END { printf "peak CM a_z: rigid %.2f, flexible %.2f m/s^2\n", r, f; exit !(f > 1.1 * r) }' ||
+    err "the flexible chassis does not raise the CM acceleration peak (seed Fig. 12)"
+fi
+# direct and virtual-body joints: the same motion (to the integration error),
+# over the front bump
+if [ -s bump_flexible.csv ] && run "$model" bump_virtual.csv --scene flexible_virtual --end 0.8; then
+  awk -F, 'NR == FNR { if (FNR > 1) for (i = 2; i <= NF; i++) a[$1, i] = $i; next }
+    FNR == 1 { for (i = 2; i <= NF; i++) name[i] = $i; next }
+    { for (i = 2; i <= NF; i++) { if (!(($1, i) in a)) continue; n++
+        if (!(i in lo) || $i < lo[i]) lo[i] = $i; if (!(i in hi) || $i > hi[i]) hi[i] = $i
+        d = $i - a[$1, i]; d = d < 0 ? -d : d; if (d > dm[i]) dm[i] = d } }
+    END { for (i in dm) { r = hi[i] - lo[i]; if (r > 0 && dm[i] / r > w) { w = dm[i] / r; c = name[i] } }
+      printf "direct against virtual joints: largest difference %.2g of the range (%s)\n", w, c
+      exit n == 0 || w > 2e-3 }' bump_flexible.csv bump_virtual.csv ||
+    err "joints through virtual bodies do not reproduce the joints on the nodes"
 fi
 
 exit $fail
