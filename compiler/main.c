@@ -335,6 +335,7 @@ static int cmd_modes(const options *o) {
   printf("flexible body '%s': %d nodes, %d modes selected%s\n", o->body, fm.nnodes, fm.nmodes,
          cb ? " (Craig-Bampton: interface constraint modes and fixed-interface normal modes, "
               "orthonormalized)"
+            : fx->nresidual > 0 ? " (normal modes and residual attachment modes of the residual_modes nodes)"
             : fx->reference_kind == REFERENCE_FREE ? " (free-free modes in mean axes)"
             : fx->reference_kind == REFERENCE_CHORD ? " (pinned-pinned modes of the chord frame)"
             : " (constrained normal modes)");

@@ -4,7 +4,9 @@
  * the simply supported Timoshenko closed form, Craig-Bampton against the full
  * FE model, mass normalization, lumped masses, axial modes, invariance under a
  * rotation of the model, the modal data file round trip and its diagnostics,
- * and the errors for bad FE data. */
+ * residual attachment modes (static correction, free-interface + residual
+ * against the full FE model, inertia relief on a free-free body), and the
+ * errors for bad FE data. */
 #include "../compiler/flex/fe.c"
 #include "../compiler/flex/fe_sparse.c"
 #include "../compiler/front/bounds.c" /* fe.c bounds the modal data file */
@@ -46,6 +48,7 @@ static void free_flex(ir_flex *fx) {
   free(fx->point_masses);
   free(fx->reference);
   free(fx->interface);
+  free(fx->residual);
   free(fx->list);
   memset(fx, 0, sizeof *fx);
 }
@@ -815,12 +818,152 @@ static void test_errors(void **state) {
   free_flex(&fx);
 }
 
+/* --- residual attachment modes ------------------------------------------------------- */
+
+/* sum over the modes of x_j(a) x_j(b) / lambda_j: the modal model's static
+ * flexibility between DOFs a and b (full DOF numbering) */
+static double modal_flexibility(const fe_modes *m, int a, int b) {
+  int n = 6 * m->nnodes;
+  double g = 0;
+  for (int j = 0; j < m->nmodes; j++) {
+    double lam = pow(2 * M_PI * m->freq_hz[j], 2);
+    g += m->shapes[(size_t)j * n + a] * m->shapes[(size_t)j * n + b] / lam;
+  }
+  return g;
+}
+
+/* the lowest frequency (Hz) of the modal model with a grounded spring ks on DOF a */
+static double spring_frequency(const fe_modes *m, int a, double ks) {
+  int n = 6 * m->nnodes, k = m->nmodes, bad = -1;
+  double *K = calloc((size_t)k * k, sizeof(double)), *M = calloc((size_t)k * k, sizeof(double));
+  double *w = calloc((size_t)k, sizeof(double)), *Y = calloc((size_t)k * k, sizeof(double));
+  for (int j = 0; j < k; j++) {
+    M[(size_t)j * k + j] = 1;
+    K[(size_t)j * k + j] = pow(2 * M_PI * m->freq_hz[j], 2);
+    for (int i = 0; i < k; i++)
+      K[(size_t)j * k + i] += ks * m->shapes[(size_t)i * n + a] * m->shapes[(size_t)j * n + a];
+  }
+  assert_int_equal(gen_eig(k, K, M, w, Y, &bad), 0);
+  double f = sqrt(w[0]) / (2 * M_PI);
+  free(K); free(M); free(w); free(Y);
+  return f;
+}
+
+static void test_residual_modes(void **state) {
+  (void)state;
+  const int nel = 16;
+  const double L = 1.2;
+  section s = square(0.02);
+  s.Iy = 100 * s.Iz; /* bending in z far stiffer: the lowest modes bend in y */
+  ir_flex fx;
+  line_beam(&fx, nel, L, ex, ey, &s, BEAM_EULER_BERNOULLI, MASS_CONSISTENT);
+  int tip_y = 6 * nel + 1;
+  double exact = L * L * L / (3 * s.E * s.Iz); /* PL^3/3EI per unit tip load */
+  /* the reference: every mode of the FE model, with the tip spring */
+  double ks = 5 * 3 * s.E * s.Iz / (L * L * L);
+  fe_modes full;
+  assert_int_equal(compute(&fx, &full), 0);
+  double f_exact = spring_frequency(&full, tip_y, ks);
+  assert_true(fabs(modal_flexibility(&full, tip_y, tip_y) / exact - 1) < 1e-9);
+  fe_modes_free(&full);
+  fx.select = MODES_COUNT;
+  printf("cantilever, unit tip load: tip deflection error / first frequency error with a tip spring,\n"
+         "against the number of normal modes kept (alone | with the 6 residual modes of the tip)\n");
+  double prev_alone = INFINITY;
+  for (int k = 1; k <= 5; k++) {
+    fx.count = k;
+    fx.nresidual = 0;
+    fe_modes alone, corr;
+    assert_int_equal(compute(&fx, &alone), 0);
+    fx.residual = realloc(fx.residual, sizeof(int));
+    fx.residual[0] = nel;
+    fx.nresidual = 1;
+    assert_int_equal(compute(&fx, &corr), 0);
+    double ea = fabs(modal_flexibility(&alone, tip_y, tip_y) / exact - 1);
+    double ec = fabs(modal_flexibility(&corr, tip_y, tip_y) / exact - 1);
+    double fa = fabs(spring_frequency(&alone, tip_y, ks) / f_exact - 1);
+    double fc = fabs(spring_frequency(&corr, tip_y, ks) / f_exact - 1);
+    printf("  %d modes: deflection %.3e | %.3e   frequency %.3e | %.3e\n", k, ea, ec, fa, fc);
+    /* static correction: the tip load's deflection is exact whatever k */
+    assert_true(ec < 1e-8);
+    assert_true(ea > 1e-4 && ea <= prev_alone * (1 + 1e-9));
+    prev_alone = ea;
+    /* free-interface + residual: the coupled frequency from above, and far closer */
+    assert_true(fc < fa / 10);
+    assert_true(spring_frequency(&corr, tip_y, ks) >= f_exact * (1 - 1e-10));
+    /* the kept modes unchanged, the set mass-orthonormal, frequencies ascending */
+    fe_system sys;
+    char e[512];
+    assert_int_equal(fe_assemble(&fx, &sys, e, sizeof e), 0);
+    assert_true(orthonormality(&corr, &sys) < 1e-9);
+    fe_system_free(&sys);
+    assert_true(corr.nmodes > k && corr.nmodes <= k + 6);
+    for (int j = 1; j < corr.nmodes; j++) assert_true(corr.freq_hz[j] >= corr.freq_hz[j - 1]);
+    for (int j = 0; j < k; j++) assert_true(fabs(corr.freq_hz[j] / alone.freq_hz[j] - 1) < 1e-12);
+    fe_modes_free(&alone);
+    fe_modes_free(&corr);
+  }
+  /* all modes kept: nothing residual is left */
+  fx.select = MODES_ALL;
+  fe_modes allm;
+  assert_int_equal(compute(&fx, &allm), 0);
+  assert_int_equal(allm.nmodes, 6 * nel);
+  fe_modes_free(&allm);
+
+  /* inertia relief on a free-free body: the elastic flexibility of a tip load
+     equals the sum over every elastic mode; the residual modes stay in mean axes */
+  free(fx.reference);
+  fx.reference = NULL;
+  fx.nreference = 0;
+  fx.reference_kind = REFERENCE_FREE;
+  fx.nresidual = 0;
+  fe_modes ff;
+  assert_int_equal(compute(&fx, &ff), 0);
+  double ge = modal_flexibility(&ff, tip_y, tip_y), ge_mid = modal_flexibility(&ff, tip_y, 6 * (nel / 2) + 1);
+  fe_modes_free(&ff);
+  fx.select = MODES_COUNT;
+  fx.count = 2;
+  fx.nresidual = 1;
+  fe_modes fr, fa2;
+  assert_int_equal(compute(&fx, &fr), 0);
+  fx.nresidual = 0;
+  assert_int_equal(compute(&fx, &fa2), 0);
+  double er = fabs(modal_flexibility(&fr, tip_y, tip_y) / ge - 1);
+  double ea2 = fabs(modal_flexibility(&fa2, tip_y, tip_y) / ge - 1);
+  double em = fabs(modal_flexibility(&fr, tip_y, 6 * (nel / 2) + 1) / ge_mid - 1);
+  printf("free-free, inertia relief: tip flexibility error with 2 modes %.3e, with residual modes %.3e "
+         "(tip to middle %.3e)\n", ea2, er, em);
+  assert_true(er < 1e-8 && em < 1e-8 && ea2 > 1e-3);
+  fe_system sys;
+  char e[512];
+  assert_int_equal(fe_assemble(&fx, &sys, e, sizeof e), 0);
+  assert_true(orthonormality(&fr, &sys) < 1e-9);
+  /* mean axes: no momentum, sum M x = 0 in each translation */
+  int n = sys.ndof;
+  for (int j = 0; j < fr.nmodes; j++)
+    for (int a = 0; a < 3; a++) {
+      double p = 0, scale = 0;
+      for (int r = 0; r < n; r++)
+        for (int cc = 0; cc < n; cc++) {
+          double v = sys.M[(size_t)cc * n + r] * fr.shapes[(size_t)j * n + r];
+          if (cc % 6 == a) p += v;
+          scale += fabs(v);
+        }
+      assert_true(fabs(p) <= 1e-9 * scale);
+    }
+  fe_system_free(&sys);
+  fe_modes_free(&fr);
+  fe_modes_free(&fa2);
+  free_flex(&fx);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_eb_convergence),
       cmocka_unit_test(test_timoshenko_vs_eb),
       cmocka_unit_test(test_timoshenko_simply_supported),
       cmocka_unit_test(test_craig_bampton),
+      cmocka_unit_test(test_residual_modes),
       cmocka_unit_test(test_normalization_and_masses),
       cmocka_unit_test(test_modal_file),
       cmocka_unit_test(test_errors),

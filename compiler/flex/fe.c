@@ -1125,6 +1125,8 @@ done:
  * modes, then dropped).  No Craig-Bampton. */
 static int modes_sparse(const ir_flex *fx, fe_modes *out, const char *state, int nf, fe_ctx *c) {
   int nnodes = fx->nnodes, ndof = 6 * nnodes, nev = 0, rigid = fx->reference_kind == REFERENCE_FREE ? 6 : 0;
+  if (fx->nresidual > 0)
+    return fail_at(c, fx->loc, "the sparse eigensolver does not add residual modes: use eigensolver: dense");
   if (fx->ninterface > 0)
     return fail_at(c, fx->loc, "the sparse eigensolver does not do Craig-Bampton (interface nodes): use "
                    "eigensolver: dense");
@@ -1201,6 +1203,237 @@ done:
   return rc;
 }
 
+/* Residual attachment modes (static correction) for unit loads at each free
+ * DOF of the residual_modes nodes, added to the ns kept modes X (nf x ns,
+ * M-orthonormal, frequencies hz).  Each load f gives the residual flexibility
+ * shape psi = G f - sum_j x_j x_j^T f / lambda_j, which is M- and
+ * K-orthogonal to the kept modes; the psi are then M-orthonormalized and
+ * diagonalized by their own small eigenproblem (the projected mass is kept,
+ * as in Rubin's method, not dropped as in MacNeal's), so that every column
+ * has a frequency.  A free-free body (free != 0) has no G: the load is first
+ * balanced by the rigid-body inertia forces it causes (inertia relief,
+ * f - M R R^T f with R the M-orthonormal rigid-body motions) and the elastic
+ * deflection solved with K + s (M R)(M R)^T (any s > 0), which leaves it
+ * M-orthogonal to R.
+ * Columns whose residual vanishes (the kept modes already span the load's
+ * deflection) are dropped.  On success *Xout (nf x *nout) and *hzout hold the
+ * kept and residual modes by ascending frequency (malloc'd). */
+static int add_residual_modes(const ir_flex *fx, const char *state, const int *perm, int nf,
+                              const double *Kf, const double *Mf, int free_body, int ns,
+                              const double *hz, const double *X, int *nout, double **Xout,
+                              double **hzout, fe_ctx *c) {
+  int ndof = 6 * fx->nnodes, rc = -1, nl = 0;
+  int *where = malloc((size_t)ndof * sizeof(int));
+  double *F = NULL, *U = NULL, *Kr = NULL, *R = NULL, *MR = NULL, *Kq = NULL, *Mq = NULL, *Y = NULL,
+         *w = NULL, *tmp = NULL, *norm0 = NULL, *all = NULL, *allhz = NULL;
+  int *order = NULL;
+  if (!where) return fail_at(c, fx->loc, "out of memory");
+  for (int i = 0; i < ndof; i++) where[i] = -1;
+  for (int p = 0; p < nf; p++) where[perm[p]] = p;
+  for (int r = 0; r < fx->nresidual; r++) {
+    int k = fx->residual[r];
+    if (k < 0 || k >= fx->nnodes) {
+      fail_at(c, fx->loc, "residual_modes: node %d out of range (the body has %d nodes)", k, fx->nnodes);
+      goto done;
+    }
+  }
+  F = xcalloc((size_t)nf * (size_t)(6 * fx->nresidual), sizeof(double));
+  if (!F) { fail_at(c, fx->loc, "out of memory"); goto done; }
+  /* one load column per free (or RBE2-dependent) DOF; a dependent DOF's
+     load acts on its independent node through the link */
+  for (int r = 0; r < fx->nresidual; r++) {
+    int k = fx->residual[r];
+    int dup = 0;
+    for (int q = 0; q < r; q++) dup |= fx->residual[q] == k;
+    if (dup) continue;
+    for (int d = 0; d < 6; d++) {
+      int i = 6 * k + d;
+      double *f = F + (size_t)nl * nf;
+      if (state[i] == 0) {
+        f[where[i]] = 1;
+      } else if (state[i] == 2) {
+        for (int l = 0; l < fx->nlinks; l++) {
+          const ir_rigid_link *L = &fx->links[l];
+          if (L->dependent != k || !(L->dofs >> d & 1)) continue;
+          double coef[6];
+          fe_link_row(fx, L, d, coef);
+          for (int a = 0; a < 6; a++) {
+            int t = where[6 * L->independent + a];
+            if (t >= 0) f[t] += coef[a];
+          }
+        }
+      } else {
+        continue; /* fixed to the body frame: no deflection */
+      }
+      nl++;
+    }
+  }
+  size_t nn = (size_t)nf * (size_t)nf;
+  Kr = malloc(nn * sizeof(double));
+  U = xcalloc((size_t)nf * (size_t)(nl ? nl : 1), sizeof(double));
+  tmp = xcalloc((size_t)nf * (size_t)(nl > 6 ? nl : 6), sizeof(double));
+  norm0 = xcalloc((size_t)(nl ? nl : 1), sizeof(double));
+  if (!Kr || !U || !tmp || !norm0) { fail_at(c, fx->loc, "out of memory"); goto done; }
+  memcpy(Kr, Kf, nn * sizeof(double));
+  if (free_body) {
+    /* rigid-body motions of the free DOFs (RBE2s folded: the independent
+       nodes carry them), M-orthonormalized */
+    R = xcalloc((size_t)nf * 6, sizeof(double));
+    MR = xcalloc((size_t)nf * 6, sizeof(double));
+    if (!R || !MR) { fail_at(c, fx->loc, "out of memory"); goto done; }
+    for (int p = 0; p < nf; p++) {
+      int k = perm[p] / 6, d = perm[p] % 6;
+      const double *x = fx->nodes + 3 * k;
+      for (int a = 0; a < 3; a++) {
+        R[(size_t)a * nf + p] = d == a;
+        /* rotation about axis a: u = e_a x x, theta = e_a */
+        double e[3] = {0, 0, 0}, u[3];
+        e[a] = 1;
+        u[0] = e[1] * x[2] - e[2] * x[1];
+        u[1] = e[2] * x[0] - e[0] * x[2];
+        u[2] = e[0] * x[1] - e[1] * x[0];
+        R[(size_t)(3 + a) * nf + p] = d < 3 ? u[d] : (d - 3 == a);
+      }
+    }
+    for (int pass = 0; pass < 2; pass++)
+      for (int a = 0; a < 6; a++) {
+        double *ra = R + (size_t)a * nf;
+        mul("N", "N", nf, 1, nf, Mf, nf, ra, nf, tmp, nf);
+        for (int b = 0; b < a; b++) {
+          double g = 0;
+          for (int p = 0; p < nf; p++) g += R[(size_t)b * nf + p] * tmp[p];
+          for (int p = 0; p < nf; p++) ra[p] -= g * R[(size_t)b * nf + p];
+        }
+        mul("N", "N", nf, 1, nf, Mf, nf, ra, nf, tmp, nf);
+        double g = 0;
+        for (int p = 0; p < nf; p++) g += ra[p] * tmp[p];
+        if (!(g > 0)) { fail_at(c, fx->loc, "residual_modes: the free-free body's rigid-body motions are degenerate"); goto done; }
+        for (int p = 0; p < nf; p++) ra[p] /= sqrt(g);
+      }
+    mul("N", "N", nf, 6, nf, Mf, nf, R, nf, MR, nf);
+    /* K + (M R)(M R)^T: positive definite, and equal to K on elastic shapes */
+    mul("N", "T", nf, nf, 6, MR, nf, MR, nf, Kr, nf);
+    /* scaled to K's size, so that the factor stays well conditioned */
+    double kmax = 0, rmax = 0;
+    for (int i = 0; i < nf; i++) {
+      kmax = fmax(kmax, Kf[(size_t)i * nf + i]);
+      rmax = fmax(rmax, Kr[(size_t)i * nf + i]);
+    }
+    double scale = rmax > 0 ? kmax / rmax : 1;
+    for (size_t i = 0; i < nn; i++) Kr[i] = Kf[i] + scale * Kr[i];
+    /* inertia relief: f - M R R^T f */
+    for (int j = 0; j < nl; j++) {
+      double *f = F + (size_t)j * nf;
+      for (int a = 0; a < 6; a++) {
+        double g = 0;
+        for (int p = 0; p < nf; p++) g += R[(size_t)a * nf + p] * f[p];
+        for (int p = 0; p < nf; p++) f[p] -= g * MR[(size_t)a * nf + p];
+      }
+    }
+  }
+  memcpy(U, F, (size_t)nf * (size_t)nl * sizeof(double));
+  if (nl > 0) {
+    int info = 0;
+    dpotrf_("U", &nf, Kr, &nf, &info);
+    if (info == 0) dpotrs_("U", &nf, &nl, Kr, &nf, U, &nf, &info);
+    if (info != 0) { fail_at(c, fx->loc, "residual_modes: the stiffness matrix is singular"); goto done; }
+  }
+  /* minus the kept modes' static part; then M-orthonormal, M-orthogonal to
+     the kept modes (again, for rounding) */
+  for (int j = 0; j < nl; j++) {
+    double *u = U + (size_t)j * nf;
+    const double *f = F + (size_t)j * nf;
+    double g0 = 0;
+    mul("N", "N", nf, 1, nf, Mf, nf, u, nf, tmp, nf);
+    for (int p = 0; p < nf; p++) g0 += u[p] * tmp[p];
+    norm0[j] = sqrt(g0);
+    for (int m = 0; m < ns; m++) {
+      const double *x = X + (size_t)m * nf;
+      double lam = 4 * FE_PI * FE_PI * hz[m] * hz[m], g = 0;
+      for (int p = 0; p < nf; p++) g += x[p] * f[p];
+      for (int p = 0; p < nf; p++) u[p] -= g / lam * x[p];
+    }
+  }
+  int nq = 0;
+  for (int j = 0; j < nl; j++) {
+    double *u = U + (size_t)j * nf, g = 0;
+    for (int pass = 0; pass < 2; pass++) {
+      mul("N", "N", nf, 1, nf, Mf, nf, u, nf, tmp, nf);
+      for (int m = 0; m < ns; m++) {
+        const double *x = X + (size_t)m * nf;
+        double h = 0;
+        for (int p = 0; p < nf; p++) h += x[p] * tmp[p];
+        for (int p = 0; p < nf; p++) u[p] -= h * x[p];
+      }
+      for (int b = 0; b < nq; b++) {
+        double *v = U + (size_t)b * nf, h = 0;
+        for (int p = 0; p < nf; p++) h += v[p] * tmp[p];
+        for (int p = 0; p < nf; p++) u[p] -= h * v[p];
+      }
+    }
+    mul("N", "N", nf, 1, nf, Mf, nf, u, nf, tmp, nf);
+    for (int p = 0; p < nf; p++) g += u[p] * tmp[p];
+    /* nothing left beyond the kept modes (and earlier loads): dropped */
+    if (!(g > 1e-16 * norm0[j] * norm0[j]) || norm0[j] == 0) continue;
+    double *dst = U + (size_t)nq * nf;
+    for (int p = 0; p < nf; p++) dst[p] = u[p] / sqrt(g);
+    nq++;
+  }
+  /* the residual block's own eigenproblem: U^T K U y = lambda y */
+  Kq = xcalloc((size_t)nq * (size_t)nq, sizeof(double));
+  Mq = xcalloc((size_t)nq * (size_t)nq, sizeof(double));
+  Y = xcalloc((size_t)nq * (size_t)nq, sizeof(double));
+  w = xcalloc((size_t)nq, sizeof(double));
+  double *K2 = xcalloc((size_t)nf * (size_t)(nq ? nq : 1), sizeof(double));
+  all = xcalloc((size_t)nf * (size_t)(ns + nq), sizeof(double));
+  allhz = xcalloc((size_t)(ns + nq), sizeof(double));
+  order = xcalloc((size_t)(ns + nq), sizeof(int));
+  if (!Kq || !Mq || !Y || !w || !K2 || !all || !allhz || !order) {
+    free(K2);
+    fail_at(c, fx->loc, "out of memory");
+    goto done;
+  }
+  mul("N", "N", nf, nq, nf, Kf, nf, U, nf, K2, nf);
+  mul("T", "N", nq, nq, nf, U, nf, K2, nf, Kq, nq);
+  free(K2);
+  for (int j = 0; j < nq; j++) {
+    Mq[(size_t)j * nq + j] = 1;
+    for (int i = 0; i < j; i++)
+      Kq[(size_t)j * nq + i] = Kq[(size_t)i * nq + j] = 0.5 * (Kq[(size_t)j * nq + i] + Kq[(size_t)i * nq + j]);
+  }
+  int bad = -1;
+  if (nq > 0 && gen_eig(nq, Kq, Mq, w, Y, &bad) != 0) {
+    fail_at(c, fx->loc, "residual_modes: the residual modes' eigenproblem failed (LAPACK)");
+    goto done;
+  }
+  /* merge by ascending frequency (stable: kept modes first on ties) */
+  for (int j = 0; j < ns; j++) { allhz[j] = hz[j]; order[j] = j; }
+  for (int j = 0; j < nq; j++) { allhz[ns + j] = lam_to_hz(w[j]); order[ns + j] = ns + j; }
+  for (int a = 1; a < ns + nq; a++)
+    for (int b = a; b > 0 && allhz[order[b]] < allhz[order[b - 1]]; b--) {
+      int t = order[b]; order[b] = order[b - 1]; order[b - 1] = t;
+    }
+  *hzout = xcalloc((size_t)(ns + nq), sizeof(double));
+  *Xout = xcalloc((size_t)nf * (size_t)(ns + nq), sizeof(double));
+  if (!*hzout || !*Xout) {
+    free(*hzout); free(*Xout); *hzout = NULL; *Xout = NULL;
+    fail_at(c, fx->loc, "out of memory");
+    goto done;
+  }
+  if (nq > 0) mul("N", "N", nf, nq, nq, U, nf, Y, nq, all + (size_t)ns * nf, nf);
+  memcpy(all, X, (size_t)nf * (size_t)ns * sizeof(double));
+  for (int j = 0; j < ns + nq; j++) {
+    (*hzout)[j] = allhz[order[j]];
+    memcpy(*Xout + (size_t)j * nf, all + (size_t)order[j] * nf, (size_t)nf * sizeof(double));
+  }
+  *nout = ns + nq;
+  rc = 0;
+done:
+  free(where); free(F); free(U); free(Kr); free(R); free(MR); free(Kq); free(Mq); free(Y); free(w);
+  free(tmp); free(norm0); free(all); free(allhz); free(order);
+  return rc;
+}
+
 static int modes_from_fe(const ir_flex *fx, fe_modes *out, fe_ctx *c) {
   if (check_flex_common(fx, c)) return -1;
   int nnodes = fx->nnodes, ndof = 6 * nnodes;
@@ -1223,7 +1456,8 @@ static int modes_from_fe(const ir_flex *fx, fe_modes *out, fe_ctx *c) {
     int nfree = 0;
     for (int i = 0; i < ndof; i++) nfree += state[i] == 0;
     int sparse = fx->eigensolver == 2 ||
-                 (fx->eigensolver == 0 && nfree > FE_SPARSE_MIN_DOFS && fx->ninterface == 0);
+                 (fx->eigensolver == 0 && nfree > FE_SPARSE_MIN_DOFS && fx->ninterface == 0 &&
+                  fx->nresidual == 0);
     if (sparse) {
       rc = modes_sparse(fx, out, state, nfree, c);
       goto done;
@@ -1261,6 +1495,11 @@ static int modes_from_fe(const ir_flex *fx, fe_modes *out, fe_ctx *c) {
   if ((fx->reference_kind != REFERENCE_FREE && check_definite(fx, Kf, nf, perm, 0, c)) ||
       check_definite(fx, Mf, nf, perm, 1, c))
     goto done;
+  if (fx->nresidual > 0 && nb > 0) {
+    fail_at(c, fx->loc, "'residual_modes' goes with free-interface modes, not with 'interface' (Craig-Bampton's "
+            "constraint modes already are the static shapes of its interface)");
+    goto done;
+  }
   if (fx->reference_kind == REFERENCE_FREE && nb > 0) {
     fail_at(c, fx->loc, "a free-free body takes no interface nodes (its modes are free-interface)");
     goto done;
@@ -1281,6 +1520,15 @@ static int modes_from_fe(const ir_flex *fx, fe_modes *out, fe_ctx *c) {
     } else {
       if (eig_select(fx, nf, Kf, Mf, "constrained normal modes", wi, sel, &ns, w, X, c)) goto done;
       nall = nf;
+    }
+    if (fx->nresidual > 0) {
+      double *Xs = NULL, *hs = NULL;
+      if (add_residual_modes(fx, state, perm, nf, Kf, Mf, fx->reference_kind == REFERENCE_FREE, ns, w, X,
+                             &ns, &Xs, &hs, c))
+        goto done;
+      free(X); free(w);
+      X = Xs;
+      w = hs;
     }
     nmodes = ns;
     if (alloc_modes(out, nnodes, nmodes, nall)) { fail_at(c, fx->loc, "out of memory"); goto done; }

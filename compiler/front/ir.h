@@ -100,6 +100,9 @@ typedef struct ir_flex {
   int nreference;
   int *interface;          /* Craig-Bampton interface nodes (none: constrained normal modes) */
   int ninterface;
+  int *residual;           /* residual_modes: nodes whose unit loads add residual attachment modes
+                              (static correction; inertia relief on a free-free body) */
+  int nresidual;
   ir_reference_kind reference_kind; /* CHORD: reference = [A, B]; FREE: none */
   int eigensolver;         /* 0 auto (sparse above FE_SPARSE_MIN_DOFS free DOFs), 1 dense, 2 sparse */
   /* imported FE models (fe_file) */

@@ -1151,7 +1151,7 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
       "nodes",   "beams",     "section",     "material", "theory",           "mass",
       "point_masses", "reference", "interface", "modes", "damping", "coupling", "modal_file",
       "fe_file", "initial_modes", "initial_mode_rates", "eigensolver", "sections", "materials",
-      "nonstructural_mass", "node_names", NULL};
+      "nonstructural_mass", "node_names", "residual_modes", NULL};
   map_reject(m, "inertia", "flexible body '%s': its inertia comes from its FE model", b->name);
   map_check_keys(m, keys);
   ir_flex *fx = xcalloc(1, sizeof *fx);
@@ -1170,7 +1170,7 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
   if (modal_file != NULL) {
     static const char *const fe_only[] = {"line", "nodes", "beams", "section", "material",
                                           "theory", "mass", "point_masses", "interface", "sections",
-                                          "materials", "nonstructural_mass", "node_names", NULL};
+                                          "materials", "nonstructural_mass", "node_names", "residual_modes", NULL};
     for (int i = 0; fe_only[i]; i++)
       map_reject(m, fe_only[i], "flexible body '%s': '%s' does not go with 'modal_file'", b->name, fe_only[i]);
     if (modal_file->type != YAML_SCALAR_NODE) {
@@ -1199,6 +1199,7 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
   yaml_node_t *ref = map_get(m, "reference");
   if (map_get(m, "fe_file") && !global) { /* the import failed (reported): nothing to refer to */
     map_get(m, "interface");
+    map_get(m, "residual_modes");
     map_get(m, "position");
     parse_modal_settings(m, fx);
     parse_initial_modes(m, fx);
@@ -1212,6 +1213,8 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
   }
   yaml_node_t *itf = map_get(m, "interface");
   if (itf != NULL) fx->interface = to_flex_node_list(r, itf, "'interface'", fx, nn, &fx->ninterface);
+  yaml_node_t *res = map_get(m, "residual_modes");
+  if (res != NULL) fx->residual = to_flex_node_list(r, res, "'residual_modes'", fx, nn, &fx->nresidual);
 
   /* body frame: the given position, or the first reference node (free-free:
      the centre of mass; chord: x along it) */
@@ -2269,6 +2272,7 @@ void free_flex(ir_flex *fx) {
   free(fx->point_masses);
   free(fx->reference);
   free(fx->interface);
+  free(fx->residual);
   free(fx->modal_file);
   free(fx->fe_source);
   for (int i = 0; i < fx->nnode_names; i++) free(fx->node_names[i]);
