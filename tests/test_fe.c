@@ -4,7 +4,7 @@
  * the simply supported Timoshenko closed form, Craig-Bampton against the full
  * FE model, mass normalization, lumped masses, axial modes, invariance under a
  * rotation of the model, the modal data file round trip and its diagnostics,
- * residual attachment modes (static correction, free-interface + residual
+ * static condensation (superelement), residual attachment modes (static correction, free-interface + residual
  * against the full FE model, inertia relief on a free-free body), and the
  * errors for bad FE data. */
 #include "../compiler/flex/fe.c"
@@ -957,6 +957,68 @@ static void test_residual_modes(void **state) {
   free_flex(&fx);
 }
 
+/* --- superelement: static condensation ---------------------------------------------- */
+
+/* fe_condense against the Schur complement K_BB - K_Bi K_ii^-1 K_iB of the
+ * assembled K (node 0 clamped, B the last node), on the 3D frame; and a
+ * straight cantilever's condensed K against the closed-form beam stiffness */
+static void test_condense(void **state) {
+  (void)state;
+  ir_flex fx;
+  frame3d(&fx, 3, MASS_CONSISTENT, BEAM_TIMOSHENKO);
+  int nn = fx.nnodes, B = nn - 1, n = 6 * nn;
+  double K6[36];
+  char err[512];
+  ir_loc where;
+  assert_int_equal(fe_condense(&fx, 0, B, K6, err, sizeof err, &where), 0);
+  fe_system sys;
+  assert_int_equal(fe_assemble(&fx, &sys, err, sizeof err), 0);
+  /* internal DOFs: nodes 1 .. nn-2 */
+  int ni = 6 * (nn - 2);
+  double *Kii = calloc((size_t)ni * ni, sizeof(double)), *KiB = calloc((size_t)ni * 6, sizeof(double));
+  for (int j = 0; j < ni; j++)
+    for (int i = 0; i < ni; i++) Kii[(size_t)j * ni + i] = sys.K[(size_t)(6 + j) * n + 6 + i];
+  for (int j = 0; j < 6; j++)
+    for (int i = 0; i < ni; i++) KiB[(size_t)j * ni + i] = sys.K[(size_t)(6 * B + j) * n + 6 + i];
+  double *X = malloc((size_t)ni * 6 * sizeof(double));
+  memcpy(X, KiB, (size_t)ni * 6 * sizeof(double));
+  int info = 0, six = 6;
+  dpotrf_("U", &ni, Kii, &ni, &info);
+  assert_int_equal(info, 0);
+  dpotrs_("U", &ni, &six, Kii, &ni, X, &ni, &info);
+  assert_int_equal(info, 0);
+  double worst = 0, big = 0;
+  for (int a = 0; a < 6; a++)
+    for (int b = 0; b < 6; b++) {
+      double v = sys.K[(size_t)(6 * B + b) * n + 6 * B + a];
+      for (int i = 0; i < ni; i++) v -= KiB[(size_t)a * ni + i] * X[(size_t)b * ni + i];
+      worst = fmax(worst, fabs(v - K6[6 * a + b]));
+      big = fmax(big, fabs(v));
+    }
+  printf("superelement: condensed K against the Schur complement: %.2e relative\n", worst / big);
+  assert_true(worst <= 1e-9 * big);
+  free(Kii); free(KiB); free(X);
+  fe_system_free(&sys);
+  assert_int_not_equal(fe_condense(&fx, 0, 0, K6, err, sizeof err, &where), 0);
+  free_flex(&fx);
+  /* a straight Euler-Bernoulli cantilever: tip stiffness 3EI/L^3 with the tip
+     free to rotate, 12EI/L^3 with it held; EA/L; GJ/L */
+  section s = square(0.02);
+  s.Iy = 3 * s.Iz;
+  const double L = 0.7;
+  line_beam(&fx, 6, L, ex, ey, &s, BEAM_EULER_BERNOULLI, MASS_LUMPED);
+  assert_int_equal(fe_condense(&fx, 0, 6, K6, err, sizeof err, &where), 0);
+  double kyy = K6[6 * 1 + 1], kyr = K6[6 * 1 + 5], krr = K6[6 * 5 + 5];
+  double ky_free = kyy - kyr * kyr / krr;
+  assert_true(fabs(ky_free / (3 * s.E * s.Iz / (L * L * L)) - 1) < 1e-10);
+  assert_true(fabs(kyy / (12 * s.E * s.Iz / (L * L * L)) - 1) < 1e-10);
+  double kzz = K6[6 * 2 + 2], kzr = K6[6 * 2 + 4], kr2 = K6[6 * 4 + 4];
+  assert_true(fabs((kzz - kzr * kzr / kr2) / (3 * s.E * s.Iy / (L * L * L)) - 1) < 1e-10);
+  assert_true(fabs(K6[0] / (s.E * s.A / L) - 1) < 1e-10);
+  assert_true(fabs(K6[21] / (s.G * s.J / L) - 1) < 1e-10);
+  free_flex(&fx);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_eb_convergence),
@@ -964,6 +1026,7 @@ int main(void) {
       cmocka_unit_test(test_timoshenko_simply_supported),
       cmocka_unit_test(test_craig_bampton),
       cmocka_unit_test(test_residual_modes),
+      cmocka_unit_test(test_condense),
       cmocka_unit_test(test_normalization_and_masses),
       cmocka_unit_test(test_modal_file),
       cmocka_unit_test(test_errors),

@@ -1,12 +1,15 @@
 /* force_field.c: the 6x6 field elements between two markers: the field
- * (general K and C), the bushing (diagonal) and the massless beam (its K
- * from the section, C a ratio of it); one runtime kind, MB_FORCE_FIELD
+ * (general K and C), the bushing (diagonal), the massless beam (its K
+ * from the section, C a ratio of it) and the superelement (its K condensed
+ * from an FE model, C a ratio of it); one runtime kind, MB_FORCE_FIELD
  * (kernel runtime/core/elements/mb_field.h). */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "element.h"
+#include "fe.h"
 #include "emit_force.h"
 #include "reader.h"
 
@@ -153,6 +156,33 @@ static void parse_beam_force(mapping *m, ir_force *f) {
   memcpy(f->axes + 6, z, sizeof z);
 }
 
+/* superelement: a massless FE model (fe_file) statically condensed to its
+ * two 'interface' nodes, clamped to body 0 at the first and loaded by body 1
+ * at the second (seed 001 section 2.2.3); the FE model's coordinates are
+ * global at t = 0, damping = damping_ratio * stiffness */
+static void parse_superelement(mapping *m, ir_force *f) {
+  reader *r = m->r;
+  get_body_pair(m, f->body, f->body_loc);
+  get_nonnegative(m, "damping_ratio", false, &f->damping_ratio);
+  ir_flex *fx = calloc(1, sizeof *fx);
+  if (!fx) return;
+  int nodes[2];
+  if (read_superelement_fe(m, f->name, fx, nodes)) {
+    char err[1024];
+    ir_loc where;
+    if (fe_condense(fx, nodes[0], nodes[1], f->K, err, sizeof err, &where)) {
+      error_at(r, where.line > 0 && !fx->fe_path && !fx->fe_source ? where : m->loc, "superelement '%s': %s",
+               f->name, err);
+    } else {
+      for (int i = 0; i < 2; i++) memcpy(f->point[i], fx->nodes + 3 * nodes[i], sizeof f->point[i]);
+      for (int i = 0; i < 36; i++) f->C[i] = f->damping_ratio * f->K[i];
+      static const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+      memcpy(f->axes, identity, sizeof identity);
+    }
+  }
+  free_flex(fx);
+}
+
 static void parse_bushing(mapping *m, ir_force *f) {
   parse_pair_at_point(m, f);
   get_six(m, "stiffness", true, true, f->k6);
@@ -205,6 +235,16 @@ static void lower_beam(lmodel *L, const ir_force *F, int index, mb_forcedef *d) 
   for (int i = 0; i < 36; i++) prm[MB_FIELD_C + i] = F->damping_ratio * K[i];
 }
 
+/* superelement: the condensed K in global axes (at t = 0), d0 the offset of
+   the loaded node from the clamped one */
+static void lower_superelement(lmodel *L, const ir_force *F, int index, mb_forcedef *d) {
+  (void)index;
+  double *prm = lower_field_common(L, F, d);
+  for (int i = 0; i < 3; i++) prm[MB_FIELD_D0 + i] = F->point[1][i] - F->point[0][i];
+  memcpy(prm + MB_FIELD_K, F->K, 36 * sizeof *prm);
+  memcpy(prm + MB_FIELD_C, F->C, 36 * sizeof *prm);
+}
+
 /* the wrench on marker 1 at its point; the reaction on body 0 at the same point */
 static void emit_field(FILE *f, const lmodel *L, int k) {
   const mb_forcedef *d = &L->force[k];
@@ -231,6 +271,8 @@ static const char *const bushing_keys[] = {"type",    "bodies",  "point", "stiff
                                            "damping", "preload", "axes",  "node", "nodes", NULL};
 static const char *const beam_keys[] = {"type", "bodies", "points", "node", "nodes", "section",
                                         "material", "theory", "damping_ratio", NULL};
+static const char *const superelement_keys[] = {"type", "bodies", "fe_file", "interface", "mass",
+                                                "damping_ratio", NULL};
 #define FIELD_LAYOUT "d0[3], K[36], C[36], preload[6]"
 
 const element_desc element_bushing = {
@@ -247,3 +289,8 @@ const element_desc element_beam = {
     .family = ELEMENT_FORCE, .type = "beam", .ir_kind = FORCE_BEAM,
     ELEMENT_RUNTIME_KIND(MB_FORCE_FIELD), .keys = beam_keys, .prm_layout = FIELD_LAYOUT,
     .parse = parse_beam_force, .lower = lower_beam, .emit_eval = emit_field};
+
+const element_desc element_superelement = {
+    .family = ELEMENT_FORCE, .type = "superelement", .ir_kind = FORCE_SUPERELEMENT,
+    ELEMENT_RUNTIME_KIND(MB_FORCE_FIELD), .keys = superelement_keys, .prm_layout = FIELD_LAYOUT,
+    .parse = parse_superelement, .lower = lower_superelement, .emit_eval = emit_field};

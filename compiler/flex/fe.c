@@ -1626,6 +1626,93 @@ done:
 }
 
 /* ------------------------------------------------------------------------- */
+/* static condensation (superelement)                                          */
+
+int fe_condense(const ir_flex *fx, int clamped, int loaded, double K6[36], char *err, size_t nerr,
+                ir_loc *where) {
+  fe_ctx cc = {err, nerr, where}, *c = &cc;
+  if (where) *where = no_loc;
+  int nnodes = fx->nnodes, ndof = 6 * nnodes, rc = -1;
+  if (clamped < 0 || clamped >= nnodes || loaded < 0 || loaded >= nnodes || clamped == loaded)
+    return fail_at(c, fx->loc, "a superelement needs two different nodes of its FE model");
+  ir_flex held = *fx; /* the clamped node as the only reference, no interface */
+  held.reference = &clamped;
+  held.nreference = 1;
+  held.reference_kind = REFERENCE_CLAMPED;
+  held.interface = NULL;
+  held.ninterface = 0;
+  held.nresidual = 0;
+  char *state = xcalloc((size_t)ndof, 1), *is_int = xcalloc((size_t)nnodes, 1), *is_ref = xcalloc((size_t)nnodes, 1);
+  int *perm = xcalloc((size_t)ndof, sizeof(int)), *where_f = xcalloc((size_t)ndof, sizeof(int));
+  double *Kf = NULL, *F = NULL;
+  fe_system sys = {0, NULL, NULL};
+  if (!state || !is_int || !is_ref || !perm || !where_f) { fail_at(c, fx->loc, "out of memory"); goto done; }
+  if (dof_states(&held, state, is_int, c)) goto done;
+  for (int i = 0; i < ndof; i++)
+    if (state[i] == 1) is_ref[i / 6] = 1;
+  if (!fx->K_given && check_connectivity(&held, is_ref, c)) goto done;
+  if (fe_assemble_at(&held, &sys, c->err, c->nerr, c->where)) goto done;
+  fold_links(&held, sys.K, ndof);
+  int nf = 0;
+  for (int i = 0; i < ndof; i++) {
+    where_f[i] = -1;
+    if (!state[i]) { where_f[i] = nf; perm[nf++] = i; }
+  }
+  Kf = xcalloc((size_t)nf * (size_t)nf, sizeof(double));
+  F = xcalloc((size_t)nf * 6, sizeof(double));
+  if (!Kf || !F) { fail_at(c, fx->loc, "out of memory"); goto done; }
+  gather(sys.K, ndof, perm, nf, perm, nf, Kf);
+  if (check_definite(&held, Kf, nf, perm, 0, c)) goto done;
+  /* unit loads on the loaded node's 6 DOFs (an RBE2-dependent DOF's through its link) */
+  for (int d = 0; d < 6; d++) {
+    int i = 6 * loaded + d;
+    double *f = F + (size_t)d * nf;
+    if (state[i] == 0) {
+      f[where_f[i]] = 1;
+    } else if (state[i] == 2) {
+      for (int l = 0; l < fx->nlinks; l++) {
+        const ir_rigid_link *L = &fx->links[l];
+        if (L->dependent != loaded || !(L->dofs >> d & 1)) continue;
+        double coef[6];
+        fe_link_row(fx, L, d, coef);
+        for (int a = 0; a < 6; a++)
+          if (where_f[6 * L->independent + a] >= 0) f[where_f[6 * L->independent + a]] += coef[a];
+      }
+    } else {
+      fail_at(c, fx->loc, "superelement: DOF %s of node %ld is fixed (an SPC), so the condensed stiffness "
+              "is infinite", dof_names[d], node_name(fx, loaded));
+      goto done;
+    }
+  }
+  /* the loaded node's flexibility G = f^T K^-1 f (6 x 6), K6 = G^-1 */
+  int info = 0, six = 6;
+  double G[36];
+  double *U = xcalloc((size_t)nf * 6, sizeof(double));
+  if (!U) { fail_at(c, fx->loc, "out of memory"); goto done; }
+  memcpy(U, F, (size_t)nf * 6 * sizeof(double));
+  dpotrf_("U", &nf, Kf, &nf, &info);
+  if (info == 0) dpotrs_("U", &nf, &six, Kf, &nf, U, &nf, &info);
+  if (info == 0) mul("T", "N", 6, 6, nf, F, nf, U, nf, G, 6);
+  free(U);
+  if (info != 0) { fail_at(c, fx->loc, "superelement: the stiffness with the first node clamped is singular"); goto done; }
+  for (int j = 0; j < 6; j++)
+    for (int i = 0; i < j; i++) G[6 * j + i] = G[6 * i + j] = 0.5 * (G[6 * j + i] + G[6 * i + j]);
+  /* the inverse, by solving G K6 = I */
+  memset(K6, 0, 36 * sizeof(double));
+  for (int i = 0; i < 6; i++) K6[7 * i] = 1;
+  dpotrf_("U", &six, G, &six, &info);
+  if (info == 0) dpotrs_("U", &six, &six, G, &six, K6, &six, &info);
+  if (info != 0) { fail_at(c, fx->loc, "superelement: the loaded node's flexibility is singular"); goto done; }
+  for (int j = 0; j < 6; j++)
+    for (int i = 0; i < j; i++) K6[6 * j + i] = K6[6 * i + j] = 0.5 * (K6[6 * j + i] + K6[6 * i + j]);
+  rc = 0;
+done:
+  fe_system_free(&sys);
+  free(state); free(is_int); free(is_ref); free(perm); free(where_f); free(Kf); free(F);
+  return rc;
+}
+
+/* ------------------------------------------------------------------------- */
 /* modal data file                                                            */
 
 typedef struct {

@@ -84,6 +84,15 @@ int fe_lumped_nodes(const ir_flex *fx, double *node_mass, double *node_inertia, 
 int fe_section_rows(const ir_flex *fx, int e, int end, const fe_modes *fm, double *rows, double sec[3],
                     char *err, size_t nerr);
 
+/* Static (Guyan) condensation for a massless superelement: the 6 x 6
+ * stiffness K6 (row-major, symmetric, the FE model's axes) of node 'loaded'
+ * with node 'clamped' held (all 6 DOFs), every other node free: the inverse
+ * of the loaded node's flexibility, equal to the Schur complement
+ * K_BB - K_Bi K_ii^-1 K_iB.  SPCs and RBE2s of the model apply.  Returns 0,
+ * or nonzero with err. */
+int fe_condense(const ir_flex *fx, int clamped, int loaded, double K6[36], char *err, size_t nerr,
+                ir_loc *where);
+
 /* Write m (its selected modes) as a modal data file (docs/modal-file.md);
  * 'description' may be NULL.  Returns 0, or nonzero with err. */
 int fe_modes_write(const fe_modes *m, const char *path, const char *description, char *err,

@@ -215,7 +215,8 @@ typedef enum {
   FORCE_BUSHING,       /* 6 diagonal stiffness and damping terms in a frame */
   FORCE_FIELD,         /* general 6x6 stiffness and damping in a frame */
   FORCE_BEAM,          /* massless Euler-Bernoulli / Timoshenko beam between two points */
-  FORCE_TYRE           /* tyre of a wheel body on a road (compiler/elements/force_tyre.c) */
+  FORCE_TYRE,          /* tyre of a wheel body on a road (compiler/elements/force_tyre.c) */
+  FORCE_SUPERELEMENT   /* massless FE model condensed to two nodes (K from fe_condense) */
 } ir_force_kind;
 
 /* a road (top-level 'roads'): z = h(x, y) */

@@ -677,6 +677,37 @@ static int *to_flex_node_list(reader *r, yaml_node_t *n, const char *label, cons
   return out;
 }
 
+/* A superelement's FE model ('fe_file' of force 'owner') and its two nodes
+ * ('interface': [clamped, loaded], numbered as the file numbers them).  The
+ * nodes stay in global axes (fx->nodes).  Returns false after an error. */
+bool read_superelement_fe(mapping *m, const char *owner, ir_flex *fx, int nodes[2]) {
+  reader *r = m->r;
+  ir_body owner_body;
+  memset(&owner_body, 0, sizeof owner_body);
+  owner_body.name = (char *)owner;
+  fx->loc = m->loc;
+  yaml_node_t *file = map_require(m, "fe_file", true, "an FE file");
+  yaml_node_t *itf = map_require(m, "interface", true, "[clamped node, loaded node]");
+  if (!file) return false;
+  int errors = diag_errors();
+  double *global = parse_fe_file(m, &owner_body, fx);
+  if (!global || diag_errors() > errors) { free(global); return false; }
+  fx->nodes = global;
+  if (fx->fe_path) {
+    static const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    fe_import_to_body(fx, identity);
+  }
+  if (!itf) return false;
+  int count = 0;
+  int *list = to_flex_node_list(r, itf, "'interface'", fx, fx->nnodes, &count);
+  bool ok = list && count == 2 && diag_errors() == errors;
+  if (list && count != 2)
+    error_at(r, loc_of(itf), "'interface': a superelement takes 2 nodes [clamped, loaded] (got %d)", count);
+  if (ok) { nodes[0] = list[0]; nodes[1] = list[1]; }
+  free(list);
+  return ok;
+}
+
 /* 'reference': a list of clamped nodes, {chord: [A, B]} or free */
 static int *parse_flex_reference(reader *r, yaml_node_t *ref, ir_flex *fx, int nnodes, int *count) {
   *count = 0;
