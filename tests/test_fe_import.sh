@@ -2,6 +2,7 @@
 # test_fe_import.sh: flexible bodies from FE files (fe_file).
 #  1. a Nastran deck (small-field, free-field, continuation, INCLUDE) and the
 #     same beam written inline in mbcc: frequencies and mode shapes to 1e-8;
+#     the deck in large-field format (GRID*, fixed and free) reads the same;
 #  2. a Matrix Market export of a beam (K and M written here from the textbook
 #     12 x 12 Euler-Bernoulli matrices, global DOF map with names) against the
 #     inline beam with the consistent mass: to 1e-8;
@@ -36,6 +37,26 @@ modes() { # model body out-prefix
 modes "$root"/tests/models/fe/beam_bdf.yaml beam "$T/bdf"
 modes "$root"/tests/models/fe/beam_inline.yaml beam "$T/inl"
 compare "$T/bdf.csv" "$T/inl.csv" "$T/bdf.modal" "$T/inl.modal" 1e-8 "Nastran vs inline" || fail "Nastran import"
+
+# --- 1b. the same deck in large-field format (GRID* with '*' continuations,
+#         fixed 16-column and free-field), against the small-field deck
+{ echo 'BEGIN BULK'
+  printf '%-8s%16s%16s%16s%16s%s\n' 'GRID*' 1 '' 0.0 0.0 '*G1'
+  printf '%-8s%16s\n' '*G1' 0.0
+  printf '%-8s%16s%16s%16s%16s\n' 'GRID*' 2 '' 2.5000000000D-01 0.0
+  printf '%-8s%16s%16s\n' '*' 0.0 ''
+  echo 'GRID*,3,,0.5,0.,*'
+  echo '*,0.'
+  echo 'GRID*,4,,.75,0.'
+  echo '*,0.'
+  echo 'GRID           5              1.      0.      0.'
+  echo "INCLUDE '$root/tests/models/fe/beam_elements.bdf'"
+  echo 'MAT1,7,2.1+11,,0.3,7850.'
+  echo 'ENDDATA'; } > "$T/large.bdf"
+sed "s|fe_file: beam.bdf|fe_file: $T/large.bdf|" "$root"/tests/models/fe/beam_bdf.yaml > "$T/large.yaml"
+modes "$T/large.yaml" beam "$T/large"
+compare "$T/large.csv" "$T/bdf.csv" "$T/large.modal" "$T/bdf.modal" 1e-12 "large-field vs small-field" ||
+  fail "Nastran large-field import"
 
 # --- 2. Matrix Market export = inline beam (consistent mass) -----------------------
 E=2.1e11; G=8.0769230769230769e10; RHO=7850; A=2.0e-4; IY=1.6667e-9; IZ=6.6667e-9; J=4.57e-9; L=0.25; NE=4

@@ -29,6 +29,7 @@ typedef struct {
   ir_loc loc;
   nas_field *f; /* f[1..nf-1]: data fields by logical position (8 per line) */
   int nf;
+  int half;     /* large-field: the last line gave only the first 4 of its 8 fields */
 } nas_card;
 
 typedef struct {
@@ -170,6 +171,16 @@ static void read_line(nas_deck *d, const char *path, int lineno, char *line, int
   int nd = 0;
   char name[24] = "";
   int free_field = strchr(buf, ',') != NULL;
+  /* large field: a name with '*' (GRID*) and its '*' continuations hold 4
+     fields of 16 columns each, two lines making one small-field line */
+  int large = 0;
+  {
+    char first[24];
+    int lead = 0;
+    const char *e = free_field ? strchr(buf, ',') : NULL;
+    size_t flen = e ? (size_t)(e - buf) : (len < 8 ? len : 8);
+    if (copy_field(buf, flen, first, sizeof first, &lead)) large = strchr(first, '*') != NULL;
+  }
   if (free_field) {
     /* name, then up to 8 data fields, then a continuation mark (ignored) */
     const char *p = buf;
@@ -187,13 +198,15 @@ static void read_line(nas_deck *d, const char *path, int lineno, char *line, int
       floc.col += lead;
       if (k == 0) {
         strcpy(name, text);
-      } else if (k <= 8) {
+      } else if (k <= (large ? 4 : 8)) {
         snprintf(data[nd].text, sizeof data[nd].text, "%s", text);
         data[nd++].loc = floc;
-      } else if (k == 9) {
+      } else if (k == (large ? 5 : 9)) {
         /* continuation mark */
       } else {
-        nas_error(d, path, floc, "a free-field line holds at most 8 data fields and a continuation "
+        nas_error(d, path, floc, large ? "a large-field free-field line holds at most 4 data fields and a "
+                  "continuation mark (continue the card on a line starting with '*')"
+                  : "a free-field line holds at most 8 data fields and a continuation "
                   "mark (continue the card on a line starting with '+' or ',')");
         return;
       }
@@ -204,10 +217,11 @@ static void read_line(nas_deck *d, const char *path, int lineno, char *line, int
   } else {
     int lead = 0;
     if (!copy_field(buf, len < 8 ? len : 8, name, sizeof name, &lead)) return;
-    for (int i = 0; i < 8; i++) {
-      size_t a = 8 + 8 * (size_t)i;
+    int width = large ? 16 : 8, nfields = large ? 4 : 8;
+    for (int i = 0; i < nfields; i++) {
+      size_t a = 8 + (size_t)width * (size_t)i;
       if (a >= len) break;
-      size_t flen = len - a < 8 ? len - a : 8;
+      size_t flen = len - a < (size_t)width ? len - a : (size_t)width;
       copy_field(buf + a, flen, data[nd].text, sizeof data[nd].text, &lead);
       data[nd].loc = (ir_loc){lineno, (int)a + 1 + (data[nd].text[0] ? lead : 0)};
       nd++;
@@ -218,13 +232,27 @@ static void read_line(nas_deck *d, const char *path, int lineno, char *line, int
       nas_error(d, path, loc, "a continuation line without a card before it");
       return;
     }
-    add_line_fields(&d->cards[d->ncards - 1], data, nd);
+    nas_card *c = &d->cards[d->ncards - 1];
+    if (large && c->half) { /* the second half of a large-field line */
+      for (int i = 0; i < 4; i++) {
+        nas_field *f = &c->f[c->nf - 4 + i];
+        if (i < nd) *f = data[i];
+        else { memset(f, 0, sizeof *f); f->loc = nd > 0 ? data[nd - 1].loc : loc; }
+      }
+      c->half = 0;
+      return;
+    }
+    add_line_fields(c, data, nd);
+    c->half = large;
     return;
   }
-  if (strchr(name, '*')) {
-    nas_error(d, path, loc, "card '%s': large-field format (16 columns) is not supported; write it "
-              "in small-field or free-field format", name);
-    return;
+  if (large) {
+    size_t n = strlen(name);
+    if (n < 2 || name[n - 1] != '*' || strchr(name, '*') != name + n - 1) {
+      nas_error(d, path, loc, "'%s' is not a card name (large field: the name followed by one '*')", name);
+      return;
+    }
+    name[n - 1] = 0;
   }
   for (const char *c = name; *c; c++)
     if (!isalnum((unsigned char)*c)) {
@@ -233,6 +261,7 @@ static void read_line(nas_deck *d, const char *path, int lineno, char *line, int
     }
   nas_card *c = new_card(d, name, path, loc);
   add_line_fields(c, data, nd);
+  c->half = large;
 }
 
 static int read_file(nas_deck *d, const char *path, const char *from, ir_loc from_loc, int depth) {
