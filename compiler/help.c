@@ -82,14 +82,16 @@ static const help_command commands[] = {
       {"--end T", "end time, s"}, {"--rtol R, --atol A", "tolerances"},
       {"--ida-rtol R", "the tolerance of IDA"},
       {"--quiet", "print the table only"}}},
-    {"modes", "mbcc modes M.yaml --body NAME [--scene S] [--shapes FILE.csv] [--write-modal FILE.modal.yaml]",
+    {"modes", "mbcc modes M.yaml --body NAME [--scene S] [--shapes FILE.csv] [--write-modal FILE.modal.yaml] [--suggest]",
      "the natural frequencies and mode shapes of one flexible body",
      "Computes the body's modes as the model selects them (constrained normal modes, or "
      "Craig-Bampton with interface nodes) and prints the frequencies.",
      {{"--body NAME", "the flexible body"},
       {"--scene S", "apply scene S of the model file"},
       {"--shapes FILE.csv", "write the mode shapes at every node"},
-      {"--write-modal FILE", "write the modes as a modal file (docs/modal-file.md)"}}},
+      {"--write-modal FILE", "write the modes as a modal file (docs/modal-file.md)"},
+      {"--suggest", "rank the modes by the loads of a rigid pre-run (the body rigid, the reactions "
+                    "of the joints on its nodes) and suggest a mode list"}}},
     {"plot", "mbcc plot A.csv [B.csv ...] [-o OUT.png] [--columns a,b+c,...] [--gnuplot FILE]",
      "plot results with gnuplot, one panel per column against time",
      "Every column (or those of --columns) gets a panel; a panel shows the column of every CSV file "

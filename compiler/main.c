@@ -25,6 +25,7 @@
 #include "params.h"
 #include "paths.h"
 #include "plot.h"
+#include "reader.h"
 #include "proc.h"
 #include "sweep.h"
 #include "trade.h"
@@ -47,6 +48,7 @@ typedef struct {
   int nsim;
   int quiet;
   int animate;      /* run --animate: pose outputs added, and the HTML animation written */
+  int suggest;      /* modes --suggest: rank the modes by the loads of a rigid pre-run */
   char set_names[64][128];   /* run --set NAME=VALUE: run-time parameters */
   double set_values[64];
   const char *set_args[64];  /* as given, for the simulator */
@@ -65,6 +67,7 @@ static int parse_options(int argc, char **argv, options *o) {
     }
     if (!strcmp(a, "--quiet")) { o->quiet = 1; o->sim_args[o->nsim++] = a; continue; }
     if (!strcmp(a, "--animate")) { o->animate = 1; continue; }
+    if (!strcmp(a, "--suggest")) { o->suggest = 1; continue; }
     if (!strcmp(a, "--equilibrium")) {
       if (o->nsim + 1 > 30) { fprintf(stderr, "mbcc: error: too many options\n"); return 2; }
       o->sim_args[o->nsim++] = a;
@@ -309,6 +312,165 @@ static int cmd_check(const options *o) {
   return 0;
 }
 
+static void settings_from_ir(const ir_sim *s, mb_settings *set);
+
+static int cmp_int_asc(const void *a, const void *b) {
+  int x = *(const int *)a, y = *(const int *)b;
+  return (x > y) - (x < y);
+}
+
+/* a CSV row's fields as numbers into v (at most n); the count */
+static int csv_numbers(char *line, double *v, int n) {
+  int k = 0;
+  for (char *p = line; p && k < n; k++) {
+    v[k] = strtod(p, NULL);
+    p = strchr(p, ',');
+    if (p) p++;
+  }
+  return k;
+}
+
+/* mbcc modes --suggest: run the model with the body rigid (coupling: rigid),
+ * record the reactions of the joints on its nodes and its orientation, and
+ * rank the modes by the static modal amplitude those loads cause,
+ * max_t |x_j^T f(t)| / omega_j^2 (seed 001 section 3.4.8): a mode the
+ * loads do not excite is not worth its cost, however low its frequency. */
+static int suggest_modes(const options *o, int ib, const fe_modes *fm) {
+  mbc_unit u;
+  if (mbc_unit_read(&u, o->model, o->scene)) return 2;
+  ir_model *ir = u.ir;
+  ir->bodies[ib].flex->coupling = COUPLING_RIGID;
+  int nj = 0, *jn = calloc((size_t)ir->njoints + 1, sizeof(int)), *js = calloc((size_t)ir->njoints + 1, sizeof(int));
+  if (!jn || !js) { free(jn); free(js); mbc_unit_free(&u); fprintf(stderr, "mbcc: error: out of memory\n"); return 2; }
+  for (int j = 0; j < ir->njoints; j++) {
+    const ir_joint *J = &ir->joints[j];
+    if (!J->active || J->kind == JOINT_DISTANCE) continue;
+    for (int side = 0; side < 2; side++)
+      if (J->body[side] == ib && J->node[side] >= 0) { jn[nj] = j; js[nj++] = side; break; }
+  }
+  if (nj == 0) {
+    fprintf(stderr, "%s: error: --suggest: no joint on a node of body '%s' (the loads it ranks the modes by)\n",
+            o->model, o->body);
+    free(jn); free(js); mbc_unit_free(&u);
+    return 2;
+  }
+  free_outputs(ir->outputs, ir->noutputs);
+  ir->noutputs = nj + 1;
+  ir->outputs = calloc((size_t)nj + 1, sizeof *ir->outputs);
+  for (int k = 0; k <= nj && ir->outputs; k++) {
+    ir_output *out = &ir->outputs[k];
+    out->body = out->joint = out->driver = out->node = out->mode = out->force = out->rel_node = -1;
+    out->chord[0] = out->chord[1] = -1;
+    out->component = -1;
+    out->scale = 1;
+    char name[32];
+    snprintf(name, sizeof name, k < nj ? "r%d" : "q", k);
+    out->name = strdup(name);
+    if (k < nj) { out->kind = OUT_REACTION; out->joint = jn[k]; }
+    else { out->kind = OUT_ORIENTATION; out->body = ib; }
+  }
+  u.overridden = 1;
+  char dir[] = "/tmp/mbcc-suggest-XXXXXX", csv[64] = "";
+  int rc = 2;
+  if (!ir->outputs || mbc_unit_finish(&u, 0) || !mkdtemp(dir)) goto done;
+  snprintf(csv, sizeof csv, "%s/pre.csv", dir);
+  {
+    mb_settings set;
+    settings_from_ir(&ir->sim, &set);
+    char *args[40];
+    int na = 0;
+    args[na++] = "mbcc-generic";
+    args[na++] = "-o";
+    args[na++] = csv;
+    args[na++] = "--quiet";
+    for (int i = 0; i < o->nsim; i++)
+      if (strcmp(o->sim_args[i], "--quiet")) args[na++] = (char *)o->sim_args[i];
+    args[na] = NULL;
+    printf("rigid pre-run (body '%s' rigid, %d joint%s on its nodes): ", o->body, nj, nj > 1 ? "s" : "");
+    fflush(stdout);
+    if (mb_main(na, args, &u.lowered->m, &set, ir->sim.solver == SOLVER_DENSE ? "dense" : "klu")) {
+      printf("failed\n");
+      goto done;
+    }
+  }
+  {
+    FILE *f = fopen(csv, "r");
+    int ncol = 1 + 6 * nj + 4, nm = fm->nmodes, nn6 = 6 * fm->nnodes, nrows = 0;
+    double *v = calloc((size_t)ncol, sizeof(double)), *amp = calloc((size_t)nm + 1, sizeof(double));
+    char *line = malloc(1 << 16);
+    if (!f || !v || !amp || !line || !fgets(line, 1 << 16, f)) {
+      fprintf(stderr, "mbcc: error: --suggest: cannot read the pre-run's results %s\n", csv);
+      if (f) fclose(f);
+      free(v); free(amp); free(line);
+      goto done;
+    }
+    while (fgets(line, 1 << 16, f)) {
+      if (csv_numbers(line, v, ncol) != ncol) continue;
+      nrows++;
+      const double *e = v + 1 + 6 * nj; /* Euler parameters: A = (2 e0^2 - 1) I + 2 (e e^T + e0 [e]) */
+      double A[9];
+      A[0] = 2 * (e[0] * e[0] + e[1] * e[1]) - 1; A[1] = 2 * (e[1] * e[2] - e[0] * e[3]); A[2] = 2 * (e[1] * e[3] + e[0] * e[2]);
+      A[3] = 2 * (e[1] * e[2] + e[0] * e[3]); A[4] = 2 * (e[0] * e[0] + e[2] * e[2]) - 1; A[5] = 2 * (e[2] * e[3] - e[0] * e[1]);
+      A[6] = 2 * (e[1] * e[3] - e[0] * e[2]); A[7] = 2 * (e[2] * e[3] + e[0] * e[1]); A[8] = 2 * (e[0] * e[0] + e[3] * e[3]) - 1;
+      for (int m = 0; m < nm; m++) {
+        double lam = pow(6.283185307179586 * fm->freq_hz[m], 2), p = 0;
+        for (int k = 0; k < nj; k++) {
+          const double *r = v + 1 + 6 * k;
+          /* the reaction acts on the joint's body 1: on the body here, with the sign of its side */
+          double sign = js[k] == 1 ? 1 : -1;
+          int node = ir->joints[jn[k]].node[js[k]];
+          const double *x = fm->shapes + (size_t)m * nn6 + 6 * (size_t)node;
+          for (int c = 0; c < 3; c++) {
+            double fb = 0, tb = 0; /* body axes: A^T r */
+            for (int i = 0; i < 3; i++) { fb += A[3 * i + c] * r[i]; tb += A[3 * i + c] * r[3 + i]; }
+            p += sign * (x[c] * fb + x[3 + c] * tb);
+          }
+        }
+        double q = lam > 0 ? fabs(p) / lam : 0;
+        if (q > amp[m]) amp[m] = q;
+      }
+    }
+    fclose(f);
+    printf("%d output times\n", nrows);
+    double any = 0;
+    for (int m = 0; m < nm; m++) any = fmax(any, amp[m]);
+    if (!(any > 0)) {
+      fprintf(stderr, "%s: error: --suggest: the rigid pre-run puts no load on body '%s' (nothing to rank the "
+              "modes by: give the model its loads and motion)\n", o->model, o->body);
+      free(line); free(v); free(amp);
+      goto done;
+    }
+    free(line);
+    int *order = calloc((size_t)nm + 1, sizeof(int));
+    double total = 0, top = 0;
+    for (int m = 0; m < nm; m++) { order[m] = m; total += amp[m] * amp[m]; top = fmax(top, amp[m]); }
+    for (int a = 1; a < nm; a++)
+      for (int b = a; b > 0 && amp[order[b]] > amp[order[b - 1]]; b--) { int t = order[b]; order[b] = order[b - 1]; order[b - 1] = t; }
+    printf("modes ranked by their static amplitude under the pre-run's loads, max_t |x_j^T f| / omega_j^2:\n");
+    printf("rank  mode  frequency_hz  amplitude      share\n");
+    double cum = 0;
+    int *keep = calloc((size_t)nm + 1, sizeof(int)), nkeep = 0;
+    for (int r = 0; r < nm; r++) {
+      int m = order[r];
+      printf("%4d  %4d  %12.6g  %12.4e  %8.2e\n", r + 1, m + 1, fm->freq_hz[m], amp[m], total > 0 ? amp[m] * amp[m] / total : 0);
+      /* suggested: the leading modes that carry 99.9 % of the squared amplitude */
+      if (total > 0 && cum < 0.999 * total) { keep[nkeep++] = m + 1; cum += amp[m] * amp[m]; }
+    }
+    qsort(keep, (size_t)nkeep, sizeof(int), cmp_int_asc);
+    printf("suggested (99.9 %% of the squared amplitude): modes: {list: [");
+    for (int k = 0; k < nkeep; k++) printf("%s%d", k ? ", " : "", keep[k]);
+    printf("]}\n");
+    free(order); free(keep); free(v); free(amp);
+    rc = 0;
+  }
+done:
+  if (csv[0]) unlink(csv);
+  if (strcmp(dir, "/tmp/mbcc-suggest-XXXXXX")) rmdir(dir);
+  free(jn); free(js);
+  mbc_unit_free(&u);
+  return rc;
+}
+
 /* mbcc modes: frequencies and (optionally) mode shapes of one flexible body */
 static int cmd_modes(const options *o) {
   if (!o->body) { fprintf(stderr, "mbcc: error: modes needs --body NAME\n"); return 2; }
@@ -378,12 +540,11 @@ static int cmd_modes(const options *o) {
       printf("wrote %s\n", o->modal_out);
     }
   }
+  if (!st && o->suggest) st = suggest_modes(o, ib, &fm);
   fe_modes_free(&fm);
   mbc_unit_free(&u);
   return st;
 }
-
-static void settings_from_ir(const ir_sim *s, mb_settings *set);
 
 /* the embedded package's fixed-step integrator and step: the model's, or
  * --integrator / --step; an adaptive choice (dopri5, auto) becomes RK4 unless
