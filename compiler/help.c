@@ -62,6 +62,8 @@ static const help_command commands[] = {
       {"--plot FILE.png|none", "the plot (default: beside the CSV)"},
       {"--columns a,b+c,...", "the columns to plot (b+c: in one panel)"},
       {"--animate", "also write the browser animation NAME.html beside the CSV (see mbcc animate)"},
+      {"--body B --loads FILE.csv", "instead of the outputs, write the loads on flexible body B at its "
+                                    "joints' nodes (body axes) over the run (generic path)"},
       {"--set NAME=VALUE", "a run-time parameter of the model (repeatable; not recompiled: the simulator "
                            "takes the value; docs/model-format.md, Parameters)"},
       {"--equilibrium", "first move the positions to static equilibrium (forces at zero velocity, "

@@ -40,7 +40,7 @@
 static void usage(void) { help_usage(stderr); }
 
 typedef struct {
-  const char *model, *scene, *outdir, *csv, *plot, *path, *body, *shapes, *modal_out;
+  const char *model, *scene, *outdir, *csv, *plot, *path, *body, *shapes, *modal_out, *loads;
   const char *results_dir; /* --results DIR: where run's CSV, units and plot go */
   int real_float;   /* --real float: single-precision generated code and runtime */
   int embedded;     /* --target embedded: a package for a microcontroller (emit_embedded.c) */
@@ -93,6 +93,7 @@ static int parse_options(int argc, char **argv, options *o) {
     else if (!strcmp(a, "--body")) o->body = v;
     else if (!strcmp(a, "--shapes")) o->shapes = v;
     else if (!strcmp(a, "--write-modal")) o->modal_out = v;
+    else if (!strcmp(a, "--loads")) o->loads = v;
     else if (!strcmp(a, "-o")) { o->outdir = v; o->csv = v; }
     else if (!strcmp(a, "--plot")) o->plot = v;
     else if (!strcmp(a, "--results")) o->results_dir = v;
@@ -330,29 +331,52 @@ static int csv_numbers(char *line, double *v, int n) {
   return k;
 }
 
-/* mbcc modes --suggest: run the model with the body rigid (coupling: rigid),
- * record the reactions of the joints on its nodes and its orientation, and
- * rank the modes by the static modal amplitude those loads cause,
- * max_t |x_j^T f(t)| / omega_j^2 (seed 001 section 3.4.8): a mode the
- * loads do not excite is not worth its cost, however low its frequency. */
-static int suggest_modes(const options *o, int ib, const fe_modes *fm) {
+/* The loads on a flexible body's nodes over a run: the reactions of the
+ * joints on its nodes (not distance joints), on the body, in its axes. */
+typedef struct {
+  int nj, nrows;
+  int *joint, *side, *node; /* per load: the joint, the body's side of it, the node */
+  double *t;                /* nrows */
+  double *f;                /* nrows x nj x 6: Fx Fy Fz Mx My Mz, body axes */
+} node_loads;
+
+static void node_loads_free(node_loads *L) {
+  free(L->joint); free(L->side); free(L->node); free(L->t); free(L->f);
+  memset(L, 0, sizeof *L);
+}
+
+/* Run the model (generic path, its simulation settings and the command's
+ * options) with reaction outputs for the joints on body ib's nodes and its
+ * orientation; rigid: with the body rigid (coupling: rigid).  0, or 2 after
+ * reporting. */
+static int run_node_loads(const options *o, int ib, int rigid, node_loads *L) {
+  memset(L, 0, sizeof *L);
   mbc_unit u;
   if (mbc_unit_read(&u, o->model, o->scene)) return 2;
   ir_model *ir = u.ir;
-  ir->bodies[ib].flex->coupling = COUPLING_RIGID;
-  int nj = 0, *jn = calloc((size_t)ir->njoints + 1, sizeof(int)), *js = calloc((size_t)ir->njoints + 1, sizeof(int));
-  if (!jn || !js) { free(jn); free(js); mbc_unit_free(&u); fprintf(stderr, "mbcc: error: out of memory\n"); return 2; }
+  if (rigid) ir->bodies[ib].flex->coupling = COUPLING_RIGID;
+  int nj = 0, rc = 2;
+  L->joint = calloc((size_t)ir->njoints + 1, sizeof(int));
+  L->side = calloc((size_t)ir->njoints + 1, sizeof(int));
+  L->node = calloc((size_t)ir->njoints + 1, sizeof(int));
+  char dir[] = "/tmp/mbcc-loads-XXXXXX", csv[64] = "";
+  FILE *f = NULL;
+  double *v = NULL;
+  char *line = NULL;
+  if (!L->joint || !L->side || !L->node) { fprintf(stderr, "mbcc: error: out of memory\n"); goto done; }
   for (int j = 0; j < ir->njoints; j++) {
     const ir_joint *J = &ir->joints[j];
     if (!J->active || J->kind == JOINT_DISTANCE) continue;
     for (int side = 0; side < 2; side++)
-      if (J->body[side] == ib && J->node[side] >= 0) { jn[nj] = j; js[nj++] = side; break; }
+      if (J->body[side] == ib && J->node[side] >= 0) {
+        L->joint[nj] = j; L->side[nj] = side; L->node[nj++] = J->node[side];
+        break;
+      }
   }
+  L->nj = nj;
   if (nj == 0) {
-    fprintf(stderr, "%s: error: --suggest: no joint on a node of body '%s' (the loads it ranks the modes by)\n",
-            o->model, o->body);
-    free(jn); free(js); mbc_unit_free(&u);
-    return 2;
+    fprintf(stderr, "%s: error: no joint on a node of body '%s' (whose loads are asked for)\n", o->model, o->body);
+    goto done;
   }
   free_outputs(ir->outputs, ir->noutputs);
   ir->noutputs = nj + 1;
@@ -366,14 +390,12 @@ static int suggest_modes(const options *o, int ib, const fe_modes *fm) {
     char name[32];
     snprintf(name, sizeof name, k < nj ? "r%d" : "q", k);
     out->name = strdup(name);
-    if (k < nj) { out->kind = OUT_REACTION; out->joint = jn[k]; }
+    if (k < nj) { out->kind = OUT_REACTION; out->joint = L->joint[k]; }
     else { out->kind = OUT_ORIENTATION; out->body = ib; }
   }
   u.overridden = 1;
-  char dir[] = "/tmp/mbcc-suggest-XXXXXX", csv[64] = "";
-  int rc = 2;
   if (!ir->outputs || mbc_unit_finish(&u, 0) || !mkdtemp(dir)) goto done;
-  snprintf(csv, sizeof csv, "%s/pre.csv", dir);
+  snprintf(csv, sizeof csv, "%s/loads.csv", dir);
   {
     mb_settings set;
     settings_from_ir(&ir->sim, &set);
@@ -386,89 +408,136 @@ static int suggest_modes(const options *o, int ib, const fe_modes *fm) {
     for (int i = 0; i < o->nsim; i++)
       if (strcmp(o->sim_args[i], "--quiet")) args[na++] = (char *)o->sim_args[i];
     args[na] = NULL;
-    printf("rigid pre-run (body '%s' rigid, %d joint%s on its nodes): ", o->body, nj, nj > 1 ? "s" : "");
-    fflush(stdout);
-    if (mb_main(na, args, &u.lowered->m, &set, ir->sim.solver == SOLVER_DENSE ? "dense" : "klu")) {
-      printf("failed\n");
-      goto done;
-    }
+    if (mb_main(na, args, &u.lowered->m, &set, ir->sim.solver == SOLVER_DENSE ? "dense" : "klu")) goto done;
   }
-  {
-    FILE *f = fopen(csv, "r");
-    int ncol = 1 + 6 * nj + 4, nm = fm->nmodes, nn6 = 6 * fm->nnodes, nrows = 0;
-    double *v = calloc((size_t)ncol, sizeof(double)), *amp = calloc((size_t)nm + 1, sizeof(double));
-    char *line = malloc(1 << 16);
-    if (!f || !v || !amp || !line || !fgets(line, 1 << 16, f)) {
-      fprintf(stderr, "mbcc: error: --suggest: cannot read the pre-run's results %s\n", csv);
-      if (f) fclose(f);
-      free(v); free(amp); free(line);
-      goto done;
+  int ncol = 1 + 6 * nj + 4, cap = 0;
+  f = fopen(csv, "r");
+  v = calloc((size_t)ncol, sizeof(double));
+  line = malloc(1 << 16);
+  if (!f || !v || !line || !fgets(line, 1 << 16, f)) {
+    fprintf(stderr, "mbcc: error: cannot read the run's results %s\n", csv);
+    goto done;
+  }
+  while (fgets(line, 1 << 16, f)) {
+    if (csv_numbers(line, v, ncol) != ncol) continue;
+    if (L->nrows == cap) {
+      cap = cap ? 2 * cap : 256;
+      double *t = realloc(L->t, (size_t)cap * sizeof(double)), *g = realloc(L->f, (size_t)cap * 6 * nj * sizeof(double));
+      if (t) L->t = t;
+      if (g) L->f = g;
+      if (!t || !g) { fprintf(stderr, "mbcc: error: out of memory\n"); goto done; }
     }
-    while (fgets(line, 1 << 16, f)) {
-      if (csv_numbers(line, v, ncol) != ncol) continue;
-      nrows++;
-      const double *e = v + 1 + 6 * nj; /* Euler parameters: A = (2 e0^2 - 1) I + 2 (e e^T + e0 [e]) */
-      double A[9];
-      A[0] = 2 * (e[0] * e[0] + e[1] * e[1]) - 1; A[1] = 2 * (e[1] * e[2] - e[0] * e[3]); A[2] = 2 * (e[1] * e[3] + e[0] * e[2]);
-      A[3] = 2 * (e[1] * e[2] + e[0] * e[3]); A[4] = 2 * (e[0] * e[0] + e[2] * e[2]) - 1; A[5] = 2 * (e[2] * e[3] - e[0] * e[1]);
-      A[6] = 2 * (e[1] * e[3] - e[0] * e[2]); A[7] = 2 * (e[2] * e[3] + e[0] * e[1]); A[8] = 2 * (e[0] * e[0] + e[3] * e[3]) - 1;
-      for (int m = 0; m < nm; m++) {
-        double lam = pow(6.283185307179586 * fm->freq_hz[m], 2), p = 0;
-        for (int k = 0; k < nj; k++) {
-          const double *r = v + 1 + 6 * k;
-          /* the reaction acts on the joint's body 1: on the body here, with the sign of its side */
-          double sign = js[k] == 1 ? 1 : -1;
-          int node = ir->joints[jn[k]].node[js[k]];
-          const double *x = fm->shapes + (size_t)m * nn6 + 6 * (size_t)node;
-          for (int c = 0; c < 3; c++) {
-            double fb = 0, tb = 0; /* body axes: A^T r */
-            for (int i = 0; i < 3; i++) { fb += A[3 * i + c] * r[i]; tb += A[3 * i + c] * r[3 + i]; }
-            p += sign * (x[c] * fb + x[3 + c] * tb);
-          }
-        }
-        double q = lam > 0 ? fabs(p) / lam : 0;
-        if (q > amp[m]) amp[m] = q;
+    const double *e = v + 1 + 6 * nj; /* Euler parameters: A = (2 e0^2 - 1) I + 2 (e e^T + e0 [e]) */
+    double A[9];
+    A[0] = 2 * (e[0] * e[0] + e[1] * e[1]) - 1; A[1] = 2 * (e[1] * e[2] - e[0] * e[3]); A[2] = 2 * (e[1] * e[3] + e[0] * e[2]);
+    A[3] = 2 * (e[1] * e[2] + e[0] * e[3]); A[4] = 2 * (e[0] * e[0] + e[2] * e[2]) - 1; A[5] = 2 * (e[2] * e[3] - e[0] * e[1]);
+    A[6] = 2 * (e[1] * e[3] - e[0] * e[2]); A[7] = 2 * (e[2] * e[3] + e[0] * e[1]); A[8] = 2 * (e[0] * e[0] + e[3] * e[3]) - 1;
+    L->t[L->nrows] = v[0];
+    for (int k = 0; k < nj; k++) {
+      const double *r = v + 1 + 6 * k;
+      /* the reaction acts on the joint's body 1: on this body with its side's sign */
+      double sign = L->side[k] == 1 ? 1 : -1;
+      double *out = L->f + ((size_t)L->nrows * nj + k) * 6;
+      for (int c = 0; c < 3; c++) {
+        out[c] = out[3 + c] = 0;
+        for (int i = 0; i < 3; i++) { out[c] += sign * A[3 * i + c] * r[i]; out[3 + c] += sign * A[3 * i + c] * r[3 + i]; }
       }
     }
-    fclose(f);
-    printf("%d output times\n", nrows);
-    double any = 0;
-    for (int m = 0; m < nm; m++) any = fmax(any, amp[m]);
-    if (!(any > 0)) {
-      fprintf(stderr, "%s: error: --suggest: the rigid pre-run puts no load on body '%s' (nothing to rank the "
-              "modes by: give the model its loads and motion)\n", o->model, o->body);
-      free(line); free(v); free(amp);
-      goto done;
-    }
-    free(line);
-    int *order = calloc((size_t)nm + 1, sizeof(int));
-    double total = 0, top = 0;
-    for (int m = 0; m < nm; m++) { order[m] = m; total += amp[m] * amp[m]; top = fmax(top, amp[m]); }
-    for (int a = 1; a < nm; a++)
-      for (int b = a; b > 0 && amp[order[b]] > amp[order[b - 1]]; b--) { int t = order[b]; order[b] = order[b - 1]; order[b - 1] = t; }
-    printf("modes ranked by their static amplitude under the pre-run's loads, max_t |x_j^T f| / omega_j^2:\n");
-    printf("rank  mode  frequency_hz  amplitude      share\n");
-    double cum = 0;
-    int *keep = calloc((size_t)nm + 1, sizeof(int)), nkeep = 0;
-    for (int r = 0; r < nm; r++) {
-      int m = order[r];
-      printf("%4d  %4d  %12.6g  %12.4e  %8.2e\n", r + 1, m + 1, fm->freq_hz[m], amp[m], total > 0 ? amp[m] * amp[m] / total : 0);
-      /* suggested: the leading modes that carry 99.9 % of the squared amplitude */
-      if (total > 0 && cum < 0.999 * total) { keep[nkeep++] = m + 1; cum += amp[m] * amp[m]; }
-    }
-    qsort(keep, (size_t)nkeep, sizeof(int), cmp_int_asc);
-    printf("suggested (99.9 %% of the squared amplitude): modes: {list: [");
-    for (int k = 0; k < nkeep; k++) printf("%s%d", k ? ", " : "", keep[k]);
-    printf("]}\n");
-    free(order); free(keep); free(v); free(amp);
-    rc = 0;
+    L->nrows++;
   }
+  rc = 0;
 done:
+  if (f) fclose(f);
+  free(v); free(line);
   if (csv[0]) unlink(csv);
-  if (strcmp(dir, "/tmp/mbcc-suggest-XXXXXX")) rmdir(dir);
-  free(jn); free(js);
+  if (strcmp(dir, "/tmp/mbcc-loads-XXXXXX")) rmdir(dir);
   mbc_unit_free(&u);
+  if (rc) node_loads_free(L);
   return rc;
+}
+
+/* mbcc modes --suggest: run the model with the body rigid (coupling: rigid),
+ * record the loads of the joints on its nodes, and rank the modes by the
+ * static modal amplitude they cause, max_t |x_j^T f(t)| / omega_j^2 (seed 001
+ * section 3.4.8): a mode the loads do not excite is not worth its cost,
+ * however low its frequency. */
+static int suggest_modes(const options *o, int ib, const fe_modes *fm) {
+  node_loads L;
+  printf("rigid pre-run (body '%s' rigid): ", o->body);
+  fflush(stdout);
+  if (run_node_loads(o, ib, 1, &L)) { printf("failed\n"); return 2; }
+  printf("%d joint%s on its nodes, %d output times\n", L.nj, L.nj > 1 ? "s" : "", L.nrows);
+  int nm = fm->nmodes, nn6 = 6 * fm->nnodes;
+  double *amp = calloc((size_t)nm + 1, sizeof(double));
+  int *order = calloc((size_t)nm + 1, sizeof(int)), *keep = calloc((size_t)nm + 1, sizeof(int));
+  if (!amp || !order || !keep) { free(amp); free(order); free(keep); node_loads_free(&L); return 2; }
+  for (int i = 0; i < L.nrows; i++)
+    for (int m = 0; m < nm; m++) {
+      double lam = pow(6.283185307179586 * fm->freq_hz[m], 2), p = 0;
+      for (int k = 0; k < L.nj; k++) {
+        const double *x = fm->shapes + (size_t)m * nn6 + 6 * (size_t)L.node[k];
+        const double *g = L.f + ((size_t)i * L.nj + k) * 6;
+        for (int c = 0; c < 6; c++) p += x[c] * g[c];
+      }
+      double q = lam > 0 ? fabs(p) / lam : 0;
+      if (q > amp[m]) amp[m] = q;
+    }
+  node_loads_free(&L);
+  double total = 0;
+  for (int m = 0; m < nm; m++) { order[m] = m; total += amp[m] * amp[m]; }
+  if (!(total > 0)) {
+    fprintf(stderr, "%s: error: --suggest: the rigid pre-run puts no load on body '%s' (nothing to rank the "
+            "modes by: give the model its loads and motion)\n", o->model, o->body);
+    free(amp); free(order); free(keep);
+    return 2;
+  }
+  for (int a = 1; a < nm; a++)
+    for (int b = a; b > 0 && amp[order[b]] > amp[order[b - 1]]; b--) { int t = order[b]; order[b] = order[b - 1]; order[b - 1] = t; }
+  printf("modes ranked by their static amplitude under the pre-run's loads, max_t |x_j^T f| / omega_j^2:\n");
+  printf("rank  mode  frequency_hz  amplitude      share\n");
+  double cum = 0;
+  int nkeep = 0;
+  for (int r = 0; r < nm; r++) {
+    int m = order[r];
+    printf("%4d  %4d  %12.6g  %12.4e  %8.2e\n", r + 1, m + 1, fm->freq_hz[m], amp[m], amp[m] * amp[m] / total);
+    /* suggested: the leading modes that carry 99.9 % of the squared amplitude */
+    if (cum < 0.999 * total) { keep[nkeep++] = m + 1; cum += amp[m] * amp[m]; }
+  }
+  qsort(keep, (size_t)nkeep, sizeof(int), cmp_int_asc);
+  printf("suggested (99.9 %% of the squared amplitude): modes: {list: [");
+  for (int k = 0; k < nkeep; k++) printf("%s%d", k ? ", " : "", keep[k]);
+  printf("]}\n");
+  free(amp); free(order); free(keep);
+  return 0;
+}
+
+/* mbcc run --body B --loads FILE.csv: the interface loads of the flexible body over
+ * a run of the model (flexible), for fatigue work: per joint on a node, the
+ * force and moment on the body at the node, body axes */
+static int export_loads(const options *o, int ib, const ir_model *ir) {
+  node_loads L;
+  if (run_node_loads(o, ib, 0, &L)) return 2;
+  out_file out;
+  if (out_file_open(&out, o->loads)) { node_loads_free(&L); return 2; }
+  static const char *const comp[6] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
+  fprintf(out.f, "t");
+  for (int k = 0; k < L.nj; k++)
+    for (int c = 0; c < 6; c++) {
+      const ir_flex *fx = ir->bodies[ib].flex; /* nodes by the FE file's ids when it has them */
+      long id = fx->node_ids ? fx->node_ids[L.node[k]] : L.node[k];
+      fprintf(out.f, ",%s@%ld.%s", ir->joints[L.joint[k]].name, id, comp[c]);
+    }
+  fputc('\n', out.f);
+  for (int i = 0; i < L.nrows; i++) {
+    fprintf(out.f, "%.17g", L.t[i]);
+    for (int k = 0; k < 6 * L.nj; k++) fprintf(out.f, ",%.12g", L.f[(size_t)i * 6 * L.nj + k]);
+    fputc('\n', out.f);
+  }
+  int st = out_file_commit(&out) ? 2 : 0;
+  if (!st) printf("wrote %s: the loads of %d joint%s on body '%s' (N, N m, body axes) at %d times\n", o->loads, L.nj,
+                  L.nj > 1 ? "s" : "", o->body, L.nrows);
+  node_loads_free(&L);
+  return st;
 }
 
 /* mbcc modes: frequencies and (optionally) mode shapes of one flexible body */
@@ -855,7 +924,28 @@ static int build_simulator(const options *o, char *exe_final, size_t n, mbc_unit
   return 0;
 }
 
+/* mbcc run --body B --loads FILE.csv: the run's loads on body B's nodes
+ * instead of the model's outputs */
+static int cmd_run_loads(const options *o) {
+  if (!o->body) {
+    fprintf(stderr, "mbcc: error: --loads needs --body NAME (the flexible body whose loads are written)\n");
+    return 2;
+  }
+  mbc_unit u;
+  if (mbc_unit_read(&u, o->model, o->scene)) return 2;
+  int ib = ir_find_body(u.ir, o->body);
+  if (ib < 0 || u.ir->bodies[ib].kind != BODY_FLEXIBLE) {
+    fprintf(stderr, "%s: error: '%s' is not a flexible body of this model\n", o->model, o->body);
+    mbc_unit_free(&u);
+    return 2;
+  }
+  int st = export_loads(o, ib, u.ir);
+  mbc_unit_free(&u);
+  return st;
+}
+
 static int cmd_run(const options *o) {
+  if (o->loads) return cmd_run_loads(o);
   if (check_run_options(o)) return 2;
   mbc_unit u;
   char csv[4096];
