@@ -165,9 +165,16 @@ static const char *base_unit(const mb_outputdef *o, int k) {
 static int write_units(const mb_model *m, const char *csv_path) {
   char path[4200], tmp[4300];
   snprintf(path, sizeof path, "%s.units", csv_path);
-  snprintf(tmp, sizeof tmp, "%s.part", path);
-  FILE *f = fopen(tmp, "w");
-  if (!f) return -1;
+  /* a temporary name of this process's own, as for the CSV: concurrent runs
+     of one model each rename a complete file into place */
+  snprintf(tmp, sizeof tmp, "%s.XXXXXX", path);
+  int fd = mkstemp(tmp);
+  FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+  if (!f) {
+    if (fd >= 0) { close(fd); unlink(tmp); }
+    return -1;
+  }
+  fchmod(fd, 0644 & ~current_umask());
   fprintf(f, "column,unit\nt,s\n");
   for (int i = 0; i < m->noutput; i++) {
     const mb_outputdef *o = &m->output[i];
