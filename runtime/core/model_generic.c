@@ -14,6 +14,7 @@ const char *mb_status_text(int status) {
   case MB_ERR_INVALID: return "invalid settings";
   case MB_ERR_NEWTON: return "Newton iteration did not converge";
   case MB_ERR_STEP_BUDGET: return "more steps than the step budget (max_steps)";
+  case MB_ERR_ENERGY: return "the energy blew up (the solution is wrong)";
   default: return "unknown error";
   }
 }
