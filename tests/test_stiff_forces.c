@@ -11,8 +11,19 @@
  *   - the same model without its tangents (a model compiled for an explicit
  *     method) at steps where the mass-only Newton cannot converge: the run
  *     stops with MB_ERR_NEWTON and the cause, and writes no rows after it;
- *   - generated and generic paths give the same trajectory. */
-// models: stiff_beam_link stiff_spring_mass
+ *   - generated and generic paths give the same trajectory;
+ *   - a quarter car on a stiff tyre (2e8 N/m under a 40 kg wheel): with the
+ *     tyre's tangent in the iteration matrix genalpha needs fewer Newton
+ *     iterations per step than with the tangents left out, and agrees with
+ *     Dormand-Prince;
+ *   - the watchdog: the beam link without its tangents at a loose tolerance,
+ *     where Newton's accepted iterates leave the stiff beam stretched (before
+ *     the watchdog: pin reactions of 1.27e5 N and 12.6 J of energy printed as
+ *     data, the truth 16.9 N and 0 J), stops with MB_ERR_ENERGY and writes no
+ *     rows after it; with the tangents the same settings run to the end;
+ *   - and does not stop a run whose energy comes from outside: a driver and
+ *     a point force feed 850 J into a model whose own energy scale is 0. */
+// models: stiff_beam_link stiff_spring_mass tyre_quarter_stiff watchdog_work
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -21,6 +32,8 @@
 #include "support.h"
 #include "stiff_beam_link.h"
 #include "stiff_spring_mass.h"
+#include "tyre_quarter_stiff.h"
+#include "watchdog_work.h"
 
 static double pin_force(const mb_model *m, const trajectory *tr, int r) {
   int c = column(m, "pin_reaction.fx");
@@ -152,11 +165,138 @@ static void no_tangent_stops(void **state) {
   trajectory_free(&tr);
 }
 
+/* The stiff tyre (omega 2236 rad/s, damping ratio 0.34) under the 1.3 Hz
+ * body mode.  Left out of the iteration matrix, the tyre's stiffness makes the
+ * mass-only modified Newton contract slowly (it diverges for
+ * K_z beta h^2 (1 - af) / ((1 - am) m) above 1: h > 0.9 ms), so the steps stay
+ * small and each takes more iterations.  With its tangent, Newton converges in
+ * about two iterations at steps set by the body mode.  Against DOPRI5 (rtol
+ * 1e-10) at the same rtol 1e-8: the body's travel is 0.15 m and genalpha's
+ * error is its truncation error on the 8 rad/s mode, which the step control
+ * keeps at about rtol times the 0.7 m coordinate per step, over some hundred
+ * steps: 1e-5 m bounds it (7e-5 of the travel); the tyre load follows the
+ * body's acceleration (peak 4387 N): 1 N, and the energy, 2249 J at the start
+ * (genalpha's numerical dissipation on the body mode is tiny, the stiff mode
+ * is damped by the tyre's own damping): 1e-2 J. */
+static void stiff_tyre_tangent(void **state) {
+  (void)state;
+  const mb_model *m = &tyre_quarter_stiff_model;
+  assert_non_null(m->force_tslot);
+  assert_true(m->force_tslot[1] >= 0); /* the tyre has its block */
+  mb_settings ref, ga;
+  test_settings(&ref, 2.0, 0.01);
+  ref.integrator = MB_DOPRI5;
+  ref.rtol = 1e-10;
+  ref.atol = 1e-13;
+  test_settings(&ga, 2.0, 0.01);
+  ga.integrator = MB_GENALPHA;
+  ga.rtol = 1e-8;
+  ga.atol = 1e-11;
+  mb_model bare = *m; /* the same model without the force tangents */
+  bare.force_tslot = NULL;
+  bare.tangent_slot = NULL;
+  trajectory a, b, c;
+  assert_int_equal(simulate(m, &ref, "ldl", &a), MB_OK);
+  assert_int_equal(simulate(m, &ga, "ldl", &b), MB_OK);
+  assert_int_equal(simulate(&bare, &ga, "ldl", &c), MB_OK);
+  assert_int_equal(a.nrows, b.nrows);
+  int cz = column(m, "z"), cf = column(m, "ty.Fz"), ce = column(m, "energy");
+  double dz = 0, df = 0, de = 0, dz_bare = 0;
+  for (int r = 0; r < a.nrows; r++) {
+    dz = fmax(dz, fabs(at(&a, r, cz) - at(&b, r, cz)));
+    df = fmax(df, fabs(at(&a, r, cf) - at(&b, r, cf)));
+    de = fmax(de, fabs(at(&a, r, ce) - at(&b, r, ce)));
+    dz_bare = fmax(dz_bare, fabs(at(&a, r, cz) - at(&c, r, cz)));
+  }
+  double it_with = (double)b.stats.newton_iterations / (double)b.stats.steps;
+  double it_without = (double)c.stats.newton_iterations / (double)c.stats.steps;
+  printf("  stiff tyre: with its tangent %ld steps, %.2f Newton iterations per step (%ld in all); "
+         "without: %ld steps, %.2f per step (%ld in all); DOPRI5 %ld steps\n",
+         b.stats.steps, it_with, b.stats.newton_iterations, c.stats.steps, it_without,
+         c.stats.newton_iterations, a.stats.steps);
+  printf("  against DOPRI5: body z %.2e m, tyre load %.2e N, energy %.2e J (without the tangent: "
+         "z %.2e m)\n", dz, df, de, dz_bare);
+  assert_true(it_with < it_without);
+  assert_true(b.stats.newton_iterations < c.stats.newton_iterations);
+  assert_true(dz < 1e-5);
+  assert_true(df < 1.0);
+  assert_true(de < 1e-2);
+  trajectory_free(&a);
+  trajectory_free(&b);
+  trajectory_free(&c);
+
+  /* auto weighs the tyre: its radial rate (Kz, Cz on the wheel) sqrt(2e8 / 40)
+     with the damping: 3108 1/s, a DOPRI5 step of 3.3 / 3108 = 1.06 ms; an
+     output step of 0.1 s (a tenth: 10 ms) makes that stiff */
+  char why[320];
+  ga.output_step = ga.max_step = 0.1;
+  assert_int_equal(mb_integrator_auto(m, &ga, why, sizeof why), MB_GENALPHA);
+  assert_non_null(strstr(why, "tyre"));
+}
+
+/* The energy of the passive beam link (no driver, no applied load) cannot
+ * rise; the watchdog allows the model's energy scale (the 0.7 kg at 9.81 m/s^2
+ * over the 0.4 m it reaches: 2.75 J) and stops beyond it.  Without the
+ * tangents at rtol 1e-2 the beam blows up within the first millisecond. */
+static void watchdog_stops_blowup(void **state) {
+  (void)state;
+  mb_model m = stiff_beam_link_model;
+  mb_settings s;
+  test_settings(&s, 1.0, 0.01);
+  s.integrator = MB_GENALPHA;
+  s.rtol = 1e-2;
+  s.atol = 1e-4;
+  trajectory ok;
+  assert_int_equal(simulate(&m, &s, "ldl", &ok), MB_OK); /* with the tangents */
+  int ce = column(&m, "energy");
+  double peak = 0, emax = 0;
+  for (int r = 0; r < ok.nrows; r++) {
+    peak = fmax(peak, pin_force(&m, &ok, r));
+    emax = fmax(emax, fabs(at(&ok, r, ce)));
+  }
+  m.force_tslot = NULL;
+  m.tangent_slot = NULL;
+  trajectory tr;
+  int st = simulate(&m, &s, "ldl", &tr);
+  printf("  watchdog: with the tangents at rtol 1e-2 peak pin reaction %.3g N, |energy| <= %.3g J; "
+         "without them status %d (%s) at t = %g s, %d rows\n", peak, emax, st, mb_status_text(st),
+         tr.fail_time, tr.nrows);
+  assert_true(peak < 25 && emax < 0.5);
+  assert_int_equal(st, MB_ERR_ENERGY);
+  assert_true(tr.fail_time > 0 && tr.fail_time < 1);
+  assert_true(tr.nrows <= 1 + (int)(tr.fail_time / 0.01)); /* no row after the failure */
+  for (int r = 0; r < tr.nrows; r++) assert_true(fabs(at(&tr, r, ce)) < 2.75);
+  trajectory_free(&ok);
+  trajectory_free(&tr);
+}
+
+/* watchdog_work.yaml: kinetic energy 800 t^2 (flywheel, omega = 40 t about
+ * its 1 kg m^2 axis) + 50 t^2 (puck, v = 10 t); the run starts at rest
+ * without gravity, so only the counted work of the driver and the force lets
+ * it through.  genalpha on this quadratic motion is exact up to the
+ * Newton tolerance: 1e-6 of the 850 J. */
+static void watchdog_counts_work(void **state) {
+  (void)state;
+  const mb_model *m = &watchdog_work_model;
+  mb_settings s;
+  test_settings(&s, 1.0, 0.01);
+  s.integrator = MB_GENALPHA;
+  trajectory tr;
+  assert_int_equal(simulate(m, &s, "ldl", &tr), MB_OK);
+  int ce = column(m, "energy");
+  for (int r = 0; r < tr.nrows; r++) assert_close(at(&tr, r, ce), 850 * tr.t[r] * tr.t[r], 850e-6);
+  assert_close(tr.t[tr.nrows - 1], 1, 1e-12);
+  trajectory_free(&tr);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(beam_link_against_dopri5),
       cmocka_unit_test(spring_mass_slow_mode),
       cmocka_unit_test(no_tangent_stops),
+      cmocka_unit_test(stiff_tyre_tangent),
+      cmocka_unit_test(watchdog_stops_blowup),
+      cmocka_unit_test(watchdog_counts_work),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

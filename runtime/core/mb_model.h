@@ -200,11 +200,13 @@ typedef struct mb_model {
  * force tangent: 0 on the ground or a virtual body (its columns are
  * eliminated by the solver's compile-time plan), 6 + nm on a flexible node
  * marker (the field's side 0: 6, its reaction acts through the body frame at
- * marker 1's point), else 6.  Only springs and fields have tangents. */
+ * marker 1's point), else 6.  Springs, fields and tyres have tangents; the
+ * tyre has one side (its wheel marker, side 0: the road is ground). */
 static inline int mb_force_tangent_side_cols(const mb_body *body, const mb_markerdef *marker,
                                              const mb_forcedef *d, int s) {
-  if (d->kind != MB_FORCE_SPRING && d->kind != MB_FORCE_FIELD) return 0;
-  if (d->m0 < 0 || d->m1 < 0) return 0;
+  if (d->kind != MB_FORCE_SPRING && d->kind != MB_FORCE_FIELD && d->kind != MB_FORCE_TYRE)
+    return 0;
+  if (d->kind == MB_FORCE_TYRE ? (s || d->m0 < 0) : (d->m0 < 0 || d->m1 < 0)) return 0;
   const mb_markerdef *md = &marker[s ? d->m1 : d->m0];
   if (md->body < 0) return 0;
   const mb_body *B = &body[md->body];

@@ -37,7 +37,8 @@ typedef enum {
   MB_ERR_NOMEM = 5,           /* allocation failed (hosted runtime only) */
   MB_ERR_INVALID = 6,         /* invalid settings */
   MB_ERR_NEWTON = 7,          /* the implicit integrator's Newton iteration diverged */
-  MB_ERR_STEP_BUDGET = 8      /* the run needs more steps than settings.max_steps */
+  MB_ERR_STEP_BUDGET = 8,     /* the run needs more steps than settings.max_steps */
+  MB_ERR_ENERGY = 9           /* the energy rose beyond what the model can supply (watchdog) */
 } mb_status;
 
 #define MB_PI 3.14159265358979323846

@@ -14,6 +14,7 @@ const char *mb_status_text(int status) {
   case MB_ERR_INVALID: return "invalid settings";
   case MB_ERR_NEWTON: return "Newton iteration did not converge";
   case MB_ERR_STEP_BUDGET: return "more steps than the step budget (max_steps)";
+  case MB_ERR_ENERGY: return "the energy blew up (the solution is wrong)";
   default: return "unknown error";
   }
 }
@@ -253,11 +254,17 @@ void mb_model_force_tangent(const mb_model *m, mb_real t, const mb_real *q, cons
       mb_field(&MK[d->m0], &MK[d->m1], m->force_prm + d->padr, F1, T, tan);
       dim = 6;
       for (int i = 0; i < 36; i++) S[i] = kfac * tan[i] + cfac * tan[36 + i];
+    } else if (d->kind == MB_FORCE_TYRE) {
+      mb_tyre(&MK[d->m0], m->force_prm + d->padr, F1, T, 0, tan);
+      dim = 6;
+      for (int i = 0; i < 36; i++) S[i] = kfac * tan[i] + cfac * tan[36 + i];
     } else {
       continue;
     }
     /* the wrench W on side 1 depends on the relative motion A1 dq1 - A0 dq0
-       (side 0 gets -W through A0): -df_s/dq_t = -sg_s sg_t A_s^T S A_t */
+       (side 0 gets -W through A0): -df_s/dq_t = -sg_s sg_t A_s^T S A_t.  The
+       tyre's wrench acts on its only side, 0, and depends on that side's
+       motion alone: -df_0/dq_0 = -A_0^T S A_0, the same sign */
     mb_real A[2][6 * (6 + MB_MAX_MODES)], SA[6 * (6 + MB_MAX_MODES)];
     int nc[2];
     for (int s = 0; s < 2; s++) nc[s] = tangent_jacobian(m, F, MK, d, s, dim, A[s]);

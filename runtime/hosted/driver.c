@@ -417,11 +417,12 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
   if (set.integrator == MB_GENALPHA && !m->force_tslot && !quiet) {
     int nstiff = 0;
     for (int e = 0; e < m->nforce; e++)
-      nstiff += m->force[e].kind == MB_FORCE_SPRING || m->force[e].kind == MB_FORCE_FIELD;
+      nstiff += m->force[e].kind == MB_FORCE_SPRING || m->force[e].kind == MB_FORCE_FIELD ||
+                m->force[e].kind == MB_FORCE_TYRE;
     if (nstiff)
       fprintf(stderr, "%s: note: the model was compiled without its force elements' tangents "
                       "(its integrator is not genalpha or auto): generalized-alpha's Newton sees "
-                      "only the masses and the modes, and stiff springs, bushings or beams force "
+                      "only the masses and the modes, and stiff springs, bushings, beams or tyres force "
                       "small steps\n", argv[0]);
   }
   mb_sim sim;

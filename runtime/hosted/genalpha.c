@@ -202,12 +202,133 @@ static int ga_newton(mb_sim *s, ga_work *g, double h, int *st, double *rate_out)
   return GA_DIVERGED;
 }
 
+/* does force element d do work that is not the change of a potential
+ * mb_model_energy counts?  Point forces and torques (applied loads), tyres
+ * (slip and rolling losses, and traction), and fields whose stiffness is not
+ * symmetric (circulatory) */
+static int does_work(const mb_model *m, const mb_forcedef *d) {
+  if (d->kind == MB_FORCE_POINT || d->kind == MB_FORCE_TORQUE || d->kind == MB_FORCE_TYRE) return 1;
+  if (d->kind == MB_FORCE_FIELD) {
+    const mb_real *K = m->force_prm + d->padr + MB_FIELD_K;
+    for (int i = 0; i < 6; i++)
+      for (int j = 0; j < i; j++)
+        if (K[6 * i + j] != K[6 * j + i]) return 1;
+  }
+  return 0;
+}
+
+/* the power the watchdog integrates at the state of s: |lambda . D v| of
+ * the constraints (D from K's constraint rows) plus |f_src . v| of the
+ * work-doing elements (their generalized forces: the generic evaluation with
+ * them minus the one without any element) */
+static double input_power(mb_watchdog *w, mb_sim *s, const mb_real *lambda) {
+  const mb_model *m = s->m;
+  double pc = 0, pf = 0;
+  for (int r = 0; r < m->nc; r++) w->phi[r] = 0;
+  for (int j = 0; j < m->nv; j++)
+    for (int p = m->Kp[j]; p < m->Kp[j + 1]; p++)
+      if (m->Ki[p] >= m->nv) w->phi[m->Ki[p] - m->nv] += s->Kx[p] * s->v[j];
+  for (int r = 0; r < m->nc; r++) pc += (double)lambda[r] * (double)w->phi[r];
+  if (w->src.nforce) {
+    mb_generic_eval(&w->src, (mb_real)s->t, s->q, s->v, w->Kx, w->r_src, w->phi, w->phid, w->work);
+    mb_generic_eval(&w->none, (mb_real)s->t, s->q, s->v, w->Kx, w->r_none, w->phi, w->phid, w->work);
+    for (int i = 0; i < m->nv; i++) pf += (double)(w->r_src[i] - w->r_none[i]) * (double)s->v[i];
+  }
+  return fabs(pc) + fabs(pf);
+}
+
+
+void mb_watchdog_free(mb_watchdog *w) {
+  free(w->src_force); free(w->Kx); free(w->r_src); free(w->r_none); free(w->phi); free(w->phid);
+  free(w->work);
+  memset(w, 0, sizeof *w);
+}
+
+int mb_watchdog_start(mb_watchdog *w, mb_sim *s) {
+  const mb_model *m = s->m;
+  memset(w, 0, sizeof *w);
+  w->src_force = malloc(sizeof(mb_forcedef) * ((size_t)m->nforce + 1));
+  w->Kx = calloc((size_t)m->nnz + 1, sizeof(mb_real));
+  w->r_src = calloc((size_t)m->n + 1, sizeof(mb_real));
+  w->r_none = calloc((size_t)m->n + 1, sizeof(mb_real));
+  w->phi = calloc((size_t)m->nc + 1, sizeof(mb_real));
+  w->phid = calloc((size_t)m->nc + 1, sizeof(mb_real));
+  w->work = malloc(mb_model_worksize(m) + 16);
+  if (!w->src_force || !w->Kx || !w->r_src || !w->r_none || !w->phi || !w->phid || !w->work) {
+    mb_watchdog_free(w);
+    return MB_ERR_NOMEM;
+  }
+  int nsrc = 0;
+  for (int e = 0; e < m->nforce; e++)
+    if (does_work(m, &m->force[e])) w->src_force[nsrc++] = m->force[e];
+  w->src = *m;
+  w->src.force = w->src_force;
+  w->src.nforce = nsrc;
+  w->src.force_tslot = w->src.tangent_slot = NULL;
+  w->none = w->src;
+  w->none.nforce = 0;
+  mb_real T, V;
+  mb_model_energy(m, (mb_real)s->t, s->q, s->v, &T, &V, w->work);
+  /* L: the model's reach from the origin, over the bodies' frames, their
+     markers (joint and element points) and a flexible body's centre of mass
+     twice over (its length) */
+  double mass = 0, L = 0;
+  for (int b = 0; b < m->nbody; b++) {
+    const mb_body *B = &m->body[b];
+    if (B->kind == MB_BODY_VIRTUAL) continue;
+    const mb_real *r = s->q + B->qadr;
+    double rb = sqrt((double)(r[0] * r[0] + r[1] * r[1] + r[2] * r[2])), reach = 0;
+    if (B->kind == MB_BODY_FLEXIBLE && B->flex) {
+      const mb_real *S0 = B->flex->S0;
+      mass += (double)B->flex->mass;
+      if (B->flex->mass > 0)
+        reach = 2 * sqrt((double)(S0[0] * S0[0] + S0[1] * S0[1] + S0[2] * S0[2])) / (double)B->flex->mass;
+    } else {
+      mass += (double)B->mass;
+    }
+    for (int k = 0; k < m->nmarker; k++)
+      if (m->marker[k].body == b) {
+        const mb_real *p = m->marker[k].s;
+        reach = fmax(reach, sqrt((double)(p[0] * p[0] + p[1] * p[1] + p[2] * p[2])));
+      }
+    L = fmax(L, rb + reach);
+  }
+  double g = sqrt((double)(m->gravity[0] * m->gravity[0] + m->gravity[1] * m->gravity[1] +
+                           m->gravity[2] * m->gravity[2]));
+  w->e0 = (double)T + (double)V;
+  w->e_ref = fabs((double)T) + fabs((double)V) + mass * g * L;
+  w->t_prev = s->t;
+  return MB_OK;
+}
+
+int mb_watchdog_check(mb_watchdog *w, mb_sim *s, const mb_real *lambda) {
+  double p = input_power(w, s, lambda);
+  w->w_in += 0.5 * (s->t - w->t_prev) * (w->p_prev + p);
+  w->p_prev = p;
+  w->t_prev = s->t;
+  mb_real T, V;
+  mb_model_energy(s->m, (mb_real)s->t, s->q, s->v, &T, &V, w->work);
+  double e = (double)T + (double)V;
+  w->rise = e - w->e0 - w->w_in;
+  /* allowed: the energy scale, the input work once more (its quadrature
+     error) and the round-off of T + V */
+  double allowed = w->e_ref + w->w_in + 1e-6 * (fabs((double)T) + fabs((double)V));
+  if (isfinite(e) && w->rise <= allowed) return MB_OK;
+  s->fail_time = s->t;
+  snprintf(s->fail_detail, sizeof s->fail_detail,
+           "generalized-alpha: the energy rose to %.4g from %.4g (work in %.3g), more than "
+           "the energy scale %.3g: a blow-up", e, w->e0, w->w_in, w->e_ref);
+  return MB_ERR_ENERGY;
+}
+
 int mb_genalpha_run(mb_sim *s, mb_output_fn out, void *user) {
   const mb_model *m = s->m;
   const mb_settings *set = &s->set;
   int nq = m->nq, nv = m->nv, nc = m->nc;
   ga_work g;
+  mb_watchdog wd;
   memset(&g, 0, sizeof g);
+  memset(&wd, 0, sizeof wd);
   if (!ga_alloc(&g, m)) { ga_free(&g); return MB_ERR_NOMEM; }
   double rho = set->rho_inf;
   if (!(rho >= 0 && rho <= 1)) { ga_free(&g); return MB_ERR_INVALID; }
@@ -225,6 +346,8 @@ int mb_genalpha_run(mb_sim *s, mb_output_fn out, void *user) {
   /* consistent accelerations at t = 0 start the recurrence: a_0 = vd_0 */
   if ((st = mb_sim_accel(s, 0, s->q, s->v, g.vd, g.lam))) goto done;
   memcpy(g.a, g.vd, sizeof(mb_real) * (size_t)nv);
+  if ((st = mb_watchdog_start(&wd, s))) goto done;
+  wd.p_prev = input_power(&wd, s, g.lam);
   while (1) {
     double tout = (double)iout * set->output_step;
     if ((st = mb_sim_step_budget(s, h))) goto done;
@@ -291,9 +414,13 @@ int mb_genalpha_run(mb_sim *s, mb_output_fn out, void *user) {
       /* index-3 positions need no Baumgarte terms: plain normalization */
       mb_model_normalize(m, s->q);
     }
+    /* before the state can reach an output row: an energy that blew up
+       stops the run (the step's K and multipliers are from its Newton) */
+    if ((st = mb_watchdog_check(&wd, s, g.lam))) goto done;
     if ((st = mb_sim_finish_step(s, s->t))) goto done;
   }
 done:
+  mb_watchdog_free(&wd);
   ga_free(&g);
   return st;
 }

@@ -351,6 +351,9 @@ static double force_rate(const mb_model *m, int e) {
     const mb_real *K = m->force_prm + d->padr + MB_FIELD_K, *C = m->force_prm + d->padr + MB_FIELD_C;
     for (int i = 0; i < 6; i++)
       rate = fmax(rate, dof_rate((double)K[7 * i], (double)C[7 * i], i < 3 ? mt : jr));
+  } else if (d->kind == MB_FORCE_TYRE) { /* the radial spring-damper on the wheel */
+    const mb_real *prm = m->force_prm + d->padr;
+    rate = dof_rate((double)prm[MB_TYRE_KZ], (double)prm[MB_TYRE_CZ], mt);
   }
   return rate;
 }
@@ -389,7 +392,8 @@ int mb_integrator_auto(const mb_model *m, const mb_settings *set, char *why, siz
                "%s: the stiffest force element (%s %d, between %s and %s, rate %.4g 1/s as "
                "k/m and c/m of the bodies it joins) limits an explicit step to %.3g s for "
                "stability, %s a tenth of the output step %.3g s",
-               implicit ? "genalpha" : "dopri5", d->kind == MB_FORCE_SPRING ? "spring" : "field",
+               implicit ? "genalpha" : "dopri5",
+               d->kind == MB_FORCE_SPRING ? "spring" : d->kind == MB_FORCE_TYRE ? "tyre" : "field",
                force, b0 >= 0 ? m->body[b0].name : "ground", b1 >= 0 ? m->body[b1].name : "ground",
                fmax_rate, hstab, implicit ? "below" : "above", hwant);
     } else {

@@ -107,4 +107,30 @@ int mb_sim_finish_step(mb_sim *s, double t);
 int mb_sim_step_budget(mb_sim *s, double h);
 int mb_genalpha_run(mb_sim *s, mb_output_fn out, void *user);
 
+/* The energy watchdog of the implicit method (genalpha.c; docs/formulation.md
+ * §15, "Watchdog").  The total energy E = T + V (mb_model_energy) of a correct
+ * solution rises by no more than the work W_in its driving elements do: the
+ * driven constraints (power lambda . D v) and the elements whose work is not
+ * a potential (point forces and torques, tyres, fields with a non-symmetric
+ * stiffness), integrated as |power| by the trapezoidal rule.  After every
+ * accepted step, E - E_0 - W_in above E_ref + W_in + 1e-6 (|T| + |V|),
+ * with the model's energy scale E_ref = |T_0| + |V_0| + (total mass) |g| L
+ * (L: the model's reach from the origin at t = 0, over its bodies and
+ * markers), stops the run with MB_ERR_ENERGY, the time and the cause: a
+ * blow-up, never a run's accuracy.  mb_watchdog_start at t = 0
+ * (MB_ERR_NOMEM), mb_watchdog_check after each accepted step with the state
+ * in s->t, s->q, s->v, K from the step's last evaluation in s->Kx and the
+ * step's multipliers, mb_watchdog_free at the end. */
+typedef struct {
+  mb_model src;          /* the model with only its work-doing elements */
+  mb_model none;         /* the model without force elements */
+  mb_forcedef *src_force;
+  mb_real *Kx, *r_src, *r_none, *phi, *phid;
+  void *work;
+  double e0, e_ref, w_in, p_prev, t_prev, rise;
+} mb_watchdog;
+int mb_watchdog_start(mb_watchdog *w, mb_sim *s);
+int mb_watchdog_check(mb_watchdog *w, mb_sim *s, const mb_real *lambda);
+void mb_watchdog_free(mb_watchdog *w);
+
 #endif
