@@ -160,6 +160,12 @@ static const char *base_unit(const mb_outputdef *o, int k) {
   }
 }
 
+static mode_t current_umask(void) {
+  mode_t u = umask(022);
+  umask(u);
+  return u;
+}
+
 /* CSV.units beside the results: "column,unit" and a row per CSV column; an
    output with a scale s is in units of 1/s of its SI unit ("0.001 m") */
 static int write_units(const mb_model *m, const char *csv_path) {
@@ -283,12 +289,6 @@ static int apply_sets(const mb_model *m, const char *prog, int nsets, const char
   m->set_params(m, p);
   free(p);
   return 0;
-}
-
-static mode_t current_umask(void) {
-  mode_t u = umask(022);
-  umask(u);
-  return u;
 }
 
 int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *defaults,
