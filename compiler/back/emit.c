@@ -723,7 +723,7 @@ static void emit_eval(emit_ctx *cx) {
     fputs("  }\n", f);
   }
   fprintf(f, "\n  /* constraint rows: D in both triangles of K, gamma, phi, phid */\n");
-  emit_rows_shared(f, L);
+  if (emit_rows_shared(f, L)) cx->failed = 1;
   static const char *prim[] = {"", "sph", "dot1", "dot2", "dist", "rot", "trans"};
   for (int r = 0; r < m->nrow; r++) {
     const mb_rowdef *R = &L->row[r];
