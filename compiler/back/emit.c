@@ -24,6 +24,7 @@
 #include "emit_rows.h"
 #include "element.h"
 #include "emit_util.h"
+#include "sym.h"
 #include "outfile.h"
 #include "version.h"
 #include "flex.h"
@@ -489,21 +490,29 @@ static void emit_flex_tables(emit_ctx *cx, int b) {
           b, b, b, b, b, b, b, b, nn, b, b, b);
 }
 
-/* "c->name[k] = c0 + sum_t coef_t * v[idx_t];" with the nonzero terms only */
-static void emit_sum(FILE *f, const char *lhs, double c0, const double *coef, const int *idx, int nt,
-                     const char *v, long *nterm) {
-  fprintf(f, "  %s = ", lhs);
-  int any = 0;
-  if (c0 != 0 || nt == 0) { num(f, c0); any = 1; }
+/* "c->name[k] = c0 + sum_t coef_t * v[idx_t];" with the nonzero terms only,
+ * formed in sym (one graph a statement, so each term's constant comes before
+ * its symbol and the sum prints in the order it adds): a term after the first
+ * with a negative coefficient subtracts its magnitude, the same number.
+ * Returns -1 out of memory (nothing written). */
+static int emit_sum(FILE *f, const char *lhs, double c0, const double *coef, const int *idx, int nt,
+                    const char *v, long *nterm) {
+  sym_graph g;
+  sym_init(&g);
+  sym_id sum = c0 != 0 || nt == 0 ? sym_const(&g, c0) : -1;
   for (int t = 0; t < nt; t++) {
-    if (any) fputs(coef[t] < 0 ? " - " : " + ", f);
-    else if (coef[t] < 0) fputs("-", f);
-    num(f, fabs(coef[t]));
-    fprintf(f, " * %s[%d]", v, idx[t]);
-    any = 1;
+    char name[32];
+    snprintf(name, sizeof name, "%s[%d]", v, idx[t]);
+    /* the constant made first (arguments' order of evaluation is unspecified) */
+    sym_id c = sym_const(&g, sum < 0 ? coef[t] : fabs(coef[t]));
+    sym_id term = sym_mul(&g, c, sym_symbol(&g, name));
+    if (sum < 0) { sum = term; continue; }
+    sum = coef[t] < 0 ? sym_sub(&g, sum, term) : sym_add(&g, sum, term);
   }
-  fputs(";\n", f);
+  int st = g.failed ? -1 : sym_print_block(f, &g, &sum, &lhs, 1, "s", "  ");
+  sym_free(&g);
   *nterm += nt;
+  return st;
 }
 
 /* a flexible body's per-step contractions (mb_flex_contract in
@@ -532,17 +541,17 @@ static void emit_flex_contract(emit_ctx *cx, int b) {
     for (int j = 0; j < nm && lin; j++)
       if (x->S1[3 * j + i] != 0) { coef[nt] = x->S1[3 * j + i]; idx[nt++] = j; }
     snprintf(lhs, sizeof lhs, "c->S[%d]", i);
-    emit_sum(f, lhs, x->S0[i], coef, idx, nt, "w", &nterm);
+    if (emit_sum(f, lhs, x->S0[i], coef, idx, nt, "w", &nterm)) cx->failed = 1;
     nt = 0;
     for (int j = 0; j < nm; j++)
       if (x->S1[3 * j + i] != 0) { coef[nt] = x->S1[3 * j + i]; idx[nt++] = j; }
     snprintf(lhs, sizeof lhs, "c->S1wd[%d]", i);
-    emit_sum(f, lhs, 0, coef, idx, nt, "wd", &nterm);
+    if (emit_sum(f, lhs, 0, coef, idx, nt, "wd", &nterm)) cx->failed = 1;
     nt = 0;
     for (int j = 0; j < nm; j++)
       if (x->CPsi[3 * j + i] != 0) { coef[nt] = x->CPsi[3 * j + i]; idx[nt++] = j; }
     snprintf(lhs, sizeof lhs, "c->Cw[%d]", i);
-    emit_sum(f, lhs, 0, coef, idx, nt, "wd", &nterm);
+    if (emit_sum(f, lhs, 0, coef, idx, nt, "wd", &nterm)) cx->failed = 1;
   }
   for (int j = 0; j < nm; j++) {
     fprintf(f, "  /* mode %d: Fw = sum_a w_a F_%d,a; Gw = C0 + sum_a w_a G_a,%d; Gd = sum_a wd_a G_a,%d */\n",
@@ -554,7 +563,7 @@ static void emit_flex_contract(emit_ctx *cx, int b) {
         if (v != 0) { coef[nt] = v; idx[nt++] = a; }
       }
       snprintf(lhs, sizeof lhs, "c->Fw[%d]", 9 * j + i);
-      emit_sum(f, lhs, 0, coef, idx, nt, "w", &nterm);
+      if (emit_sum(f, lhs, 0, coef, idx, nt, "w", &nterm)) cx->failed = 1;
     }
     for (int i = 0; i < 3; i++) {
       int nt = 0;
@@ -563,14 +572,14 @@ static void emit_flex_contract(emit_ctx *cx, int b) {
         if (v != 0) { coef[nt] = v; idx[nt++] = a; }
       }
       snprintf(lhs, sizeof lhs, "c->Gw[%d]", 3 * j + i);
-      emit_sum(f, lhs, x->C0[3 * j + i], coef, idx, nt, "w", &nterm);
+      if (emit_sum(f, lhs, x->C0[3 * j + i], coef, idx, nt, "w", &nterm)) cx->failed = 1;
       nt = 0;
       for (int a = 0; a < nm; a++) {
         double v = x->G[3 * ((size_t)a * nm + j) + i];
         if (v != 0) { coef[nt] = v; idx[nt++] = a; }
       }
       snprintf(lhs, sizeof lhs, "c->Gd[%d]", 3 * j + i);
-      emit_sum(f, lhs, 0, coef, idx, nt, "wd", &nterm);
+      if (emit_sum(f, lhs, 0, coef, idx, nt, "wd", &nterm)) cx->failed = 1;
     }
   }
   /* J = J0 + sum_j w_j (2 tr(E_j) I - E_j - E_j^T) [+ sum_j w_j (tr(Fw_j) I - (Fw_j + Fw_j^T) / 2)] */
@@ -586,7 +595,7 @@ static void emit_flex_contract(emit_ctx *cx, int b) {
         if (v != 0) { coef[nt] = v; idx[nt++] = j; }
       }
       snprintf(lhs, sizeof lhs, "c->J[%d]", 3 * i + l);
-      emit_sum(f, lhs, x->J0[3 * i + l], coef, idx, nt, "w", &nterm);
+      if (emit_sum(f, lhs, x->J0[3 * i + l], coef, idx, nt, "w", &nterm)) cx->failed = 1;
     }
   if (quad && lin) {
     fputs("  for (int j = 0; j < ", f);
@@ -714,7 +723,7 @@ static void emit_eval(emit_ctx *cx) {
     fputs("  }\n", f);
   }
   fprintf(f, "\n  /* constraint rows: D in both triangles of K, gamma, phi, phid */\n");
-  emit_rows_shared(f, L);
+  if (emit_rows_shared(f, L)) cx->failed = 1;
   static const char *prim[] = {"", "sph", "dot1", "dot2", "dist", "rot", "trans"};
   for (int r = 0; r < m->nrow; r++) {
     const mb_rowdef *R = &L->row[r];

@@ -120,6 +120,13 @@ void emit_ldl_fields(emit_ctx *cx, int emitted) {
 
 static int kconst(const emit_ctx *cx, int q, double *v);
 
+/* a compile-time constant of K or of the factorization: sym's literal */
+static void klit(FILE *f, double c) {
+  char b[40];
+  sym_literal(b, sizeof b, c);
+  fputs(b, f);
+}
+
 /* 1 if the slot of the block pivots' space (k1) or of Kx holds a compile-time
  * constant (K1's constants, init's entries of Kx), its value in *v */
 static int slot_const(const emit_ctx *cx, int slot, int k1, double *v) {
@@ -157,7 +164,7 @@ static void kname(emit_ctx *cx, int q) {
  * a compile-time constant */
 static void kput_buf(const emit_ctx *cx, char *buf, size_t n, int slot, int k1) {
   double c;
-  if (slot_const(cx, slot, k1, &c)) snprintf(buf, n, "%.17g", c == 0 ? 0 : c);
+  if (slot_const(cx, slot, k1, &c)) sym_literal(buf, n, c);
   else kname_buf(cx, buf, n, slot, k1);
 }
 
@@ -179,7 +186,7 @@ static void put_term(emit_ctx *cx, int *any, int known, double c, const char *co
     if (c == 0) return;
     fputs(*any ? (c < 0 ? " - " : " + ") : (c < 0 ? "-" : ""), f);
     if (fabs(c) != 1) {
-      num(f, fabs(c));
+      klit(f, fabs(c));
       fputs(" * ", f);
     }
     fputs(v, f);
@@ -201,7 +208,7 @@ static void put_kterm(emit_ctx *cx, int *any, int slot, const char *v) {
 static void kval(emit_ctx *cx, int q) {
   FILE *f = cx->f;
   double c;
-  if (kconst(cx, q, &c)) num(f, c);
+  if (kconst(cx, q, &c)) klit(f, c);
   else if (!cx->ldl.kc_of) kname(cx, q);
   else if (cx->ldl.kc_of[q] >= 0) fprintf(f, "Kc[%d]", cx->ldl.kc_of[q]);
   else if (cx->ldl.kc_map[q] >= 0) kname(cx, cx->ldl.kc_map[q]);
@@ -214,9 +221,7 @@ static int kconst(const emit_ctx *cx, int q, double *v) {
   int src = q;
   if (cx->ldl.kc_of) {
     if (cx->ldl.kc_of[q] >= 0) {
-      if (!cx->ldl.kc_cst || !cx->ldl.kc_cst[cx->ldl.kc_of[q]]) return 0;
-      *v = cx->ldl.kc_val[cx->ldl.kc_of[q]];
-      return 1;
+      return cx->ldl.kc_sym && sym_is_const(&cx->ldl.sym, cx->ldl.kc_sym[cx->ldl.kc_of[q]], v);
     }
     src = cx->ldl.kc_map[q];
     if (src < 0) {
@@ -769,7 +774,7 @@ static void emit_reduced_rhs(emit_ctx *cx, const char *v, int i, int row, const 
     if (sl < 0) continue;
     if (!slot_const(cx, sl, cx->ldl.kput_k1, &c)) { fputs(" - ", f); kname(cx, sl); fprintf(f, " * d[%d]", cols[k]); }
     else if (c == 1 || c == -1) fprintf(f, " %c d[%d]", c == 1 ? '-' : '+', cols[k]);
-    else if (c != 0) { fputs(" - ", f); num(f, c); fprintf(f, " * d[%d]", cols[k]); }
+    else if (c != 0) { fputs(" - ", f); klit(f, c); fprintf(f, " * d[%d]", cols[k]); }
   }
   fputs(";\n", f);
 }
@@ -798,9 +803,11 @@ static void emit_blocks_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *
   for (int e = 0; e < p->nelim; e++) nw += 6 * (p->esp[e + 1] - p->esp[e]);
   char *wk = calloc((size_t)nw + 1, 1); /* W's entries known at compile time, per block at 6 esp[e] */
   double *wc = calloc((size_t)nw + 1, sizeof(double));
-  cx->ldl.kc_cst = calloc((size_t)nkc + 1, 1);
-  cx->ldl.kc_val = calloc((size_t)nkc + 1, sizeof(double));
-  if (!dinz || !dk || !wk || !wc || !cx->ldl.kc_cst || !cx->ldl.kc_val) { free(src); free(dinz); free(dk); free(wk); free(wc); cx->failed = 1; return; }
+  sym_graph *g = &cx->ldl.sym;
+  cx->ldl.kc_sym = malloc(sizeof(sym_id) * ((size_t)nkc + 1));
+  if (cx->ldl.kc_sym)
+    for (int k = 0; k < nkc; k++) cx->ldl.kc_sym[k] = -1;
+  if (!dinz || !dk || !wk || !wc || !cx->ldl.kc_sym) { free(src); free(dinz); free(dk); free(wk); free(wc); cx->failed = 1; return; }
   for (int e = 0; e < p->nelim; e++) ldl_block_dinz(p, e, dinz[e]);
   /* the entries of Kc that a block's update reaches (their first update sets them) */
   char *updated = calloc((size_t)nkc + 1, 1);
@@ -827,8 +834,7 @@ static void emit_blocks_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *
     double c;
     if (updated[k]) continue;
     if (src[k] < 0 || slot_const(cx, src[k], 1, &c)) { /* a constant of K' */
-      cx->ldl.kc_cst[k] = 1;
-      cx->ldl.kc_val[k] = src[k] >= 0 ? c : src[k] == -2 ? 1 : src[k] == -3 ? -1 : 0;
+      cx->ldl.kc_sym[k] = sym_const(g, src[k] >= 0 ? c : src[k] == -2 ? 1 : src[k] == -3 ? -1 : 0);
       continue;
     }
     fprintf(f, "  Kc[%d] = ", k);
@@ -853,15 +859,17 @@ static void emit_blocks_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *
       fprintf(f, "  /* %s */\n", name);
       for (int i = 0; i < 6; i++) { /* only the entries w_nonzero: the readers skip the others */
         int any = 0, known = 1;
-        double sum = 0, c;
+        sym_id sum = sym_const(g, 0);
+        double c;
         for (int c6 = 0; c6 < 6; c6++)
           if (eu[c6] >= 0 && dinz[e][6 * c6 + i]) {
             any = 1;
-            if (slot_const(cx, eu[c6], 1, &c) && dk[e].k[6 * c6 + i]) sum += c * dk[e].c[6 * c6 + i];
+            if (slot_const(cx, eu[c6], 1, &c) && dk[e].k[6 * c6 + i])
+              sum = sym_add(g, sum, sym_mul(g, sym_const(g, c), sym_const(g, dk[e].c[6 * c6 + i])));
             else known = 0;
           }
         if (!any) continue;
-        if (known) { wki[i] = 1; wci[i] = sum; continue; } /* read as a literal */
+        if (known && sym_is_const(g, sum, &wci[i])) { wki[i] = 1; continue; } /* read as a literal */
         fprintf(f, "  W[%d] = ", 6 * si + i);
         any = 0;
         for (int c6 = 0; c6 < 6; c6++)
@@ -880,14 +888,16 @@ static void emit_blocks_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *
       for (int xi = 0; xi < nx; xi++, k++) {
         const int *dx = p->edx + 6 * (xs + xi);
         int any = 0, known = 1;
-        double vsum = 0, c;
+        sym_id vsum = sym_const(g, 0);
+        double c, vsum_c = 0;
         for (int i = 0; i < 6; i++)
           if (dx[i] >= 0 && ldl_w_nonzero(eu, dinz[e], i)) {
             any = 1;
-            if (wki[i] && slot_const(cx, dx[i], 1, &c)) vsum += wci[i] * c;
+            if (wki[i] && slot_const(cx, dx[i], 1, &c)) vsum = sym_add(g, vsum, sym_mul(g, sym_const(g, wci[i]), sym_const(g, c)));
             else known = 0;
           }
         if (!any) continue;
+        if (known && !sym_is_const(g, vsum, &vsum_c)) { cx->failed = 1; known = 0; } /* out of memory */
         if (!known) {
           fputs("  v = ", f);
           any = 0;
@@ -906,15 +916,17 @@ static void emit_blocks_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *
         for (int h = 0; h < 2; h++) {
           int kc = cx->ldl.kc_of[p->ekr[2 * k + h]];
           if (updated[kc] == 2) { /* a later change */
-            if (cx->ldl.kc_cst[kc] && known) { cx->ldl.kc_val[kc] -= vsum; continue; }
-            if (cx->ldl.kc_cst[kc]) {
+            double kv;
+            int kknown = sym_is_const(g, cx->ldl.kc_sym[kc], &kv);
+            if (kknown && known) { cx->ldl.kc_sym[kc] = sym_sub(g, cx->ldl.kc_sym[kc], vsum); continue; }
+            if (kknown) {
               fprintf(f, "  Kc[%d] = ", kc);
-              num(f, cx->ldl.kc_val[kc]);
+              klit(f, kv);
               fputs(" - v;\n", f);
-              cx->ldl.kc_cst[kc] = 0;
+              cx->ldl.kc_sym[kc] = -1;
             } else if (known) {
               fprintf(f, "  Kc[%d] -= ", kc);
-              num(f, vsum);
+              klit(f, vsum_c);
               fputs(";\n", f);
             } else {
               fprintf(f, "  Kc[%d] -= v;\n", kc);
@@ -925,12 +937,12 @@ static void emit_blocks_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *
           double base;
           int bknown = src[kc] < 0 || slot_const(cx, src[kc], 1, &base);
           if (src[kc] < 0) base = src[kc] == -2 ? 1 : src[kc] == -3 ? -1 : 0;
-          if (bknown && known) { cx->ldl.kc_cst[kc] = 1; cx->ldl.kc_val[kc] = base - vsum; continue; }
+          if (bknown && known) { cx->ldl.kc_sym[kc] = sym_sub(g, sym_const(g, base), vsum); continue; }
           fprintf(f, "  Kc[%d] = ", kc);
           if (!bknown) { kname(cx, src[kc]); fputs(" - ", f); }
-          else if (base != 0) { num(f, base); fputs(" - ", f); }
+          else if (base != 0) { klit(f, base); fputs(" - ", f); }
           else fputc('-', f);
-          if (known) num(f, vsum);
+          if (known) klit(f, vsum_c);
           else fputc('v', f);
           fputs(";\n", f);
         }
@@ -1978,10 +1990,10 @@ int emit_ldl(emit_ctx *cx) {
   cx->ldl.k1_direct = 0;
   cx->ldl.kx_cst = NULL;
   free(cst);
-  free(cx->ldl.kc_cst);
-  free(cx->ldl.kc_val);
-  cx->ldl.kc_cst = NULL;
-  cx->ldl.kc_val = NULL;
+  if (cx->ldl.sym.failed) cx->failed = 1;
+  free(cx->ldl.kc_sym);
+  cx->ldl.kc_sym = NULL;
+  sym_free(&cx->ldl.sym);
   free(kc);
   fputs("static int ldl_factor_m(const mb_model *m, const mb_real *Kx, mb_real *work) {\n", f);
   fprintf(f, "  (void)m;\n  return %s_ldl_factor(Kx, work);\n}\n", nm);

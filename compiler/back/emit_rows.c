@@ -521,13 +521,13 @@ static int frame_pair_cmp(const void *x, const void *y) {
   return a->r < b->r ? -1 : a->r > b->r;
 }
 
-void emit_rows_shared(FILE *f, const lmodel *L) {
+int emit_rows_shared(FILE *f, const lmodel *L) {
   const mb_model *m = &L->m;
   /* the rows grouped by pair, pairs in (b0, b1) order: one pass and a sort,
      not a pass over the rows for every pair of bodies (cubic in a chain) */
   frame_pair_row *pr = malloc(sizeof *pr * ((size_t)m->nrow + 1));
   int npr = 0;
-  if (!pr) { fprintf(stderr, "mbcc: error: out of memory while emitting\n"); exit(2); }
+  if (!pr) return -1; /* the caller reports it (no exit in library code) */
   for (int r = 0; r < m->nrow; r++) {
     int x0, x1;
     if (dot1_frames(L, r, &x0, &x1)) pr[npr++] = (frame_pair_row){x0, x1, r};
@@ -554,6 +554,7 @@ void emit_rows_shared(FILE *f, const lmodel *L) {
             b0, b1, b0, b1, b0, b1, b0, b1, b0, b1);
   }
   free(pr);
+  return 0;
 }
 
 static void emit_dot1_frames(FILE *f, const lmodel *L, int r, int b0, int b1) {

@@ -6,6 +6,7 @@
 
 #include <stdio.h>
 
+#include "sym.h"
 #include "unit.h"
 
 /* The emitted LDL^T's compile-time knowledge of K while its code is written
@@ -34,11 +35,11 @@ typedef struct {
    * computes (-4), and constants are literals */
   int k1_direct;
   /* straight-line block pivots: the entries of Kc known at compile time (a
-   * weld's translational rows: unit D_u and unit rows on both sides),
-   * kc_cst[k] set and the value in kc_val[k]; those are not stored, their
-   * readers get the literal */
-  char *kc_cst;
-  double *kc_val;
+   * weld's translational rows: unit D_u and unit rows on both sides) are
+   * constant nodes of 'sym', kc_sym[k] (-1: stored in Kc); the block updates
+   * fold into them there, and their readers get the literal */
+  sym_id *kc_sym;
+  sym_graph sym;
   int inv6_emitted; /* ldl_invn and ldl_inv6 are written once per file */
 } emit_ldl_state;
 
