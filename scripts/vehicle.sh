@@ -98,19 +98,21 @@ bval() {
 
 # columns of the study CSVs by name
 col() { awk -F, -v n="$2" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == n) { print i; exit } }' "$W/$1.csv"; }
-# the suspension travels (wheel centre less the chassis point above it, from t = 0), mm
-travel() { # travel SCENE -> $W/SCENE.travel.csv: t, FL, RL
-  awk -F, -v a="$(col "$1" FL_wheel_z)" -v b="$(col "$1" FL_above_z)" -v c="$(col "$1" RL_wheel_z)" \
-      -v d="$(col "$1" RL_above_z)" 'NR == 1 { print "t,FL_travel,RL_travel"; next }
-    NR == 2 { f0 = $a - $b; r0 = $c - $d }
-    { printf "%s,%.6f,%.6f\n", $1, ($a - $b - f0) * 1000, ($c - $d - r0) * 1000 }' "$W/$1.csv" >"$W/$1.travel.csv"
-}
-for s in $SCENES; do travel "$s"; done
+# the static equilibrium each run starts from: Newton's report and the wheel
+# loads of the first row (the settled car)
+declare -A eq_iter eq_res eq_loads
+for s in $SCENES; do
+  eq_iter[$s]=$(sed -n 's/.*static equilibrium in \([0-9]*\) Newton.*/\1/p' "$W/$s.run")
+  eq_res[$s]=$(sed -n 's/.*static equilibrium in .*force residual \([0-9.e+-]*\) of.*/\1/p' "$W/$s.run")
+  [ -n "${eq_res[$s]}" ] || die "scene $s: no static equilibrium reported by mbcc run"
+  eq_loads[$s]=$(awk -F, -v a="$(col "$s" FL.Fz)" -v b="$(col "$s" FR.Fz)" -v c="$(col "$s" RL.Fz)" -v d="$(col "$s" RR.Fz)" \
+    'NR == 2 { printf "%.2f %.2f %.2f %.2f %.2f", $a, $b, $c, $d, $a + $b + $c + $d; exit }' "$W/$s.csv")
+done
 
 # peaks of a column over the run: max, its time, min, its time
 peaks() {
   awk -F, -v k="$2" 'NR == 1 { next } NR == 2 || $k > mx { mx = $k; tx = $1 } NR == 2 || $k < mn { mn = $k; tn = $1 }
-    END { printf "%.2f %.3f %.2f %.3f", mx, tx, mn, tn }' "$3"
+    END { printf "%.6g %.3f %.6g %.3f", mx, tx, mn, tn }' "$3"
 }
 
 # figures
@@ -126,30 +128,33 @@ plot "$IMG/vehicle_wheel_loads.png" <<EOF
 set title "Tyre normal loads, flexible chassis"
 set xlabel "t [s]"; set ylabel "F_z [kN]"
 set xrange [0.4:1.4]
-plot "$W/flexible.csv" using 1:(\$$(col flexible FL_Fz) / 1000) with lines title "front left", \
-     "$W/flexible.csv" using 1:(\$$(col flexible FR_Fz) / 1000) with lines title "front right", \
-     "$W/flexible.csv" using 1:(\$$(col flexible RL_Fz) / 1000) with lines title "rear left", \
-     "$W/flexible.csv" using 1:(\$$(col flexible RR_Fz) / 1000) with lines title "rear right"
+plot "$W/flexible.csv" using 1:(\$$(col flexible FL.Fz) / 1000) with lines title "front left", \
+     "$W/flexible.csv" using 1:(\$$(col flexible FR.Fz) / 1000) with lines title "front right", \
+     "$W/flexible.csv" using 1:(\$$(col flexible RL.Fz) / 1000) with lines title "rear left", \
+     "$W/flexible.csv" using 1:(\$$(col flexible RR.Fz) / 1000) with lines title "rear right"
 EOF
 plot "$IMG/vehicle_travel.png" <<EOF
-set title "Suspension travel, left side (wheel centre relative to the chassis, + = bump)"
+set title "Suspension travel, left side (wheel centre relative to its top mount, chassis axes, + = bump)"
 set xlabel "t [s]"; set ylabel "travel [mm]"
 set xrange [0.4:1.4]
-plot "$W/rigid.travel.csv" using 1:2 with lines lc rgb "#1f77b4" title "front left, rigid", \
-     "$W/flexible.travel.csv" using 1:2 with lines lc rgb "#d62728" title "front left, flexible", \
-     "$W/rigid.travel.csv" using 1:3 with lines dt 2 lc rgb "#1f77b4" title "rear left, rigid", \
-     "$W/flexible.travel.csv" using 1:3 with lines dt 2 lc rgb "#d62728" title "rear left, flexible"
+plot "$W/rigid.csv" using 1:(\$$(col rigid FL_travel) * 1000) with lines lc rgb "#1f77b4" title "front left, rigid", \
+     "$W/flexible.csv" using 1:(\$$(col flexible FL_travel) * 1000) with lines lc rgb "#d62728" title "front left, flexible", \
+     "$W/rigid.csv" using 1:(\$$(col rigid RL_travel) * 1000) with lines dt 2 lc rgb "#1f77b4" title "rear left, rigid", \
+     "$W/flexible.csv" using 1:(\$$(col flexible RL_travel) * 1000) with lines dt 2 lc rgb "#d62728" title "rear left, flexible"
 EOF
 
 # numbers for the page
-declare -A az fl rl trv
+declare -A az fl rl trv cmz
 for s in $SCENES; do
   az[$s]=$(peaks "$s" "$(col "$s" chassis_az)" "$W/$s.csv")
-  fl[$s]=$(peaks "$s" "$(col "$s" FL_Fz)" "$W/$s.csv")
-  rl[$s]=$(peaks "$s" "$(col "$s" RL_Fz)" "$W/$s.csv")
-  trv[$s]=$(peaks "$s" 2 "$W/$s.travel.csv")
+  fl[$s]=$(peaks "$s" "$(col "$s" FL.Fz)" "$W/$s.csv")
+  rl[$s]=$(peaks "$s" "$(col "$s" RL.Fz)" "$W/$s.csv")
+  trv[$s]=$(peaks "$s" "$(col "$s" FL_travel)" "$W/$s.csv")
+  cmz[$s]=$(peaks "$s" "$(col "$s" cm_az)" "$W/$s.csv")
 done
 first() { echo "$1" | cut -d' ' -f"$2"; }
+freqs=$(sed -n 's/^ *frequencies (Hz): //p' "$W/flexible.check" | head -1)
+[ "$(echo "$freqs" | wc -w)" = 10 ] || die "mbcc check --scene flexible printed no 10 frequencies"
 seed_dim() { case $1 in rigid) echo 194 ;; flexible) echo 196 ;; flexible_virtual) echo 290 ;; *) echo "" ;; esac; }
 base_run=$(bval rigid generated+ldl run_s)
 ratio() { [ -n "$1" ] && awk -v a="$1" -v b="$base_run" 'BEGIN { printf "%.2f", a / b }'; }
@@ -168,7 +173,9 @@ vehicle specification (spec: /work/shared/reference/vehicle-model-spec.md):
 stops, four Gim–Nikravesh tyres, and the flexible space-frame chassis of spec
 §10 (models/sports_car_chassis.fe.yaml: 303 nodes, 487 beams, 10 constrained
 modes at 2 % damping). Every number in the model carries its provenance.
-The car starts at the design pose at 60 km/h, every wheel spinning at
+The car starts settled: static equilibrium at t = 0 (\`simulation:
+{equilibrium: true}\`: Newton on the constrained static equations, the
+flexible chassis statically deformed), then 60 km/h, every wheel spinning at
 v / R_e; the front-left wheel meets the 10 cm cosine bump (1 m long, left
 wheels only) at t = 0.600 s, the rear-left at 0.731 s; 2 s are simulated.
 tests/test_sports_car.sh checks the model against the spec's acceptance
@@ -206,26 +213,66 @@ per body, the modal coordinates, and the constraint rows kept
   massless virtual body welded to its node: + 8 × (6 coordinates + 6 weld
   rows) = +96, as in the seed (290 − 194 = 96).
 
+## Static equilibrium
+
+Each run starts from the static equilibrium of its scene. Newton's report
+(\`mbcc run\`'s stderr; the force residual relative to the weight) and the
+wheel loads of the first output row, the settled car:
+
+| scene | Newton iterations | force residual / weight | FL [N] | FR [N] | RL [N] | RR [N] | sum [N] |
+|---|--:|--:|--:|--:|--:|--:|--:|
+EOF
+for s in $SCENES; do
+  read -r a b c d sum <<<"${eq_loads[$s]}"
+  echo "| \`$s\` | ${eq_iter[$s]} | ${eq_res[$s]} | $a | $b | $c | $d | $sum |"
+done
+cat <<EOF
+| spec §4 | | | 2092.8 | 2092.8 | 2714.1 | 2714.1 | 9613.8 (980 kg) |
+
+The flexible chassis sags under its own weight; its loads differ from the
+rigid chassis's by hundredths of a newton (the FE frame is not exactly
+symmetric). tests/test_sports_car.sh checks the sum against the weight of the
+masses to 1e-6 and the front/rear split against the moment balance.
+
+## The chassis's modes (seed Table 5)
+
+The 10 lowest modes of the FE chassis clamped at its CM node, as
+\`mbcc check models/sports_car.yaml --scene flexible\` computes them for the
+model, beside the spec's substitute frame and the seed's published (never
+released) FE model; why they differ: [model-format.md](model-format.md#flexible-bodies).
+
+| mode | 1 | 2 | 3 | 4 | 5 | 6 | 7 | 8 | 9 | 10 |
+|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|
+| mbcc, Hz | $(echo "$freqs" | awk '{ for (i = 1; i <= NF; i++) printf "%s%.4g", i > 1 ? " | " : "", $i }') |
+| vehicle spec §10.3 (substitute frame), Hz | 7.72 | 9.05 | 18.15 | 21.22 | 22.87 | 24.83 | 27.57 | 29.09 | 33.75 | 38.79 |
+| seed 000 Table 5 (published model), Hz | 6.97 | 9.41 | 10.96 | 13.81 | 25.26 | 32.41 | 38.55 | 45.95 | 50.27 | 50.31 |
+
+$(echo "$freqs" | awk '{ ok = NF == 10; for (i = 1; i <= NF; i++) if ($i < 7 || $i > 50) ok = 0
+  print ok ? "All ten lie in the seed'"'"'s 7–50 Hz band." : "Not all ten lie in the seed'"'"'s 7–50 Hz band." }')
+
 ## Vertical acceleration of the centre of mass (seed Fig. 12)
 
 ![CM vertical acceleration, rigid and flexible chassis](img/vehicle_cm_acceleration.png)
 
-| scene | a_z max [m/s²] (t [s]) | a_z min [m/s²] (t [s]) | peak tyre load FL [kN] | RL [kN] | FL bump travel [mm] |
-|---|--:|--:|--:|--:|--:|
+| scene | a_z max [m/s²] (t [s]) | a_z min [m/s²] (t [s]) | whole car's CM a_z max / min [m/s²] | peak tyre load FL [kN] | RL [kN] | FL bump travel [mm] |
+|---|--:|--:|--:|--:|--:|--:|
 EOF
+f2() { awk -v x="$1" -v k="$2" 'BEGIN { printf "%.2f", x * k }'; }
 for s in $SCENES; do
-  echo "| \`$s\` | $(first "${az[$s]}" 1) ($(first "${az[$s]}" 2)) | $(first "${az[$s]}" 3) ($(first "${az[$s]}" 4)) | $(awk -v x="$(first "${fl[$s]}" 1)" 'BEGIN { printf "%.2f", x / 1000 }') | $(awk -v x="$(first "${rl[$s]}" 1)" 'BEGIN { printf "%.2f", x / 1000 }') | $(first "${trv[$s]}" 1) |"
+  echo "| \`$s\` | $(f2 "$(first "${az[$s]}" 1)" 1) ($(first "${az[$s]}" 2)) | $(f2 "$(first "${az[$s]}" 3)" 1) ($(first "${az[$s]}" 4)) | $(f2 "$(first "${cmz[$s]}" 1)" 1) / $(f2 "$(first "${cmz[$s]}" 3)" 1) | $(f2 "$(first "${fl[$s]}" 1)" 0.001) | $(f2 "$(first "${rl[$s]}" 1)" 0.001) | $(awk -v x="$(first "${trv[$s]}" 1)" 'BEGIN { printf "%.1f", x * 1000 }') |"
 done
 cat <<EOF
-| spec §12 (7-DOF estimate, disc contact) | +10.5 (0.64) | −5.1 (0.85) | 13.7 | 14.8 | 100 |
+| spec §12 (7-DOF estimate, disc contact) | +10.5 (0.64) | −5.1 (0.85) | | 13.7 | 14.8 | 100 |
 
 The acceleration is that of the chassis body frame's origin, the CM node
 (−1.24, 0, 0.44) (seed: "the vertical acceleration of the vehicle centre of
 mass"; the spec's output, §9). As in the seed, the flexible chassis adds
-high-frequency content (its modes at 7.7–39 Hz) and raises the peaks. The
-flexible chassis starts undeformed and rings under gravity in the first
-0.3 s (spec §9: the 0.6 s before the bump let it settle); static equilibrium
-before the run (\`simulation: {equilibrium: true}\`) removes that.
+high-frequency content (its modes at 7.7–39 Hz) and raises the peaks.
+The whole car's centre of mass (output \`type: center_of_mass\`, all 17
+bodies with the chassis's deformation) accelerates by the tyres' vertical
+force over the mass less g; the chassis's vibration hardly shows there. The
+flexible chassis starts statically deformed, so nothing rings before the
+bump.
 
 ## Wheel loads and suspension travel
 
@@ -236,8 +283,10 @@ pushes only.
 
 ![suspension travel](img/vehicle_travel.png)
 
-The front-left travel reaches the bump stop (contact at about 60 mm of
-bump, spec §7).
+The travel is the wheel centre's motion relative to its spring's (front) or
+strut's (rear) top mount on the chassis, in chassis axes, from the settled
+start (output \`type: relative\`). The front-left travel reaches the bump
+stop (contact at about 60 mm of bump, spec §7).
 
 ## Analysis time (seed Table 6)
 

@@ -3,8 +3,8 @@
 # against the data and the acceptance checks of the vehicle specification
 # (/work/shared/reference/vehicle-model-spec.md, "spec §N").  Checks 1-5 take
 # the scene 'rigid' (the chassis rigid, spec §12 items 1-6), standing still on
-# the flat road; 6 runs the bump study.  Exit 0 = pass.  Every run takes the
-# generic path (no C compile): seconds.
+# the flat road; 6 runs the bump study, 7 the flat road at speed.  Exit 0 =
+# pass.  Every run takes the generic path (no C compile).
 #   1. mbcc check: the design pose closes without a Newton iteration (every
 #      joint is one global point shared by its bodies, spec §6.3: that the
 #      hardpoints are the spec's is checked by 4.), the two rear lower ball
@@ -28,13 +28,20 @@
 #      mass per corner), to 1.5 %.  Measured: heave +0.3 %, pitch -0.8 %; the
 #      ideal two-mass model leaves out the arms' and strut rods' inertia moving
 #      with the chassis and the rear's rising motion ratio under preload;
-#   6. the bump at 60 km/h (spec §9), rigid and flexible chassis: the bands of
-#      spec §12 (a reduced-model estimate, not a target): CM vertical
-#      acceleration peaks, peak tyre loads, front-left bump travel; both left
-#      tyres leave the road after the crest; the flexible chassis adds to the
-#      rigid one's peak acceleration (seed Fig. 12); the speed holds but for
-#      rolling resistance and the bump; the joints through 8 virtual bodies
-#      (scene flexible_virtual) give the motion of the joints on the nodes.
+#   6. the bump at 60 km/h (spec §9), rigid and flexible chassis, each started
+#      from its static equilibrium: Newton's residual, the static wheel loads
+#      against the weight (to 1e-6) and the moment balance, the whole car's
+#      CM acceleration against the tyres' vertical forces (Newton's second
+#      law, at every output), the bands of spec §12 (a reduced-model
+#      estimate: CM vertical acceleration peaks, peak tyre loads, front-left
+#      bump travel; both left tyres leave the road after the crest); the
+#      flexible chassis adds to the rigid one's peak acceleration (seed
+#      Fig. 12); the flexible chassis stiffened 1e3 times gives the rigid
+#      chassis's response; the joints through 8 virtual bodies (scene
+#      flexible_virtual) give the motion of the joints on the nodes;
+#   7. straight running on the flat road: the speed falls by the rolling
+#      resistance only, the course holds.
+# About 15 s of CPU (generic path, no C compile).
 set -u
 cd "$(dirname "$0")/.."
 . tests/shell_setup.sh
@@ -42,7 +49,7 @@ model="$root/models/sports_car.yaml"
 
 run() { # run MODEL CSV [ARGS]: generic path, quiet; the log beside the CSV
   m=$1 csv=$2; shift 2
-  "$MBCC" run "$m" --path generic -o "$csv" --plot none --quiet "$@" > "$csv.log" 2>&1 ||
+  "$MBCC" run "$m" --path generic -o "$csv" --plot none "$@" > "$csv.log" 2>&1 ||
     { err "mbcc run $m $* failed: $(tail -3 "$csv.log")"; return 1; }
 }
 # the model without its outputs and simulation settings (a variant appends its
@@ -205,48 +212,142 @@ if ride_run heave '  rig_heave: {type: prismatic, bodies: [ground, chassis], poi
     err "ride frequencies are not those of 1.60 / 1.75 Hz corners (within 1.5 %)"
 fi
 
-# 6. the bump at 60 km/h: the model as it is, rigid and flexible chassis
+# 6. the bump at 60 km/h: the model as it is (static equilibrium first), rigid
+#    and flexible chassis.  Columns are looked up by name (col["FL.Fz"]).
+HDR='NR == 1 { for (i = 1; i <= NF; i++) col[$i] = i; next }'
 for sc in rigid flexible; do
   run "$model" "bump_$sc.csv" --scene "$sc" || continue
-  # columns: t, chassis_az, chassis_z, chassis_x, chassis_vx, pitch, roll, FL FR RL RR Fz,
-  # FL wheel z, chassis z above it, RL wheel z, chassis z above it
-  awk -F, -v sc="$sc" 'NR == 1 { next } NR == 2 { tf0 = $12 - $13; v0 = $5 }
-    { if ($2 > amax) amax = $2; if ($2 < amin) amin = $2
-      if ($8 > fl) fl = $8; if ($10 > rl) rl = $10
-      if ((tr = ($12 - $13 - tf0) * 1000) > trmax) trmax = tr
-      if ($1 > 0.63 && $1 < 0.75 && $8 == 0) flair = 1; if ($1 > 0.76 && $1 < 0.9 && $10 == 0) rlair = 1
-      if ($1 <= 0.55) v55 = $5; v = $5 }
-    END {
-      printf "%s: CM a_z %+.2f / %+.2f m/s^2, peak tyre loads FL %.0f N, RL %.0f N, FL bump travel %.1f mm, speed %.3f -> %.3f (0.55 s) -> %.3f m/s\n", sc, amax, amin, fl, rl, trmax, v0, v55, v
+  # the equilibrium: Newton's report (force residual relative to the weight)
+  eqline=$(grep 'static equilibrium in' "bump_$sc.csv.log")
+  echo "$sc: ${eqline#*: }"
+  res=$(sed -n 's/.*force residual \([0-9.e+-]*\) of.*/\1/p' <<< "$eqline")
+  awk -v r="${res:-1}" 'BEGIN { exit !(r < 1e-9) }' || err "$sc: no static equilibrium to 1e-9 of the weight: $eqline"
+  # the static wheel loads (first row: the settled car) against the weight M g
+  # of the masses measured in 2. (to 1e-6) and their split by the moment
+  # balance about the axles' contact lines (to 1e-3: the contacts sit a few
+  # tenths of a millimetre off x = 0, -2.18 by camber and compliance);
+  # travel and joint outputs count from the settled state (0 there)
+  awk -F, -v sc="$sc" -v M="$M" -v x="$xg" "$HDR"'
+    NR == 2 { W = M * 9.81; front = W * (x + 2.18) / 2.18 / 2; rear = W / 2 - front
+      fl = $col["FL.Fz"]; fr = $col["FR.Fz"]; rl = $col["RL.Fz"]; rr = $col["RR.Fz"]; s = fl + fr + rl + rr
+      printf "%s: static wheel loads FL %.3f FR %.3f RL %.3f RR %.3f N, sum %.4f N = %.2e of the weight off; moment balance %.2f / %.2f N\n",
+        sc, fl, fr, rl, rr, s, s / W - 1, front, rear
       bad = 0
-      # spec §12 (L_b = 1 m): +10.0..10.5 / -5.0..-5.1 m/s^2, 13.7 / 14.8 kN, 99-100 mm
-      if (amax < 7 || amax > 16 || amin < -9 || amin > -3.5) { print "CM acceleration outside the band"; bad = 1 }
+      if ((s / W - 1) ^ 2 > 1e-12) { print "wheel loads do not sum to the weight to 1e-6"; bad = 1 }
+      if (((fl + fr) / (2 * front) - 1) ^ 2 > 1e-6 || ((rl + rr) / (2 * rear) - 1) ^ 2 > 1e-6) { print "not the moment balance"; bad = 1 }
+      if ($col["FL_travel"] != 0 || $col["RL_travel"] != 0 || $col["FL_arm_angle"] != 0) { print "travel or joint angle not 0 at the settled start"; bad = 1 }
+      exit bad }' "bump_$sc.csv" || err "$sc: static equilibrium's wheel loads"
+  # the whole car: M a_cm,z = the tyres' vertical forces - M g at every output
+  # (centre-of-mass acceleration against the tyre force outputs), to 1e-3 N
+  awk -F, -v M="$M" "$HDR"'{ s = $col["FL_fz"] + $col["FR_fz"] + $col["RL_fz"] + $col["RR_fz"]
+      d = M * $col["cm_az"] - (s - M * 9.81); d = d < 0 ? -d : d; if (d > w) w = d }
+    END { printf "M a_cm,z against the tyres'"'"' vertical forces: largest difference %.2g N\n", w; exit !(w < 1e-3) }' "bump_$sc.csv" ||
+    err "$sc: the centre of mass's acceleration is not the tyres' vertical force over the mass"
+  # spec §12 (L_b = 1 m): the bands of its reduced-model table.  The spec calls
+  # them sanity bands of a 7-DOF model, not targets; chosen bands: chassis CM
+  # a_z maximum within its cases' spread 7.3..10.5 m/s^2 widened by 10 %
+  # (6.6..11.6; the flexible chassis adds vibration on top: seed Fig. 12,
+  # checked after the loop), minimum -5.1..-4.9 widened by 10 % (-5.6..-4.4);
+  # peak tyre loads 13.7 / 14.8 kN +-15 %; FL bump travel 91..100 mm of its
+  # cases widened to 85..115 mm; both left tyres leave the road after the crest
+  awk -F, -v sc="$sc" "$HDR"'{ a = $col["chassis_az"]; if (a > amax) amax = a; if (a < amin) amin = a
+      if ($col["FL.Fz"] > fl) fl = $col["FL.Fz"]; if ($col["RL.Fz"] > rl) rl = $col["RL.Fz"]
+      if ((tr = $col["FL_travel"] * 1000) > trmax) trmax = tr
+      if ($1 > 0.63 && $1 < 0.75 && $col["FL.Fz"] == 0) flair = 1; if ($1 > 0.76 && $1 < 0.9 && $col["RL.Fz"] == 0) rlair = 1 }
+    END {
+      printf "%s: chassis CM a_z %+.2f / %+.2f m/s^2, peak tyre loads FL %.0f N, RL %.0f N, FL bump travel %.1f mm\n", sc, amax, amin, fl, rl, trmax
+      bad = 0
+      if (sc == "rigid" && (amax < 6.6 || amax > 11.6 || amin < -5.6 || amin > -4.4)) { print "chassis CM acceleration outside 6.6..11.6 / -5.6..-4.4"; bad = 1 }
+      if (sc != "rigid" && (amax < 6.6 || amax > 16 || amin < -9 || amin > -4.4)) { print "flexible chassis CM acceleration outside 6.6..16 / -9..-4.4"; bad = 1 }
       if (fl < 11600 || fl > 15800 || rl < 12600 || rl > 17000) { print "peak tyre load outside 13.7 / 14.8 kN +-15 %"; bad = 1 }
-      if (trmax < 85 || trmax > 115) { print "FL bump travel outside 100 +-15 mm"; bad = 1 }
+      if (trmax < 85 || trmax > 115) { print "FL bump travel outside 85..115 mm"; bad = 1 }
       if (!flair || !rlair) { print "a left tyre does not leave the road after the crest"; bad = 1 }
-      # rolling resistance: C_rr F_z / R over the weight: 0.005 / 0.318 g = 0.154 m/s^2 before the bump
-      d = (v0 - v55) / 0.55; if (d < 0.10 || d > 0.20) { print "deceleration before the bump not the rolling loss 0.154 m/s^2"; bad = 1 }
       exit bad }' "bump_$sc.csv" || err "bump run ($sc) outside the bands of spec §12"
 done
+peak() { awk -F, -v c="$2" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == c) k = i; next } $k > p { p = $k } END { print p + 0 }' "$1"; }
 if [ -s bump_rigid.csv ] && [ -s bump_flexible.csv ]; then
   # seed Fig. 12: the flexible chassis adds high-frequency content to the CM
-  # acceleration; its peak is larger than the rigid chassis's
-  paste -d, bump_rigid.csv bump_flexible.csv | awk -F, 'NR > 1 { r = $2 > r ? $2 : r; f = $17 > f ? $17 : f }
-    END { printf "peak CM a_z: rigid %.2f, flexible %.2f m/s^2\n", r, f; exit !(f > 1.1 * r) }' ||
-    err "the flexible chassis does not raise the CM acceleration peak (seed Fig. 12)"
+  # node's acceleration; its peak is larger than the rigid chassis's
+  r=$(peak bump_rigid.csv chassis_az) f=$(peak bump_flexible.csv chassis_az)
+  echo "peak chassis CM a_z: rigid $r, flexible $f m/s^2"
+  awk -v r="$r" -v f="$f" 'BEGIN { exit !(f > 1.1 * r) }' || err "the flexible chassis does not raise the CM acceleration peak (seed Fig. 12)"
+fi
+
+# largest difference of each named column between two runs (common times),
+# relative to the first run's range, as "column=value ..."
+compare() { # compare A.csv B.csv COLUMN...
+  local a=$1 b=$2; shift 2
+  awk -F, -v cols="$*" 'BEGIN { nc = split(cols, want, " ") }
+    FNR == 1 { for (i = 1; i <= NF; i++) idx[FILENAME == ARGV[1], $i] = i; next }
+    FILENAME == ARGV[1] { for (j = 1; j <= nc; j++) { v = $idx[1, want[j]]; A[$1, j] = v
+        if (!((j) in lo) || v < lo[j]) lo[j] = v; if (!((j) in hi) || v > hi[j]) hi[j] = v }; next }
+    { for (j = 1; j <= nc; j++) { if (!(($1, j) in A)) continue; n++
+        d = $idx[0, want[j]] - A[$1, j]; d = d < 0 ? -d : d; if (d > dm[j]) dm[j] = d } }
+    END { if (!n) { print "none"; exit }
+      for (j = 1; j <= nc; j++) printf "%s=%.3g ", want[j], (hi[j] > lo[j] ? dm[j] / (hi[j] - lo[j]) : dm[j]); print "" }' "$a" "$b"
+}
+cols="chassis_az cm_az FL.Fz FR.Fz RL.Fz RR.Fz FL_travel RL_travel pitch roll"
+# the flexible chassis with its stiffness scaled by 1e3 (E and G of its steel;
+# modes at 31.6 times the frequencies) agrees with the rigid chassis over the
+# bump (first second): its deflections shrink by 1e3, so wheel loads, travel,
+# attitude and the whole car's CM acceleration within 1e-3 of their range
+# (measured about 2e-5; the flexible chassis differs by 3e-3..9e-2); the CM
+# node's acceleration within 2 % (measured 0.3 %: the stiffened modes, now at
+# 0.2-1.6 kHz, are still rung by the tyres' landing; flexible: 53 %)
+sed 's/steel: {E: 2.1e+11, G: 8.08e+10,/steel: {E: 2.1e+14, G: 8.08e+13,/' "$root/models/sports_car_chassis.fe.yaml" > stiff_chassis.fe.yaml
+sed "s|fe_file: sports_car_chassis.fe.yaml|fe_file: $PWD/stiff_chassis.fe.yaml|" "$model" > stiff_car.yaml
+if grep -q 'E: 2.1e+14' stiff_chassis.fe.yaml && [ -s bump_rigid.csv ] && run stiff_car.yaml bump_stiff.csv --scene flexible --end 1.0; then
+  d=$(compare bump_rigid.csv bump_stiff.csv $cols)
+  echo "flexible chassis x 1e3 stiffness against rigid (of the range): $d"
+  awk -v d="$d" 'BEGIN { n = split(d, p, " "); if (n < 10) exit 1
+    for (i = 1; i <= n; i++) { split(p[i], kv, "="); if (kv[2] > (kv[1] == "chassis_az" ? 0.02 : 1e-3)) exit 1 } }' ||
+    err "the flexible chassis stiffened 1e3 times does not agree with the rigid chassis"
+  [ -s bump_flexible.csv ] && echo "flexible chassis against rigid (of the range): $(compare bump_rigid.csv bump_flexible.csv $cols)"
+else
+  err "the stiffened chassis run failed"
 fi
 # direct and virtual-body joints: the same motion (to the integration error),
-# over the front bump
+# over the front bump, every output column within 2e-3 of its range
 if [ -s bump_flexible.csv ] && run "$model" bump_virtual.csv --scene flexible_virtual --end 0.8; then
-  awk -F, 'NR == FNR { if (FNR > 1) for (i = 2; i <= NF; i++) a[$1, i] = $i; next }
-    FNR == 1 { for (i = 2; i <= NF; i++) name[i] = $i; next }
-    { for (i = 2; i <= NF; i++) { if (!(($1, i) in a)) continue; n++
-        if (!(i in lo) || $i < lo[i]) lo[i] = $i; if (!(i in hi) || $i > hi[i]) hi[i] = $i
-        d = $i - a[$1, i]; d = d < 0 ? -d : d; if (d > dm[i]) dm[i] = d } }
-    END { for (i in dm) { r = hi[i] - lo[i]; if (r > 0 && dm[i] / r > w) { w = dm[i] / r; c = name[i] } }
-      printf "direct against virtual joints: largest difference %.2g of the range (%s)\n", w, c
-      exit n == 0 || w > 2e-3 }' bump_flexible.csv bump_virtual.csv ||
+  d=$(compare bump_flexible.csv bump_virtual.csv $cols FL.Fx FL.Fy FL_spring_force FL_tie_rod_force)
+  echo "direct against virtual joints (of the range): $d"
+  awk -v d="$d" 'BEGIN { n = split(d, p, " "); if (n < 14) exit 1
+    for (i = 1; i <= n; i++) { split(p[i], kv, "="); if (kv[2] > 2e-3) exit 1 } }' ||
     err "joints through virtual bodies do not reproduce the joints on the nodes"
 fi
+
+# 7. straight running on the flat road at 60 km/h, settled first, 1 s: the
+#    whole car's speed falls by the rolling resistance only (as test_tyre's
+#    cart): C_rr Fz_i / R_i summed over the wheels, over the mass plus the
+#    wheels' spin inertia I_i / R_i^2, with R_i between the rolling radius
+#    R_e = R0 - delta/3 and the contact lever rho = R0 - delta (delta =
+#    Fz / K_z), within 0.5 %; the car holds its course (lateral drift below
+#    1 mm, yaw below 1e-4 rad: only the FE chassis's small asymmetry steers)
+awk '/^[A-Za-z_]/ { skip = ($0 ~ /^(outputs|simulation):/) } !skip' "$model" |
+  sed -e 's/road: bump_road/road: flat_road/' -e "s|fe_file: sports_car_chassis.fe.yaml|fe_file: $root/models/sports_car_chassis.fe.yaml|" > flat.yaml
+cat >> flat.yaml <<'EOF'
+outputs:
+  - {name: vx, type: center_of_mass, quantity: velocity, component: x}
+  - {name: y, type: position, body: chassis, component: y}
+  - {name: yaw, type: angle, body: chassis, axis: [0, 0, 1]}
+  - {name: FL, type: tyre, element: tyre_FL, component: Fz}
+  - {name: FR, type: tyre, element: tyre_FR, component: Fz}
+  - {name: RL, type: tyre, element: tyre_RL, component: Fz}
+  - {name: RR, type: tyre, element: tyre_RR, component: Fz}
+simulation: {equilibrium: true, end_time: 1.0, output_step: 0.01}
+EOF
+for sc in rigid flexible; do
+  run flat.yaml "flat_$sc.csv" --scene "$sc" || continue
+  awk -F, -v sc="$sc" -v M="$M" 'NR == 2 { v0 = $2; for (i = 5; i <= 8; i++) F[i] = $i }
+    NR > 1 { if ($3 ^ 2 > ym) ym = $3 ^ 2; if ($4 ^ 2 > yw) yw = $4 ^ 2; v = $2; T = $1 }
+    END { Crr = 0.005; R0 = 0.3213; KZ = 2e5; lo = hi = 0; d1 = d2 = M
+      for (i = 5; i <= 8; i++) { d = F[i] / KZ; Re = R0 - d / 3; rho = R0 - d; I = i < 7 ? 1.1 : 1.2
+        lo += Crr * F[i] / Re; hi += Crr * F[i] / rho; d1 += I / (Re * Re); d2 += I / (Re * rho) }
+      lo = lo / d1 * T; hi = hi / d2 * T
+      printf "%s, flat road: speed loss %.5f m/s in %.1f s, rolling resistance predicts %.5f to %.5f; lateral drift %.2g m, yaw %.2g rad\n",
+        sc, v0 - v, T, lo, hi, sqrt(ym), sqrt(yw)
+      exit !(T > 0.99 && v0 - v > 0.995 * lo && v0 - v < 1.005 * hi && ym < 1e-6 && yw < 1e-8) }' "flat_$sc.csv" ||
+    err "$sc: straight running on the flat road does not hold its speed and course within the rolling loss"
+done
 
 exit $fail

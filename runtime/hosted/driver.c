@@ -430,6 +430,8 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
   sim.on_step = track_angles;
   sim.on_step_user = &w;
   int equilibrium_failed = 0;
+  mb_model settled; /* the model whose initial state is the equilibrium */
+  mb_real *settled_q0 = NULL, *settled_v0 = NULL;
   if (!st && set.equilibrium) {
     mb_equilibrium_info eq;
     st = mb_sim_equilibrium(&sim, &eq);
@@ -446,6 +448,19 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
         fprintf(stderr, "; %d free direction%s without load left as given", eq.free_directions,
                 eq.free_directions > 1 ? "s" : "");
       fprintf(stderr, "\n");
+    }
+    /* relative displacements and joint outputs count from the equilibrium
+       (docs/model-format.md), not from the assembled state */
+    if (!st && (settled_q0 = malloc(sizeof(mb_real) * ((size_t)m->nq + 1))) &&
+        (settled_v0 = malloc(sizeof(mb_real) * ((size_t)m->nv + 1)))) {
+      memcpy(settled_q0, sim.q, sizeof(mb_real) * (size_t)m->nq);
+      memcpy(settled_v0, sim.v, sizeof(mb_real) * (size_t)m->nv);
+      settled = *m;
+      settled.q0 = settled_q0;
+      settled.v0 = settled_v0;
+      w.m = &settled;
+    } else if (!st) {
+      st = MB_ERR_NOMEM;
     }
   }
   if (!st) st = mb_sim_run(&sim, write_row, &w);
@@ -518,6 +533,6 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
   }
   mb_sim_free(&sim);
   ls->destroy(ls);
-  free(w.out); free(w.angle_ref); free(w.work);
+  free(w.out); free(w.angle_ref); free(w.work); free(settled_q0); free(settled_v0);
   return rc;
 }

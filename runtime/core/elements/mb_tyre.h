@@ -232,7 +232,11 @@ static inline mb_real mb_tyre(const mb_marker *mk, const mb_real *prm, mb_real F
      the contact point (l = sqrt(8 R0 delta), the brush's l/6 at small slip,
      none at full slide) */
   mb_real Mz = -(MB_SQRT(8 * R0 * delta) * xi / 6) * Fy;
-  Fy -= Kg * sg * xi; /* camber thrust, towards the side the wheel leans to */
+  /* camber thrust, towards the side the wheel leans to; it builds up with
+     the rolling speed as the slips do (factor V / D): at standstill nothing
+     would hold it, and toed-in cambered wheels would push a car at rest */
+  mb_real rolling = MB_SQRT(MB_FMAX(Vx * Vx, Vr * Vr)) / D;
+  Fy -= Kg * sg * xi * rolling;
   /* rolling resistance: a lever arm C_rr against the spin (sign regularized) */
   mb_real sgn = Vr / MB_SQRT(Vr * Vr + vlow * vlow), My = -Crr * Fz * sgn;
 
@@ -268,7 +272,7 @@ static inline mb_real mb_tyre(const mb_marker *mk, const mb_real *prm, mb_real F
         dF[1][i][j] += -ey[i] * cy * ey[j] / D;
         /* turning the wheel: camber (d sin g = dphi . (a x n)), the contact
            frame turning under V (steer) and Omega (spin axis) */
-        dF[0][i][3 + j] += -ey[i] * Kg * xi * axe[j] - ex[i] * cx * axv[j] / D -
+        dF[0][i][3 + j] += -ey[i] * Kg * xi * rolling * axe[j] - ex[i] * cx * axv[j] / D -
                            ey[i] * cy * yxv[j] / D + ex[i] * cx * Re * axw[j] / D;
       }
     for (int j = 0; j < 3; j++) {
