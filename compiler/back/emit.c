@@ -191,7 +191,9 @@ static void emit_runtime_params(emit_ctx *cx) {
     const runtime_binding *b = &u->bind[i];
     const ir_force *F = &ir->forces[L->force_ir[b->force]];
     const ir_expr_use *use = &ir->uses[b->use];
-    fprintf(f, "  /* force '%s', %s:%d:%d */\n  ", F->name, u->file_name, use->loc.line, use->loc.col);
+    fprintf(f, "  /* force '%s', ", F->name); /* an included or subsystem file's line: that file's */
+    loc_comment(f, L, use->loc);
+    fputs(" */\n  ", f);
     if (b->pool == BIND_PRM) fprintf(f, "force_prm[%d] = (mb_real)", b->index);
     else fprintf(f, "force_laws[%d].%s = (mb_real)", b->index, b->pool == BIND_LAW_COEF ? "coef" : "exponent");
     expr_print_c(f, ir, use->expr, "(double)p");

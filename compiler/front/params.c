@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "bounds.h"
+#include "compose.h"
 
 static const struct {
   const char *name;
@@ -247,7 +248,15 @@ static int parse_primary(parser *p, int depth) {
     }
     const ir_model *m = p->r->model;
     char suggest[128];
-    int param = find_length(m, name, n, suggest, sizeof suggest);
+    /* in a subsystem instance, its own (prefixed) parameters hide the
+       enclosing ones' (compose.c) */
+    int param = -1;
+    for (int in = diag_loc_instance(loc_of(p->scalar)); param < 0 && in != 0; in = diag_instance_parent(in)) {
+      char scoped[256];
+      int length = snprintf(scoped, sizeof scoped, "%s%.*s", diag_instance_prefix(in), (int)n, name);
+      if (length > 0 && (size_t)length < sizeof scoped) param = find_length(m, scoped, (size_t)length, NULL, 0);
+    }
+    if (param < 0) param = find_length(m, name, n, suggest, sizeof suggest);
     if (param < 0) {
       if (is_reserved(name, n))
         fail(p, start, false, "'%s' is a function: write %s(...)", show_text(p->r, name, n),
@@ -470,6 +479,15 @@ int expr_number(reader *r, yaml_node_t *n, const char *label, double *out) {
     /* without 'parameters:', not an expression: the caller says "must be a
        number"; with, a parameter it names failed and was reported there */
     return r->params_block ? -1 : 0;
+  }
+  if (compose_is_mirrored(n)) {
+    if (runtime) {
+      error_at(r, loc_of(n), "%s is mirrored (a subsystem instance with 'mirror: true') and cannot use a run-time "
+               "parameter", label);
+      free(e.node);
+      return -1;
+    }
+    value = compose_mirror_value(value);
   }
   *out = value;
   if (names_any(&e)) record_use(r, n, &e, value, runtime);

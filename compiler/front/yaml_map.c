@@ -5,6 +5,7 @@
  * parsers of compiler/elements/ and fe.c. */
 #include "yaml_map.h"
 #include "bounds.h"
+#include "compose.h"
 #include "params.h"
 
 #include <errno.h>
@@ -309,7 +310,7 @@ bool to_number(reader *r, yaml_node_t *n, const char *label, double *out) {
     double value = blank_start ? 0 : strtod(text, &end);
     if (!blank_start && end == text + scalar_length(n)) {
       if (isfinite(value) && fabs(value) <= LIMIT_MAGNITUDE) {
-        *out = value;
+        *out = compose_is_mirrored(n) ? compose_mirror_value(value) : value;
         return true;
       }
       if (isfinite(value)) {
