@@ -462,6 +462,25 @@ static void record_use(reader *r, const yaml_node_t *n, ir_expr *e, double value
   u->uses_runtime = runtime;
 }
 
+void params_note_rule(reader *r, ir_loc loc, ir_value_rule rule, const char *field) {
+  ir_model *m = r->model;
+  if (m == NULL) return;
+  for (int i = m->nuses - 1; i >= 0; i--)
+    if (m->uses[i].loc.line == loc.line && m->uses[i].loc.col == loc.col) {
+      m->uses[i].rule = rule;
+      snprintf(m->uses[i].field, sizeof m->uses[i].field, "%s", field);
+      return;
+    }
+}
+
+const char *params_rule_text(ir_value_rule rule) {
+  return rule == RULE_NONNEGATIVE ? "must be >= 0" : rule == RULE_POSITIVE ? "must be positive" : "";
+}
+
+bool params_rule_holds(ir_value_rule rule, double v) {
+  return rule == RULE_NONNEGATIVE ? v >= 0 : rule == RULE_POSITIVE ? v > 0 : true;
+}
+
 int expr_number(reader *r, yaml_node_t *n, const char *label, double *out) {
   if (n->type != YAML_SCALAR_NODE || scalar_length(n) == 0 || r->model == NULL) return 0;
   ir_expr e;
@@ -656,6 +675,44 @@ void parse_parameters(reader *r, yaml_node_t *n) {
 /* ---------------------------------------------------------------------------
  * C text
  * ------------------------------------------------------------------------- */
+
+static double eval_runtime(const ir_model *m, const ir_expr *e, int k, const double *p) {
+  const ir_expr_node *n = &e->node[k];
+  double a = n->a >= 0 ? eval_runtime(m, e, n->a, p) : 0, b = n->b >= 0 ? eval_runtime(m, e, n->b, p) : 0;
+  switch (n->op) {
+  case EXPR_NUMBER: return n->number;
+  case EXPR_PARAM: {
+    const ir_param *P = &m->params[n->param];
+    if (P->runtime) return p[params_runtime_index(m, n->param)];
+    if (P->uses_runtime && P->expr) return eval_runtime(m, P->expr, P->expr->root, p);
+    return P->value;
+  }
+  case EXPR_NEG: return -a;
+  case EXPR_ADD: return a + b;
+  case EXPR_SUB: return a - b;
+  case EXPR_MUL: return a * b;
+  case EXPR_DIV: return a / b;
+  case EXPR_POW: return pow(a, b);
+  case EXPR_CALL:
+    switch (n->param) {
+    case FN_SQRT: return sqrt(a);
+    case FN_SIN: return sin(a);
+    case FN_COS: return cos(a);
+    case FN_TAN: return tan(a);
+    case FN_ATAN2: return atan2(a, b);
+    case FN_EXP: return exp(a);
+    case FN_LOG: return log(a);
+    case FN_ABS: return fabs(a);
+    case FN_MIN: return fmin(a, b);
+    case FN_MAX: return fmax(a, b);
+    }
+  }
+  return NAN;
+}
+
+double expr_eval_runtime(const ir_model *m, const ir_expr *e, const double *p) {
+  return eval_runtime(m, e, e->root, p);
+}
 
 static void print_number(FILE *f, double v) {
   char text[40];

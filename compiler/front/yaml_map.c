@@ -454,10 +454,19 @@ bool get_number(mapping *m, const char *key, bool required, double *out) {
   return n != NULL && to_number(m->r, n, label, out);
 }
 
+/* the rule of field 'key' of m noted for a value written as an expression */
+static void note_rule(mapping *m, const char *key, ir_value_rule rule) {
+  yaml_node_t *n = map_get(m, key);
+  char label[64];
+  quote_key(label, sizeof label, key);
+  if (n != NULL) params_note_rule(m->r, loc_of(n), rule, label);
+}
+
 bool get_positive(mapping *m, const char *key, bool required, double *out) {
   double value;
   if (!get_number(m, key, required, &value))
     return false;
+  note_rule(m, key, RULE_POSITIVE);
   if (!(value > 0)) {
     error_at(m->r, m->last_loc, "'%s' must be positive (got %g)", key, value);
     return false;
@@ -470,6 +479,7 @@ bool get_nonnegative(mapping *m, const char *key, bool required, double *out) {
   double value;
   if (!get_number(m, key, required, &value))
     return false;
+  note_rule(m, key, RULE_NONNEGATIVE);
   if (!(value >= 0)) {
     error_at(m->r, m->last_loc, "'%s' must be >= 0 (got %g)", key, value);
     return false;
