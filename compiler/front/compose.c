@@ -452,8 +452,9 @@ typedef struct scope {
   size_t own_prefix;    /* the length of the enclosing prefix, where its own begins */
   bool mirror;          /* y -> -y, the enclosing instances' mirrors included */
   name_set local[KIND_COUNT]; /* its own names (and those its inner instances made), unprefixed */
-  name_set attach;      /* its attachments ... */
-  char **attach_to;     /* ... and the model bodies they map to */
+  name_set attach;      /* its attachments (bodies, then the 'nodes' of the header) ... */
+  char **attach_to;     /* ... and the model bodies (nodes) they map to */
+  int nbody_attach;     /* attach.name[0..nbody_attach) are bodies */
 } scope;
 
 /* the model's name for 'name' of kind 'kind' used in scope s, or NULL */
@@ -469,8 +470,9 @@ static char *resolve(const scope *s, int kind, const char *name, size_t length) 
   if (kind != KIND_BODY) return NULL;
   if (length == 6 && memcmp(name, "ground", 6) == 0) return xstrdup("ground");
   int a = names_find(&s->attach, name, length);
-  return a >= 0 ? xstrdup(s->attach_to[a]) : NULL;
+  return a >= 0 && a < s->nbody_attach ? xstrdup(s->attach_to[a]) : NULL;
 }
+
 
 static int add_scalar_like(yaml_document_t *doc, const yaml_node_t *like, const char *tag, const char *text) {
   int to = yaml_document_add_scalar(doc, (yaml_char_t *)(uintptr_t)tag, (const yaml_char_t *)text, (int)strlen(text),
@@ -538,6 +540,39 @@ static void rename_key(instancer *g, int map, const char *key, int kind) {
   } else {
     rename_ref(g, slot, kind);
   }
+}
+
+/* an FE node named in the subsystem: a node attachment becomes the instance's node, anything else stays */
+static void rename_node(yaml_document_t *doc, const scope *s, yaml_node_item_t *slot) {
+  yaml_node_t *n = yaml_document_get_node(doc, *slot);
+  if (n == NULL || n->type != YAML_SCALAR_NODE) return;
+  int a = names_find(&s->attach, (const char *)n->data.scalar.value, n->data.scalar.length);
+  if (a >= s->nbody_attach) *slot = add_scalar_like(doc, n, NULL, s->attach_to[a]);
+}
+
+static void rename_nodes(instancer *g, int map) {
+  yaml_document_t *doc = g->c->doc;
+  if (g->s->nbody_attach == g->s->attach.count) return;
+  yaml_node_item_t *one = value_slot(doc, map, "node");
+  if (one != NULL) rename_node(doc, g->s, one);
+  yaml_node_item_t *slot = value_slot(doc, map, "nodes");
+  if (slot == NULL || yaml_document_get_node(doc, *slot)->type != YAML_SEQUENCE_NODE) return;
+  yaml_node_t *v = yaml_document_get_node(doc, *slot);
+  int list = yaml_document_add_sequence(doc, v->tag, v->data.sequence.style); /* fresh: it may be shared */
+  if (!list) out_of_memory();
+  v = yaml_document_get_node(doc, *slot);
+  int count = (int)(v->data.sequence.items.top - v->data.sequence.items.start);
+  yaml_mark_t start = v->start_mark, end = v->end_mark;
+  for (int i = 0; i < count; i++) {
+    v = yaml_document_get_node(doc, *slot);
+    yaml_node_item_t item = v->data.sequence.items.start[i];
+    rename_node(doc, g->s, &item);
+    if (!yaml_document_append_sequence_item(doc, list, item)) out_of_memory();
+  }
+  yaml_node_t *l = yaml_document_get_node(doc, list);
+  l->start_mark = start;
+  l->end_mark = end;
+  *value_slot(doc, map, "nodes") = list;
 }
 
 /* mirror: the numbers at the set bits of 'mask' of the list in *slot change
@@ -690,6 +725,7 @@ static void instance_output(instancer *g, int o) {
   if (value_is(doc, o, "type", "force") || value_is(doc, o, "type", "tyre")) rename_key(g, o, "element", KIND_FORCE);
   rename_key(g, o, "joint", KIND_JOINT);
   rename_key(g, o, "driver", KIND_DRIVER);
+  rename_nodes(g, o);
   if (g->s->mirror) {
     flip(doc, value_slot(doc, o, "point"), POLAR);
     flip(doc, value_slot(doc, o, "axis"), AXIAL);
@@ -754,20 +790,25 @@ static bool read_header(includer *c, scope *s, yaml_document_t *src, ir_loc from
     return false;
   }
   bool ok = true;
+  for (int pass = 0; pass < 2; pass++) /* the bodies first, then the nodes */
   for (int i = 0; i < npairs(h); i++) {
+    if (pass == 1 && i == 0) s->nbody_attach = s->attach.count;
     yaml_node_t *k = yaml_document_get_node(src, h->data.mapping.pairs.start[i].key);
     yaml_node_t *v = yaml_document_get_node(src, h->data.mapping.pairs.start[i].value);
     if (scalar_equals(k, "description")) continue;
-    if (!scalar_equals(k, "attachments")) {
-      diag_error(s->path, mark_loc(k->start_mark), "unknown key in 'subsystem' (expected attachments, description)");
+    if (!scalar_equals(k, "attachments") && !scalar_equals(k, "nodes")) {
+      diag_error(s->path, mark_loc(k->start_mark), "unknown key in 'subsystem' (expected attachments, nodes, "
+                 "description)");
       ok = false;
       continue;
     }
     if (v->type != YAML_SEQUENCE_NODE) {
-      diag_error(s->path, mark_loc(v->start_mark), "'attachments' must be a list of names");
+      diag_error(s->path, mark_loc(v->start_mark), "'%s' must be a list of names",
+                 scalar_equals(k, "nodes") ? "nodes" : "attachments");
       ok = false;
       continue;
     }
+    if (scalar_equals(k, "nodes") != (pass == 1)) continue;
     for (yaml_node_item_t *it = v->data.sequence.items.start; it < v->data.sequence.items.top; it++) {
       yaml_node_t *a = yaml_document_get_node(src, *it);
       if (a->type != YAML_SCALAR_NODE || a->data.scalar.length == 0) {
@@ -782,6 +823,7 @@ static bool read_header(includer *c, scope *s, yaml_document_t *src, ir_loc from
       }
     }
   }
+  if (npairs(h) == 0) s->nbody_attach = s->attach.count;
   (void)c;
   return ok;
 }
@@ -945,8 +987,9 @@ static void instantiate(includer *c, scope *parent, const char *from_path, yaml_
       g.ok = false;
       continue;
     }
-    char *to = av->type == YAML_SCALAR_NODE ? resolve(parent, KIND_BODY, (const char *)av->data.scalar.value,
-                                                      av->data.scalar.length) : NULL;
+    char *to = av->type != YAML_SCALAR_NODE ? NULL
+               : a >= s.nbody_attach ? xstrndup((const char *)av->data.scalar.value, av->data.scalar.length)
+               : resolve(parent, KIND_BODY, (const char *)av->data.scalar.value, av->data.scalar.length);
     if (to == NULL) {
       diag_error(from_path, mark_loc(av->start_mark), "attachment '%s' must name a body%s", s.attach.name[a],
                  parent ? " of the enclosing subsystem, 'ground' or one of its attachments" : "");
@@ -1059,7 +1102,10 @@ static void instantiate(includer *c, scope *parent, const char *from_path, yaml_
             f->start_mark = sm;
             f->end_mark = em;
             value = fresh;
-            if (kind == KIND_JOINT || kind == KIND_FORCE) rename_key(&g, value, "bodies", KIND_BODY);
+            if (kind == KIND_JOINT || kind == KIND_FORCE) {
+              rename_key(&g, value, "bodies", KIND_BODY);
+              rename_nodes(&g, value);
+            }
             if (kind == KIND_FORCE) rename_key(&g, value, "body", KIND_BODY);
             if (kind == KIND_DRIVER) rename_key(&g, value, "joint", KIND_JOINT);
             if (s.mirror) mirror_element(&g, kind, value);
