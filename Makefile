@@ -22,7 +22,7 @@ CC_SRC  := $(wildcard compiler/*.c) $(foreach d,$(CC_DIRS),$(wildcard $(d)/*.c))
 B       ?= build
 DEPFLAGS = -MMD -MP
 
-.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser embedded man release-check  install scaling chassis vehicle sweeps
+.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser embedded man release-check  install scaling chassis vehicle sweeps slurm-check
 all: $(B)/mbcc $(B)/libmbrt.a $(B)/libmbrt_float.a
 
 # objects keep the source's folders: $(B)/rt/core/x.o, $(B)/cc/front/x.o
@@ -138,6 +138,11 @@ include docs/vehicle.mk
 
 clean:
 	rm -rf $(B) generated/*/ results
+
+# a sweep's Slurm job array on a single-node Slurm started here (munge, slurmctld, slurmd), against
+# GNU parallel (scripts/slurm-check.sh; needs Debian slurm-wlm and munge, not part of make test)
+slurm-check: all
+	MBCC=$(B)/mbcc bash scripts/slurm-check.sh
 
 # the design-of-experiments study (scripts/sweeps.sh): writes docs/sweeps.md and docs/img/sweep_*.png
 sweeps: all

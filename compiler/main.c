@@ -171,7 +171,8 @@ static int build(const options *o, mbc_unit *u, int verbose) { return build_read
 
 /* run --set: each a run-time parameter of the model (read into ir) with a
  * value in its range; 0, or 2 after reporting */
-static int check_sets(const options *o, const ir_model *ir) {
+static int check_sets(const options *o, const mbc_unit *u) {
+  const ir_model *ir = u->ir;
   for (int i = 0; i < o->nset; i++) {
     char suggest[128];
     int k = params_find(ir, o->set_names[i], suggest, sizeof suggest);
@@ -193,14 +194,64 @@ static int check_sets(const options *o, const ir_model *ir) {
       return 2;
     }
   }
-  return 0;
+  if (!o->nset || u->overridden) return 0;
+  /* the values against the rules of the fields they set (a stiffness >= 0 ...) */
+  int nrt = 0;
+  for (int k = 0; k < ir->nparams; k++) nrt += ir->params[k].runtime;
+  double *p = calloc((size_t)nrt + 1, sizeof *p);
+  if (p == NULL) return 2;
+  char context[1024] = "--set";
+  for (int k = 0, j = 0; k < ir->nparams; k++)
+    if (ir->params[k].runtime) p[j++] = ir->params[k].value;
+  for (int i = 0; i < o->nset; i++) {
+    p[params_runtime_index(ir, params_find(ir, o->set_names[i], NULL, 0))] = o->set_values[i];
+    size_t used = strlen(context);
+    snprintf(context + used, sizeof context - used, " %s", o->set_args[i]);
+  }
+  int rc = mbc_check_runtime_rules(u, p, context);
+  free(p);
+  return rc;
+}
+
+/* sweep: the run-time parameter vector of each run (the defaults, the
+ * shared --set values, the run's varied values) against the fields' rules;
+ * 0, or 2 after reporting the first run that breaks one */
+static int sweep_check_rules(const mbc_unit *u, const options *o, const sweep_plan *plan, const double *table,
+                             int nrun) {
+  const ir_model *ir = u->ir;
+  int nrt = 0;
+  for (int k = 0; k < ir->nparams; k++) nrt += ir->params[k].runtime;
+  double *p = calloc((size_t)nrt + 1, sizeof *p);
+  if (p == NULL) return 2;
+  int rc = 0;
+  for (int r = 0; r < nrun && !rc; r++) {
+    for (int k = 0, j = 0; k < ir->nparams; k++)
+      if (ir->params[k].runtime) p[j++] = ir->params[k].value;
+    for (int i = 0; i < o->nset; i++) {
+      int k = params_find(ir, o->set_names[i], NULL, 0);
+      if (k >= 0 && ir->params[k].runtime) p[params_runtime_index(ir, k)] = o->set_values[i];
+    }
+    char context[1024];
+    int used = snprintf(context, sizeof context, "run %d of the sweep (--vary", r + 1);
+    for (int v = 0; v < plan->nvar; v++) {
+      int k = params_find(ir, plan->var[v].name, NULL, 0);
+      double x = table[(long)r * plan->nvar + v];
+      p[params_runtime_index(ir, k)] = x;
+      if (used > 0 && (size_t)used < sizeof context)
+        used += snprintf(context + used, sizeof context - (size_t)used, " %s=%.17g", plan->var[v].name, x);
+    }
+    if (used > 0 && (size_t)used < sizeof context) snprintf(context + used, sizeof context - (size_t)used, ")");
+    rc = mbc_check_runtime_rules(u, p, context);
+  }
+  free(p);
+  return rc;
 }
 
 /* the generic path with --set: the model read again with the values (every
  * field that names them follows, and the model is assembled with them) */
 static int build_with_sets(const options *o, mbc_unit *u) {
   if (build(o, u, 0)) return 2;
-  if (check_sets(o, u->ir)) { mbc_unit_free(u); return 2; }
+  if (check_sets(o, u)) { mbc_unit_free(u); return 2; }
   if (!o->nset) return 0;
   mbc_unit_free(u);
   const char *names[64];
@@ -898,7 +949,7 @@ static int build_simulator(const options *o, char *exe_final, size_t n, mbc_unit
   o2.outdir = NULL;
   memset(u, 0, sizeof *u);
   int rc = cmd_compile(&o2, dir, sizeof dir, u);
-  if (!rc) rc = check_sets(o, u->ir);
+  if (!rc) rc = check_sets(o, u);
   if (rc) { mbc_unit_free(u); return rc; }
   const lmodel *L = u->lowered;
   /* the simulator under a name of this process's own (two runs of one
@@ -1221,9 +1272,8 @@ static int cmd_sweep(int argc, char **argv) {
         }
     }
   }
-  mbc_unit_free(&u);
-  if (rc != 2) { rc = 2; goto done; }
-  if (sweep_design(&p, baseline, &table, &nrun)) goto done;
+  if (rc != 2) { rc = 2; mbc_unit_free(&u); goto done; }
+  if (sweep_design(&p, baseline, &table, &nrun)) { mbc_unit_free(&u); goto done; }
   for (int r = 0; r < nrun; r++)
     for (int k = 0; k < p.nvar; k++) {
       double x = table[(long)r * p.nvar + k];
@@ -1231,9 +1281,17 @@ static int cmd_sweep(int argc, char **argv) {
         fprintf(stderr, "mbcc: error: --vary %s: the value %.17g is outside the parameter's range [%g, %g]\n",
                 p.var[k].name, x, pmin[k], pmax[k]);
         free(table);
+        mbc_unit_free(&u);
         goto done;
       }
     }
+  /* every run's values against the rules of the fields they set, before any run */
+  if (sweep_check_rules(&u, &o, &p, table, nrun)) {
+    free(table);
+    mbc_unit_free(&u);
+    goto done;
+  }
+  mbc_unit_free(&u);
   if (sweep_write_jobs(dir, exe, &p, table, nrun, fixed)) { free(table); goto done; }
   free(table);
   if (!quiet) fprintf(stderr, "mbcc sweep: %d runs of %s; jobs in %s/jobs.txt\n", nrun, name, dir);

@@ -208,6 +208,22 @@ done:
   return rc;
 }
 
+int mbc_check_runtime_rules(const mbc_unit *u, const double *p, const char *context) {
+  const ir_model *ir = u->ir;
+  int rc = 0;
+  for (int i = 0; i < u->nbind; i++) {
+    const ir_expr_use *use = &ir->uses[u->bind[i].use];
+    if (use->rule == RULE_ANY) continue;
+    double v = expr_eval_runtime(ir, use->expr, p);
+    if (params_rule_holds(use->rule, v)) continue;
+    const ir_force *F = &ir->forces[u->lowered->force_ir[u->bind[i].force]];
+    diag_error(ir->path, use->loc, "%s: %s of force '%s' would be %g, but it %s (it depends on run-time parameter "
+               "'%s')", context, use->field, F->name, v, params_rule_text(use->rule), runtime_name(ir, use->expr));
+    rc = 2;
+  }
+  return rc;
+}
+
 int mbc_unit_finish(mbc_unit *u, int verbose) {
   if (flex_reduce(u->ir, &u->flex)) return 2;
   if (drop_modal_outputs(u->ir, &u->flex)) return 2;

@@ -51,6 +51,11 @@ int mbc_unit_read(mbc_unit *u, const char *path, const char *scene);
  * analysis (verbose: its report on stdout), the LDL^T plan.  0, or 2 after
  * reporting. */
 int mbc_unit_finish(mbc_unit *u, int verbose);
+/* the fields the run-time parameters set (u->bind), at the run-time values
+ * p (in the order of run-time parameters), against the rule the reader checks
+ * them by (>= 0, > 0): 0, or 2 after an error at each field that breaks its
+ * rule ('context' leads the message, e.g. "--set k=-5") */
+int mbc_check_runtime_rules(const mbc_unit *u, const double *p, const char *context);
 /* Both: the whole pipeline */
 int mbc_unit_build(mbc_unit *u, const char *path, const char *scene, int verbose);
 void mbc_unit_free(mbc_unit *u);

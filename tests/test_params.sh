@@ -11,7 +11,10 @@
 #      file; the generic path with --set agrees with the generated one; the
 #      motion matches the closed form x0 + pull cos(sqrt(k/m) t);
 #   4. errors: --set of an unknown or compile-time parameter, of a value
-#      outside its range, on mbcc run and on the generated simulator: exit 2.
+#      outside its range, on mbcc run and on the generated simulator: exit 2;
+#   5. a --set value that breaks the rule of the field it sets (a negative
+#      stiffness or free length): exit 2 from mbcc run and from the generated
+#      simulator, with the field's file:line:col and rule; the bound 0 passes.
 set -u
 cd "$(dirname "$0")/.."
 # shellcheck source=tests/shell_setup.sh
@@ -161,4 +164,22 @@ else
   err "no simulator in generated/param_oscillator"
 fi
 [ -e e.csv ] && err "a refused run wrote e.csv"
+
+# 5. a --set value is checked against the rule of the field it sets, not only
+#    the parameter's range: sweep_oscillator's k (no min) is its spring's
+#    stiffness (>= 0), L0 its free length (>= 0); mbcc refuses before running,
+#    the generated simulator's set_params too (and writes nothing)
+osc="$root/tests/models/sweep_oscillator.yaml"
+expect_error "sweep_oscillator.yaml:19:16: error: --set k=-5: 'stiffness' of force 'spring' would be -5, but it must be >= 0 (it depends on run-time parameter 'k')" run "$osc" -o e.csv --set k=-5
+expect_error "sweep_oscillator.yaml:18:18: error: --set L0=-0.25: 'free_length' of force 'spring' would be -0.25, but it must be >= 0" run "$osc" -o e.csv --set L0=-0.25
+run "$osc" -o osc.csv --set k=0 > /dev/null 2>&1 || err "--set k=0 (the rule's bound) refused"
+sim=$(ls generated/sweep_oscillator/sweep_oscillator_sim 2>/dev/null)
+if [ -x "$sim" ]; then
+  expect_error "error: --set k=-5: force 'spring': 'stiffness' at sweep_oscillator.yaml:19:16 must be >= 0" "$sim" -o e.csv --set k=-5
+  expect_error "'free_length' at sweep_oscillator.yaml:18:18 must be >= 0" "$sim" -o e.csv --set k=5 --set L0=-1e-9
+  "$sim" -o osc2.csv --set k=0 --quiet > /dev/null 2>&1 || err "the simulator refuses --set k=0"
+else
+  err "no simulator in generated/sweep_oscillator"
+fi
+[ -e e.csv ] && err "a run refused by a field's rule wrote e.csv"
 exit $fail

@@ -36,6 +36,12 @@ bad --vary k=10:1:3
 bad --vary k=1:10
 bad --vary k=1:10:3 --design nope
 bad --vary k=1,2 --vary k=3
+# a value that breaks the rule of the field the parameter sets (the spring's
+# stiffness >= 0), though k has no min: refused before any run
+bad --vary k=-5,100 --dir rule
+grep -q "sweep_oscillator.yaml:19:16: error: run 1 of the sweep (--vary k=-5): 'stiffness' of force 'spring' would be -5, but it must be >= 0" err.txt ||
+  err "sweep --vary k=-5,100: not the field's rule: $(cat err.txt)"
+[ -e rule/jobs.txt ] && err "sweep --vary k=-5,100 wrote a job list"
 
 # 2. a full design, run by GNU parallel; speeds against the closed form
 "$MBCC" sweep "$osc" --vary k=100,400,900 --vary L0=0.9,0.8 --metric v:max --metric x:min \

@@ -187,18 +187,39 @@ static void emit_runtime_params(emit_ctx *cx) {
     }
     fputs("};\n", f);
   }
-  fputs("static void set_params(const mb_model *m, const mb_real *p) {\n  (void)m;\n", f);
+  fputs("static const char *set_params(const mb_model *m, const mb_real *p) {\n  (void)m;\n", f);
+  /* first the values against their fields' rules: nothing is written when one breaks its rule */
   for (int i = 0; i < u->nbind; i++) {
     const runtime_binding *b = &u->bind[i];
     const ir_force *F = &ir->forces[L->force_ir[b->force]];
     const ir_expr_use *use = &ir->uses[b->use];
-    fprintf(f, "  /* force '%s', %s:%d:%d */\n  ", F->name, u->file_name, use->loc.line, use->loc.col);
+    if (use->rule == RULE_ANY) continue;
+    fputs("  if (!(", f);
+    expr_print_c(f, ir, use->expr, "(double)p");
+    const char *file = diag_loc_file(use->loc, L->ir->path), *slash = strrchr(file, '/');
+    ir_loc at = diag_loc_in_file(use->loc);
+    char rule[1400];
+    snprintf(rule, sizeof rule, "force '%s': %s at %s:%d:%d %s", F->name, use->field, slash ? slash + 1 : file,
+             at.line, at.col, params_rule_text(use->rule));
+    fprintf(f, " %s 0)) return \"", use->rule == RULE_POSITIVE ? ">" : ">=");
+    for (const char *c = rule; *c; c++) /* a C string: quotes and backslashes escaped, no control characters */
+      if (*c == '"' || *c == '\\') fprintf(f, "\\%c", *c);
+      else fputc((unsigned char)*c < 0x20 ? '?' : *c, f);
+    fputs("\";\n", f);
+  }
+  for (int i = 0; i < u->nbind; i++) {
+    const runtime_binding *b = &u->bind[i];
+    const ir_force *F = &ir->forces[L->force_ir[b->force]];
+    const ir_expr_use *use = &ir->uses[b->use];
+    fprintf(f, "  /* force '%s', ", F->name); /* an included or subsystem file's line: that file's */
+    loc_comment(f, L, use->loc);
+    fputs(" */\n  ", f);
     if (b->pool == BIND_PRM) fprintf(f, "force_prm[%d] = (mb_real)", b->index);
     else fprintf(f, "force_laws[%d].%s = (mb_real)", b->index, b->pool == BIND_LAW_COEF ? "coef" : "exponent");
     expr_print_c(f, ir, use->expr, "(double)p");
     fputs(";\n", f);
   }
-  fputs("}\n", f);
+  fputs("  return NULL;\n}\n", f);
 }
 
 /* the force records (kind and addresses) and their pools: force_prm, force_laws */

@@ -12,12 +12,20 @@
 #include "fe.h"
 #include "emit_force.h"
 #include "reader.h"
+#include "params.h"
 
 /* Six numbers, each >= 0 when 'nonnegative'. */
 static void get_six(mapping *m, const char *key, bool required, bool nonnegative, double out[6]) {
   double v[6];
   if (!get_vector(m, key, 6, required, v))
     return;
+  yaml_node_t *list = map_get(m, key);
+  for (int i = 0; nonnegative && list != NULL && list->type == YAML_SEQUENCE_NODE && i < 6; i++) {
+    char label[64];
+    snprintf(label, sizeof label, "'%s' entry %d", key, i + 1);
+    params_note_rule(m->r, loc_of(yaml_document_get_node(m->r->doc, list->data.sequence.items.start[i])),
+                     RULE_NONNEGATIVE, label);
+  }
   for (int i = 0; i < 6; i++) {
     if (nonnegative && !(v[i] >= 0)) {
       error_at(m->r, m->last_loc, "'%s': every entry must be >= 0 (entry %d is %g)", key, i + 1,

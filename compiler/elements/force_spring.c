@@ -7,6 +7,7 @@
 #include "element.h"
 #include "emit_force.h"
 #include "reader.h"
+#include "params.h"
 
 /* A number (linear), {coefficient, exponent} (power) or {table: ...}. */
 static void parse_law(reader *r, yaml_node_t *n, const char *key, const char *owner, ir_law *law) {
@@ -17,6 +18,7 @@ static void parse_law(reader *r, yaml_node_t *n, const char *key, const char *ow
     double coef;
     if (!to_number(r, n, label, &coef))
       return;
+    params_note_rule(r, loc_of(n), RULE_NONNEGATIVE, label);
     if (!(coef >= 0)) {
       error_at(r, loc_of(n), "%s must be >= 0 (got %g)", label, coef);
       return;

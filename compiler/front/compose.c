@@ -10,6 +10,7 @@
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "bounds.h"
@@ -19,7 +20,7 @@
 /* the sections an included file may supply; everything else belongs to the
  * including model */
 static const char *const included_sections[] = {"bodies", "joints", "drivers", "forces",
-                                                "outputs", "scenes", NULL};
+                                                "outputs", "scenes", "parameters", NULL};
 
 typedef struct {
   const char *path;   /* the file the document came from, for messages */
@@ -174,6 +175,7 @@ static bool expand_merges(const char *path, yaml_document_t *doc) {
  * ------------------------------------------------------------------------- */
 
 typedef struct {
+  const char *path;       /* the model's file */
   yaml_document_t *doc;   /* the model's document, receiving the included nodes */
   compose_files *files;   /* every file included, for the input hash */
   char *stack[LIMIT_INCLUDE_DEPTH + 1]; /* the canonical paths being included (cycles) */
@@ -194,7 +196,7 @@ static char *relative_to(const char *from, const char *name, size_t length) {
 }
 
 /* loads one YAML file; its lines are moved to its registered number */
-static bool load_file(const char *path, ir_loc at, const char *at_file, yaml_document_t *doc) {
+static bool load_file(const char *path, ir_loc at, const char *at_file, int instance, yaml_document_t *doc) {
   FILE *f = fopen(path, "rb");
   if (f == NULL) {
     diag_error(at_file, at, "cannot read the included file '%s': %s", path, strerror(errno));
@@ -219,7 +221,7 @@ static bool load_file(const char *path, ir_loc at, const char *at_file, yaml_doc
     free(data);
     return false;
   }
-  int k = diag_register_file(path);
+  int k = instance ? instance : diag_register_file(path);
   if (k == 0) {
     diag_error(at_file, at, "more than %d included files", DIAG_MAX_FILES);
     free(data);
@@ -306,8 +308,8 @@ static void merge_sections(includer *c, const char *path, yaml_document_t *src) 
     for (int s = 0; included_sections[s] && !allowed; s++) allowed = scalar_equals(key, included_sections[s]);
     if (!allowed) {
       diag_error(path, mark_loc(key->start_mark),
-                 "%s%.*s%s cannot come from an included file (it supplies bodies, joints, drivers, forces, "
-                 "outputs and scenes)", key->type == YAML_SCALAR_NODE ? "'" : "",
+                 "%s%.*s%s cannot come from an included file (it supplies parameters, bodies, joints, drivers, "
+                 "forces, outputs and scenes)", key->type == YAML_SCALAR_NODE ? "'" : "",
                  key->type == YAML_SCALAR_NODE ? (int)key->data.scalar.length : 7,
                  key->type == YAML_SCALAR_NODE ? (const char *)key->data.scalar.value : "this key",
                  key->type == YAML_SCALAR_NODE ? "'" : "");
@@ -384,7 +386,7 @@ static void include_files(includer *c, const char *path, yaml_document_t *doc) {
       c->ok = false;
     } else {
       yaml_document_t included;
-      if (!load_file(file, loc, path, &included)) {
+      if (!load_file(file, loc, path, 0, &included)) {
         c->ok = false;
       } else {
         c->stack[c->depth++] = canonical;
@@ -401,6 +403,743 @@ static void include_files(includer *c, const char *path, yaml_document_t *doc) {
   }
 }
 
+
+/* ---------------------------------------------------------------------------
+ * subsystems:
+ * ------------------------------------------------------------------------- */
+
+bool compose_is_mirrored(const yaml_node_t *n) {
+  return n->type == YAML_SCALAR_NODE && n->tag != NULL && strcmp((const char *)n->tag, COMPOSE_MIRROR_TAG) == 0;
+}
+
+double compose_mirror_value(double v) { return v == 0 ? 0.0 : -v; }
+
+enum { KIND_BODY, KIND_JOINT, KIND_DRIVER, KIND_FORCE, KIND_PARAM, KIND_COUNT };
+static const char *const kind_section[KIND_COUNT] = {"bodies", "joints", "drivers", "forces", "parameters"};
+static const char *const kind_word[KIND_COUNT] = {"body", "joint", "driver", "force", "parameter"};
+
+typedef struct {
+  char **name;
+  int count, cap;
+} name_set;
+
+static void names_add(name_set *s, const char *name, size_t length) {
+  if (s->count == s->cap) {
+    s->cap = s->cap ? 2 * s->cap : 16;
+    s->name = realloc(s->name, (size_t)s->cap * sizeof *s->name);
+    if (s->name == NULL) out_of_memory();
+  }
+  s->name[s->count++] = xstrndup(name, length);
+}
+
+static int names_find(const name_set *s, const char *name, size_t length) {
+  for (int i = 0; i < s->count; i++)
+    if (strlen(s->name[i]) == length && memcmp(s->name[i], name, length) == 0) return i;
+  return -1;
+}
+
+static void names_free(name_set *s) {
+  for (int i = 0; i < s->count; i++) free(s->name[i]);
+  free(s->name);
+  memset(s, 0, sizeof *s);
+}
+
+/* one subsystem instance being expanded */
+typedef struct scope {
+  struct scope *parent; /* the enclosing instance, NULL for the model */
+  const char *path;     /* the subsystem file */
+  char *prefix;         /* the full prefix of its names (the enclosing ones' first) */
+  size_t own_prefix;    /* the length of the enclosing prefix, where its own begins */
+  bool mirror;          /* y -> -y, the enclosing instances' mirrors included */
+  name_set local[KIND_COUNT]; /* its own names (and those its inner instances made), unprefixed */
+  name_set attach;      /* its attachments (bodies, then the 'nodes' of the header) ... */
+  char **attach_to;     /* ... and the model bodies (nodes) they map to */
+  int nbody_attach;     /* attach.name[0..nbody_attach) are bodies */
+} scope;
+
+/* the model's name for 'name' of kind 'kind' used in scope s, or NULL */
+static char *resolve(const scope *s, int kind, const char *name, size_t length) {
+  if (s == NULL) return xstrndup(name, length);
+  if (names_find(&s->local[kind], name, length) >= 0) {
+    size_t pl = strlen(s->prefix);
+    char *out = xcalloc(pl + length + 1, 1);
+    memcpy(out, s->prefix, pl);
+    memcpy(out + pl, name, length);
+    return out;
+  }
+  if (kind != KIND_BODY) return NULL;
+  if (length == 6 && memcmp(name, "ground", 6) == 0) return xstrdup("ground");
+  int a = names_find(&s->attach, name, length);
+  return a >= 0 && a < s->nbody_attach ? xstrdup(s->attach_to[a]) : NULL;
+}
+
+
+static int add_scalar_like(yaml_document_t *doc, const yaml_node_t *like, const char *tag, const char *text) {
+  int to = yaml_document_add_scalar(doc, (yaml_char_t *)(uintptr_t)tag, (const yaml_char_t *)text, (int)strlen(text),
+                                    YAML_PLAIN_SCALAR_STYLE);
+  if (!to) out_of_memory();
+  yaml_node_t *n = yaml_document_get_node(doc, to);
+  n->start_mark = like->start_mark;
+  n->end_mark = like->end_mark;
+  return to;
+}
+
+typedef struct {
+  includer *c;
+  scope *s;
+  bool ok;
+} instancer;
+
+/* *slot (a node of c->doc naming a 'kind') replaced by the model's name */
+static void rename_ref(instancer *g, yaml_node_item_t *slot, int kind) {
+  yaml_document_t *doc = g->c->doc;
+  yaml_node_t *n = yaml_document_get_node(doc, *slot);
+  if (n == NULL || n->type != YAML_SCALAR_NODE) return; /* the reader reports the type */
+  char *to = resolve(g->s, kind, (const char *)n->data.scalar.value, n->data.scalar.length);
+  if (to == NULL) {
+    diag_error(g->s->path, mark_loc(n->start_mark),
+               "unknown %s '%.*s' in the subsystem (neither one of its own%s)", kind_word[kind],
+               (int)n->data.scalar.length, (const char *)n->data.scalar.value,
+               kind == KIND_BODY ? " bodies, 'ground' nor one of its 'attachments'" : "");
+    g->ok = false;
+    return;
+  }
+  *slot = add_scalar_like(doc, n, (const char *)n->tag, to);
+  free(to);
+}
+
+/* the value of 'key' in mapping 'map' (c->doc), as a slot, or NULL */
+static yaml_node_item_t *value_slot(yaml_document_t *doc, int map, const char *key) {
+  yaml_node_t *m = yaml_document_get_node(doc, map);
+  if (m == NULL || m->type != YAML_MAPPING_NODE) return NULL;
+  for (yaml_node_pair_t *p = m->data.mapping.pairs.start; p < m->data.mapping.pairs.top; p++)
+    if (scalar_equals(yaml_document_get_node(doc, p->key), key)) return &p->value;
+  return NULL;
+}
+
+static void rename_key(instancer *g, int map, const char *key, int kind) {
+  yaml_node_item_t *slot = value_slot(g->c->doc, map, key);
+  if (slot == NULL) return;
+  yaml_node_t *v = yaml_document_get_node(g->c->doc, *slot);
+  if (v->type == YAML_SEQUENCE_NODE) { /* a list of names: a fresh list (the original may be shared) */
+    int list = yaml_document_add_sequence(g->c->doc, v->tag, v->data.sequence.style);
+    if (!list) out_of_memory();
+    v = yaml_document_get_node(g->c->doc, *slot);
+    int count = (int)(v->data.sequence.items.top - v->data.sequence.items.start);
+    yaml_mark_t start = v->start_mark, end = v->end_mark;
+    for (int i = 0; i < count; i++) {
+      v = yaml_document_get_node(g->c->doc, *slot);
+      yaml_node_item_t item = v->data.sequence.items.start[i];
+      rename_ref(g, &item, kind);
+      if (!yaml_document_append_sequence_item(g->c->doc, list, item)) out_of_memory();
+    }
+    yaml_node_t *l = yaml_document_get_node(g->c->doc, list);
+    l->start_mark = start;
+    l->end_mark = end;
+    *value_slot(g->c->doc, map, key) = list;
+  } else {
+    rename_ref(g, slot, kind);
+  }
+}
+
+/* an FE node named in the subsystem: a node attachment becomes the instance's node, anything else stays */
+static void rename_node(yaml_document_t *doc, const scope *s, yaml_node_item_t *slot) {
+  yaml_node_t *n = yaml_document_get_node(doc, *slot);
+  if (n == NULL || n->type != YAML_SCALAR_NODE) return;
+  int a = names_find(&s->attach, (const char *)n->data.scalar.value, n->data.scalar.length);
+  if (a >= s->nbody_attach) *slot = add_scalar_like(doc, n, NULL, s->attach_to[a]);
+}
+
+static void rename_nodes(instancer *g, int map) {
+  yaml_document_t *doc = g->c->doc;
+  if (g->s->nbody_attach == g->s->attach.count) return;
+  yaml_node_item_t *one = value_slot(doc, map, "node");
+  if (one != NULL) rename_node(doc, g->s, one);
+  yaml_node_item_t *slot = value_slot(doc, map, "nodes");
+  if (slot == NULL || yaml_document_get_node(doc, *slot)->type != YAML_SEQUENCE_NODE) return;
+  yaml_node_t *v = yaml_document_get_node(doc, *slot);
+  int list = yaml_document_add_sequence(doc, v->tag, v->data.sequence.style); /* fresh: it may be shared */
+  if (!list) out_of_memory();
+  v = yaml_document_get_node(doc, *slot);
+  int count = (int)(v->data.sequence.items.top - v->data.sequence.items.start);
+  yaml_mark_t start = v->start_mark, end = v->end_mark;
+  for (int i = 0; i < count; i++) {
+    v = yaml_document_get_node(doc, *slot);
+    yaml_node_item_t item = v->data.sequence.items.start[i];
+    rename_node(doc, g->s, &item);
+    if (!yaml_document_append_sequence_item(doc, list, item)) out_of_memory();
+  }
+  yaml_node_t *l = yaml_document_get_node(doc, list);
+  l->start_mark = start;
+  l->end_mark = end;
+  *value_slot(doc, map, "nodes") = list;
+}
+
+/* mirror: the numbers at the set bits of 'mask' of the list in *slot change
+ * sign (a fresh list and fresh scalars carrying COMPOSE_MIRROR_TAG: the
+ * original nodes may be shared through anchors) */
+static void flip(yaml_document_t *doc, yaml_node_item_t *slot, unsigned mask) {
+  if (slot == NULL) return;
+  yaml_node_t *v = yaml_document_get_node(doc, *slot);
+  if (v == NULL || v->type != YAML_SEQUENCE_NODE) return;
+  int list = yaml_document_add_sequence(doc, v->tag, v->data.sequence.style);
+  if (!list) out_of_memory();
+  v = yaml_document_get_node(doc, *slot);
+  int count = (int)(v->data.sequence.items.top - v->data.sequence.items.start);
+  yaml_mark_t start = v->start_mark, end = v->end_mark;
+  for (int i = 0; i < count; i++) {
+    v = yaml_document_get_node(doc, *slot);
+    int item = v->data.sequence.items.start[i];
+    yaml_node_t *n = yaml_document_get_node(doc, item);
+    if (i < 32 && (mask >> i & 1u) && n->type == YAML_SCALAR_NODE) {
+      char *text = xstrndup((const char *)n->data.scalar.value, n->data.scalar.length);
+      n = yaml_document_get_node(doc, item);
+      int to = add_scalar_like(doc, n, compose_is_mirrored(n) ? NULL : COMPOSE_MIRROR_TAG, text);
+      yaml_node_t *t = yaml_document_get_node(doc, to);
+      n = yaml_document_get_node(doc, item);
+      t->data.scalar.style = n->data.scalar.style;
+      free(text);
+      item = to;
+    }
+    if (!yaml_document_append_sequence_item(doc, list, item)) out_of_memory();
+  }
+  yaml_node_t *l = yaml_document_get_node(doc, list);
+  l->start_mark = start;
+  l->end_mark = end;
+  *slot = list;
+}
+
+enum { POLAR = 2u, AXIAL = 5u }; /* y flips for a position, x and z for a rotation axis */
+
+/* flips every row of the list of lists in *slot by its mask (rows[i], or the last one) */
+static void flip_rows(yaml_document_t *doc, yaml_node_item_t *slot, const unsigned *rows, int nrows) {
+  if (slot == NULL) return;
+  yaml_node_t *v = yaml_document_get_node(doc, *slot);
+  if (v == NULL || v->type != YAML_SEQUENCE_NODE) return;
+  /* a fresh outer list too */
+  int list = yaml_document_add_sequence(doc, v->tag, v->data.sequence.style);
+  if (!list) out_of_memory();
+  v = yaml_document_get_node(doc, *slot);
+  int count = (int)(v->data.sequence.items.top - v->data.sequence.items.start);
+  yaml_mark_t start = v->start_mark, end = v->end_mark;
+  for (int i = 0; i < count; i++) {
+    v = yaml_document_get_node(doc, *slot);
+    yaml_node_item_t item = v->data.sequence.items.start[i];
+    flip(doc, &item, rows[i < nrows ? i : nrows - 1]);
+    if (!yaml_document_append_sequence_item(doc, list, item)) out_of_memory();
+  }
+  yaml_node_t *l = yaml_document_get_node(doc, list);
+  l->start_mark = start;
+  l->end_mark = end;
+  *slot = list;
+}
+
+static bool value_is(yaml_document_t *doc, int map, const char *key, const char *text) {
+  yaml_node_item_t *slot = value_slot(doc, map, key);
+  return slot != NULL && scalar_equals(yaml_document_get_node(doc, *slot), text);
+}
+
+/* y -> -y on element 'e' of section 'kind' (a reflection: positions flip
+ * y; rotation axes, angular velocities and torques are axial vectors and
+ * flip x and z, so that a mirrored joint turns by the same angle as its
+ * original; inertia products with one y index change sign) */
+static void mirror_element(instancer *g, int kind, int e) {
+  yaml_document_t *doc = g->c->doc;
+  static const unsigned frame_axes[3] = {POLAR, AXIAL, POLAR}; /* rows x, y, z of a proper mirrored frame */
+  static const unsigned six[1] = {0x2Au}; /* 6-vectors: y, then the x and z rotations */
+  if (kind == KIND_BODY) {
+    if (value_is(doc, e, "type", "flexible")) {
+      yaml_node_t *n = yaml_document_get_node(doc, e);
+      diag_error(g->s->path, mark_loc(n->start_mark), "a flexible body cannot be mirrored (mirror: true) yet");
+      g->ok = false;
+      return;
+    }
+    flip(doc, value_slot(doc, e, "position"), POLAR);
+    flip(doc, value_slot(doc, e, "velocity"), POLAR);
+    flip(doc, value_slot(doc, e, "angular_velocity"), AXIAL);
+    yaml_node_item_t *o = value_slot(doc, e, "orientation");
+    if (o != NULL) {
+      yaml_node_t *on = yaml_document_get_node(doc, *o);
+      if (on->type == YAML_SEQUENCE_NODE) flip(doc, o, 0xAu); /* e1, e3 */
+      else flip(doc, value_slot(doc, *o, "axis"), AXIAL);
+    }
+    yaml_node_item_t *in = value_slot(doc, e, "inertia");
+    if (in != NULL) {
+      yaml_node_t *n = yaml_document_get_node(doc, *in);
+      int count = n->type == YAML_SEQUENCE_NODE ? (int)(n->data.sequence.items.top - n->data.sequence.items.start) : 0;
+      bool matrix = count == 3 && yaml_document_get_node(doc, n->data.sequence.items.start[0])->type == YAML_SEQUENCE_NODE;
+      static const unsigned products[3] = {2u, 5u, 2u}; /* Ixy, Iyz (and their transposes) */
+      if (matrix) flip_rows(doc, in, products, 3);
+      else if (count == 6) flip(doc, in, 0x28u); /* [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] */
+    }
+    yaml_node_item_t *shape = value_slot(doc, e, "shape");
+    if (shape != NULL) {
+      flip(doc, value_slot(doc, *shape, "center"), POLAR);
+      flip(doc, value_slot(doc, *shape, "axis"), POLAR);
+    }
+  } else if (kind == KIND_JOINT) {
+    flip(doc, value_slot(doc, e, "point"), POLAR);
+    static const unsigned polar[1] = {POLAR}, axial[1] = {AXIAL};
+    flip_rows(doc, value_slot(doc, e, "points"), polar, 1);
+    flip(doc, value_slot(doc, e, "axis"), value_is(doc, e, "type", "prismatic") ? POLAR : AXIAL);
+    flip_rows(doc, value_slot(doc, e, "axes"), axial, 1);
+    flip(doc, value_slot(doc, e, "reference"), POLAR);
+  } else if (kind == KIND_FORCE) {
+    static const unsigned polar[1] = {POLAR};
+    flip(doc, value_slot(doc, e, "point"), POLAR);
+    flip_rows(doc, value_slot(doc, e, "points"), polar, 1);
+    flip(doc, value_slot(doc, e, "value"), value_is(doc, e, "type", "torque") ? AXIAL : POLAR);
+    flip(doc, value_slot(doc, e, "axis"), AXIAL); /* a tyre's spin axis */
+    flip_rows(doc, value_slot(doc, e, "axes"), frame_axes, 3);
+    if (value_is(doc, e, "type", "bushing") || value_is(doc, e, "type", "field")) {
+      flip(doc, value_slot(doc, e, "preload"), six[0]);
+      if (value_is(doc, e, "type", "field")) { /* D K D, D = diag(1, -1, 1, -1, 1, -1) */
+        static const unsigned rows[6] = {0x2Au, 0x15u, 0x2Au, 0x15u, 0x2Au, 0x15u};
+        flip_rows(doc, value_slot(doc, e, "stiffness"), rows, 6);
+        flip_rows(doc, value_slot(doc, e, "damping"), rows, 6);
+      }
+    }
+    yaml_node_item_t *section = value_slot(doc, e, "section");
+    if (section != NULL) flip(doc, value_slot(doc, *section, "yaxis"), AXIAL);
+  }
+}
+
+/* the outputs' names prefixed and their references renamed (and mirrored) */
+static void instance_output(instancer *g, int o) {
+  yaml_document_t *doc = g->c->doc;
+  yaml_node_item_t *name = value_slot(doc, o, "name");
+  if (name != NULL && yaml_document_get_node(doc, *name)->type == YAML_SCALAR_NODE) {
+    yaml_node_t *n = yaml_document_get_node(doc, *name);
+    size_t pl = strlen(g->s->prefix);
+    char *to = xcalloc(pl + n->data.scalar.length + 1, 1);
+    memcpy(to, g->s->prefix, pl);
+    memcpy(to + pl, n->data.scalar.value, n->data.scalar.length);
+    *name = add_scalar_like(doc, n, NULL, to);
+    free(to);
+  }
+  rename_key(g, o, "body", KIND_BODY);
+  rename_key(g, o, "bodies", KIND_BODY);
+  if (!value_is(doc, o, "frame", "global")) rename_key(g, o, "frame", KIND_BODY);
+  yaml_node_item_t *rel = value_slot(doc, o, "relative_to");
+  if (rel != NULL) rename_key(g, *rel, "body", KIND_BODY);
+  if (value_is(doc, o, "type", "force") || value_is(doc, o, "type", "tyre")) rename_key(g, o, "element", KIND_FORCE);
+  rename_key(g, o, "joint", KIND_JOINT);
+  rename_key(g, o, "driver", KIND_DRIVER);
+  rename_nodes(g, o);
+  if (g->s->mirror) {
+    flip(doc, value_slot(doc, o, "point"), POLAR);
+    flip(doc, value_slot(doc, o, "axis"), AXIAL);
+  }
+}
+
+/* the model's section 'name' (created empty when absent), a node of c->doc */
+static int model_section(includer *c, const char *name, bool list) {
+  int at = root_pair(c->doc, name);
+  if (at >= 0) return yaml_document_get_root_node(c->doc)->data.mapping.pairs.start[at].value;
+  int k = yaml_document_add_scalar(c->doc, NULL, (const yaml_char_t *)name, (int)strlen(name), YAML_PLAIN_SCALAR_STYLE);
+  int v = list ? yaml_document_add_sequence(c->doc, NULL, YAML_BLOCK_SEQUENCE_STYLE)
+               : yaml_document_add_mapping(c->doc, NULL, YAML_BLOCK_MAPPING_STYLE);
+  if (!k || !v || !yaml_document_append_mapping_pair(c->doc, 1, k, v)) out_of_memory();
+  return v;
+}
+
+static void instantiate(includer *c, scope *parent, const char *from_path, yaml_document_t *from_doc,
+                        int key_index, int value_index);
+
+/* the 'subsystems:' of document 'doc' (the model, parent NULL, or a subsystem file) */
+static void instantiate_all(includer *c, scope *parent, const char *path, yaml_document_t *doc) {
+  yaml_node_t *root = yaml_document_get_root_node(doc);
+  if (root == NULL || root->type != YAML_MAPPING_NODE) return;
+  int at = -1;
+  for (int i = 0; i < npairs(root); i++)
+    if (scalar_equals(yaml_document_get_node(doc, root->data.mapping.pairs.start[i].key), "subsystems")) at = i;
+  if (at < 0) return;
+  int list = root->data.mapping.pairs.start[at].value;
+  yaml_node_t *l = yaml_document_get_node(doc, list);
+  if (l->type != YAML_MAPPING_NODE) {
+    diag_error(path, mark_loc(l->start_mark), "'subsystems' must be a mapping of instance name -> {file, ...}");
+    c->ok = false;
+    return;
+  }
+  int count = npairs(l);
+  for (int i = 0; i < count; i++) { /* the document's nodes move as instances add to it: by index */
+    l = yaml_document_get_node(doc, list);
+    yaml_node_pair_t p = l->data.mapping.pairs.start[i];
+    instantiate(c, parent, path, doc, p.key, p.value);
+  }
+}
+
+static char *scalar_copy(const yaml_node_t *n) {
+  return xstrndup((const char *)n->data.scalar.value, n->data.scalar.length);
+}
+
+/* the names of the attachments in the subsystem's header */
+static bool read_header(includer *c, scope *s, yaml_document_t *src, ir_loc from, const char *from_path) {
+  yaml_node_t *root = yaml_document_get_root_node(src);
+  int at = -1;
+  for (int i = 0; i < npairs(root); i++)
+    if (scalar_equals(yaml_document_get_node(src, root->data.mapping.pairs.start[i].key), "subsystem")) at = i;
+  if (at < 0) {
+    diag_error(from_path, from, "'%s' is no subsystem file (it has no 'subsystem:' header with its 'attachments')",
+               s->path);
+    return false;
+  }
+  yaml_node_t *h = yaml_document_get_node(src, root->data.mapping.pairs.start[at].value);
+  if (h->type != YAML_MAPPING_NODE) {
+    diag_error(s->path, mark_loc(h->start_mark), "'subsystem' must be a mapping (attachments, description)");
+    return false;
+  }
+  bool ok = true;
+  for (int pass = 0; pass < 2; pass++) /* the bodies first, then the nodes */
+  for (int i = 0; i < npairs(h); i++) {
+    if (pass == 1 && i == 0) s->nbody_attach = s->attach.count;
+    yaml_node_t *k = yaml_document_get_node(src, h->data.mapping.pairs.start[i].key);
+    yaml_node_t *v = yaml_document_get_node(src, h->data.mapping.pairs.start[i].value);
+    if (scalar_equals(k, "description")) continue;
+    if (!scalar_equals(k, "attachments") && !scalar_equals(k, "nodes")) {
+      diag_error(s->path, mark_loc(k->start_mark), "unknown key in 'subsystem' (expected attachments, nodes, "
+                 "description)");
+      ok = false;
+      continue;
+    }
+    if (v->type != YAML_SEQUENCE_NODE) {
+      diag_error(s->path, mark_loc(v->start_mark), "'%s' must be a list of names",
+                 scalar_equals(k, "nodes") ? "nodes" : "attachments");
+      ok = false;
+      continue;
+    }
+    if (scalar_equals(k, "nodes") != (pass == 1)) continue;
+    for (yaml_node_item_t *it = v->data.sequence.items.start; it < v->data.sequence.items.top; it++) {
+      yaml_node_t *a = yaml_document_get_node(src, *it);
+      if (a->type != YAML_SCALAR_NODE || a->data.scalar.length == 0) {
+        diag_error(s->path, mark_loc(a->start_mark), "an attachment is a name");
+        ok = false;
+      } else if (names_find(&s->attach, (const char *)a->data.scalar.value, a->data.scalar.length) >= 0) {
+        diag_error(s->path, mark_loc(a->start_mark), "attachment '%.*s' is named twice",
+                   (int)a->data.scalar.length, (const char *)a->data.scalar.value);
+        ok = false;
+      } else {
+        names_add(&s->attach, (const char *)a->data.scalar.value, a->data.scalar.length);
+      }
+    }
+  }
+  if (npairs(h) == 0) s->nbody_attach = s->attach.count;
+  (void)c;
+  return ok;
+}
+
+static void instantiate(includer *c, scope *parent, const char *from_path, yaml_document_t *from_doc,
+                        int key_index, int value_index) {
+  yaml_node_t *key = yaml_document_get_node(from_doc, key_index);
+  yaml_node_t *inst = yaml_document_get_node(from_doc, value_index);
+  ir_loc at = mark_loc(key->start_mark);
+  if (key->type != YAML_SCALAR_NODE || inst->type != YAML_MAPPING_NODE) {
+    diag_error(from_path, at, "a subsystem instance is 'name: {file: F, prefix: P, mirror: true|false, attach: "
+                              "{...}, parameters: {...}}'");
+    c->ok = false;
+    return;
+  }
+  char *name = scalar_copy(key);
+  yaml_node_t *file = NULL, *prefix = NULL, *mirror = NULL, *attach = NULL, *params = NULL;
+  int params_index = 0;
+  bool ok = true;
+  for (int i = 0; i < npairs(inst); i++) {
+    yaml_node_t *k = yaml_document_get_node(from_doc, inst->data.mapping.pairs.start[i].key);
+    yaml_node_t *v = yaml_document_get_node(from_doc, inst->data.mapping.pairs.start[i].value);
+    if (scalar_equals(k, "file")) file = v;
+    else if (scalar_equals(k, "prefix")) prefix = v;
+    else if (scalar_equals(k, "mirror")) mirror = v;
+    else if (scalar_equals(k, "attach")) attach = v;
+    else if (scalar_equals(k, "parameters")) {
+      params = v;
+      params_index = inst->data.mapping.pairs.start[i].value;
+    }
+    else {
+      diag_error(from_path, mark_loc(k->start_mark),
+                 "unknown key in subsystem instance '%s' (expected file, prefix, mirror, attach, parameters)", name);
+      ok = false;
+    }
+  }
+  if (file == NULL || file->type != YAML_SCALAR_NODE || file->data.scalar.length == 0) {
+    diag_error(from_path, file ? mark_loc(file->start_mark) : at, "subsystem instance '%s' needs 'file: NAME.yaml'",
+               name);
+    ok = false;
+  }
+  if (prefix != NULL && prefix->type != YAML_SCALAR_NODE) {
+    diag_error(from_path, mark_loc(prefix->start_mark), "'prefix' must be text such as 'fl_'");
+    ok = false;
+  }
+  if (mirror != NULL && !scalar_equals(mirror, "true") && !scalar_equals(mirror, "false")) {
+    diag_error(from_path, mark_loc(mirror->start_mark), "'mirror' must be true or false");
+    ok = false;
+  }
+  if (attach != NULL && attach->type != YAML_MAPPING_NODE) {
+    diag_error(from_path, mark_loc(attach->start_mark), "'attach' must map the subsystem's attachments to bodies");
+    ok = false;
+  }
+  if (params != NULL && params->type != YAML_MAPPING_NODE) {
+    diag_error(from_path, mark_loc(params->start_mark), "'parameters' of an instance must be a mapping name -> value");
+    ok = false;
+  }
+  if (!ok) {
+    free(name);
+    c->ok = false;
+    return;
+  }
+  scope s = {.parent = parent};
+  s.path = relative_to(diag_loc_file(mark_loc(file->start_mark), from_path), (const char *)file->data.scalar.value,
+                       file->data.scalar.length);
+  {
+    const char *outer = parent ? parent->prefix : "";
+    size_t ol = strlen(outer);
+    const char *own = prefix ? (const char *)prefix->data.scalar.value : name;
+    size_t length = prefix ? prefix->data.scalar.length : strlen(name) + 1;
+    s.prefix = xcalloc(ol + length + 1, 1);
+    memcpy(s.prefix, outer, ol);
+    memcpy(s.prefix + ol, own, prefix ? length : length - 1);
+    if (!prefix) s.prefix[ol + length - 1] = '_';
+    s.own_prefix = ol;
+  }
+  s.mirror = (parent && parent->mirror) != (mirror != NULL && scalar_equals(mirror, "true"));
+  char *canonical = realpath(s.path, NULL);
+  bool cycle = false;
+  for (int d = 0; canonical && d < c->depth; d++) cycle = cycle || strcmp(c->stack[d], canonical) == 0;
+  yaml_document_t src;
+  int k = 0;
+  if (cycle) {
+    diag_error(from_path, at, "'%s' is already being instantiated (subsystem cycle)", s.path);
+    ok = false;
+  } else if (c->depth >= LIMIT_INCLUDE_DEPTH) {
+    diag_error(from_path, at, "subsystems nested more than %d deep", LIMIT_INCLUDE_DEPTH);
+    ok = false;
+  } else if ((k = diag_register_instance(s.path, name, s.prefix, at, from_path)) == 0) {
+    diag_error(from_path, at, "more than %d included files", DIAG_MAX_FILES);
+    ok = false;
+  } else if (!load_file(s.path, at, from_path, k, &src)) {
+    ok = false;
+  }
+  if (!ok) {
+    free(canonical);
+    free((char *)s.path);
+    free(s.prefix);
+    free(name);
+    c->ok = false;
+    return;
+  }
+  c->stack[c->depth++] = canonical;
+  if (c->files->count < (int)(sizeof c->files->path / sizeof *c->files->path))
+    c->files->path[c->files->count++] = xstrdup(s.path);
+  instancer g = {c, &s, expand_merges(s.path, &src)};
+  yaml_node_t *root = yaml_document_get_root_node(&src);
+  if (root->type != YAML_MAPPING_NODE) {
+    diag_error(s.path, mark_loc(root->start_mark), "a subsystem file must be a mapping of sections");
+    g.ok = false;
+  } else {
+    g.ok = read_header(c, &s, &src, at, from_path) && g.ok;
+    static const char *const allowed[] = {"subsystem", "parameters", "bodies", "joints", "drivers", "forces",
+                                          "outputs", "subsystems", "templates", NULL};
+    for (int i = 0; i < npairs(root); i++) {
+      yaml_node_t *sk = yaml_document_get_node(&src, root->data.mapping.pairs.start[i].key);
+      yaml_node_t *sv = yaml_document_get_node(&src, root->data.mapping.pairs.start[i].value);
+      bool known = false;
+      for (int a = 0; allowed[a] && !known; a++) known = scalar_equals(sk, allowed[a]);
+      if (!known) {
+        diag_error(s.path, mark_loc(sk->start_mark),
+                   "this key cannot be in a subsystem file (it has subsystem, parameters, bodies, joints, drivers, "
+                   "forces, outputs, subsystems and templates)");
+        g.ok = false;
+        continue;
+      }
+      for (int kind = 0; kind < KIND_COUNT; kind++) {
+        if (!scalar_equals(sk, kind_section[kind])) continue;
+        if (sv->type != YAML_MAPPING_NODE) {
+          diag_error(s.path, mark_loc(sv->start_mark), "'%s' must be a mapping", kind_section[kind]);
+          g.ok = false;
+          continue;
+        }
+        for (int j = 0; j < npairs(sv); j++) {
+          yaml_node_t *ek = yaml_document_get_node(&src, sv->data.mapping.pairs.start[j].key);
+          if (ek->type == YAML_SCALAR_NODE)
+            names_add(&s.local[kind], (const char *)ek->data.scalar.value, ek->data.scalar.length);
+        }
+      }
+      if (scalar_equals(sk, "outputs") && sv->type != YAML_SEQUENCE_NODE) {
+        diag_error(s.path, mark_loc(sv->start_mark), "'outputs' must be a list");
+        g.ok = false;
+      }
+    }
+  }
+  /* the instance's attachments: each one mapped, to a body of the enclosing model or subsystem */
+  s.attach_to = xcalloc((size_t)s.attach.count + 1, sizeof *s.attach_to);
+  for (int i = 0; g.ok && attach != NULL && i < npairs(attach); i++) {
+    yaml_node_t *ak = yaml_document_get_node(from_doc, attach->data.mapping.pairs.start[i].key);
+    yaml_node_t *av = yaml_document_get_node(from_doc, attach->data.mapping.pairs.start[i].value);
+    int a = ak->type == YAML_SCALAR_NODE ? names_find(&s.attach, (const char *)ak->data.scalar.value,
+                                                      ak->data.scalar.length) : -1;
+    if (a < 0) {
+      char list[512] = "";
+      for (int j = 0; j < s.attach.count; j++)
+        snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", j ? ", " : "", s.attach.name[j]);
+      diag_error(from_path, mark_loc(ak->start_mark), "unknown attachment '%.*s' of the subsystem '%s' (it has: %s)",
+                 ak->type == YAML_SCALAR_NODE ? (int)ak->data.scalar.length : 1,
+                 ak->type == YAML_SCALAR_NODE ? (const char *)ak->data.scalar.value : "?", s.path,
+                 s.attach.count ? list : "none");
+      g.ok = false;
+      continue;
+    }
+    char *to = av->type != YAML_SCALAR_NODE ? NULL
+               : a >= s.nbody_attach ? xstrndup((const char *)av->data.scalar.value, av->data.scalar.length)
+               : resolve(parent, KIND_BODY, (const char *)av->data.scalar.value, av->data.scalar.length);
+    if (to == NULL) {
+      diag_error(from_path, mark_loc(av->start_mark), "attachment '%s' must name a body%s", s.attach.name[a],
+                 parent ? " of the enclosing subsystem, 'ground' or one of its attachments" : "");
+      g.ok = false;
+      continue;
+    }
+    free(s.attach_to[a]);
+    s.attach_to[a] = to;
+  }
+  for (int a = 0; g.ok && a < s.attach.count; a++)
+    if (s.attach_to[a] == NULL) {
+      diag_error(from_path, at, "subsystem instance '%s' does not say what its attachment '%s' is ('attach: {%s: BODY}')",
+                 name, s.attach.name[a], s.attach.name[a]);
+      g.ok = false;
+    }
+  /* parameter overrides name parameters of the subsystem */
+  for (int i = 0; g.ok && params != NULL && i < npairs(params); i++) {
+    yaml_node_t *pk = yaml_document_get_node(from_doc, params->data.mapping.pairs.start[i].key);
+    if (pk->type != YAML_SCALAR_NODE ||
+        names_find(&s.local[KIND_PARAM], (const char *)pk->data.scalar.value, pk->data.scalar.length) < 0) {
+      diag_error(from_path, mark_loc(pk->start_mark), "the subsystem '%s' has no parameter '%.*s' to set", s.path,
+                 pk->type == YAML_SCALAR_NODE ? (int)pk->data.scalar.length : 1,
+                 pk->type == YAML_SCALAR_NODE ? (const char *)pk->data.scalar.value : "?");
+      g.ok = false;
+    }
+  }
+  /* inner instances first: the subsystem's own elements may name what they make */
+  if (g.ok) {
+    bool outer_ok = c->ok;
+    c->ok = true;
+    instantiate_all(c, &s, s.path, &src);
+    g.ok = c->ok;
+    c->ok = outer_ok;
+  }
+  if (g.ok) {
+    int *copied = xcalloc((size_t)(src.nodes.top - src.nodes.start) + 1, sizeof *copied);
+    int *copied_from = from_doc == c->doc ? NULL
+                                          : xcalloc((size_t)(from_doc->nodes.top - from_doc->nodes.start) + 1, sizeof *copied_from);
+    root = yaml_document_get_root_node(&src);
+    bool clash = false;
+    for (int i = 0; i < npairs(root); i++) {
+      yaml_node_pair_t p = root->data.mapping.pairs.start[i];
+      yaml_node_t *sk = yaml_document_get_node(&src, p.key);
+      bool outputs = scalar_equals(sk, "outputs");
+      int kind = -1;
+      for (int kk = 0; kk < KIND_COUNT; kk++)
+        if (scalar_equals(sk, kind_section[kk])) kind = kk;
+      if (kind < 0 && !outputs) continue;
+      yaml_node_t *sv = yaml_document_get_node(&src, p.value);
+      if (outputs) {
+        if (sv->type != YAML_SEQUENCE_NODE) continue;
+        int target = model_section(c, "outputs", true);
+        for (int j = 0; j < (int)(sv->data.sequence.items.top - sv->data.sequence.items.start); j++) {
+          sv = yaml_document_get_node(&src, p.value);
+          int o = copy_node(c, &src, sv->data.sequence.items.start[j], copied);
+          if (yaml_document_get_node(c->doc, o)->type == YAML_MAPPING_NODE) instance_output(&g, o);
+          if (!yaml_document_append_sequence_item(c->doc, target, o)) out_of_memory();
+        }
+        continue;
+      }
+      if (sv->type != YAML_MAPPING_NODE) continue;
+      int target = model_section(c, kind_section[kind], false);
+      for (int j = 0; j < npairs(sv); j++) {
+        sv = yaml_document_get_node(&src, p.value);
+        yaml_node_pair_t q = sv->data.mapping.pairs.start[j];
+        yaml_node_t *ek = yaml_document_get_node(&src, q.key);
+        if (ek->type != YAML_SCALAR_NODE) continue;
+        char *full = resolve(&s, kind, (const char *)ek->data.scalar.value, ek->data.scalar.length);
+        /* a name the model (or another instance) already has: the prefixes clash */
+        yaml_node_t *t = yaml_document_get_node(c->doc, target);
+        for (yaml_node_pair_t *tp = t->data.mapping.pairs.start; !clash && tp < t->data.mapping.pairs.top; tp++)
+          if (scalar_equals(yaml_document_get_node(c->doc, tp->key), full)) {
+            yaml_node_t *other = yaml_document_get_node(c->doc, tp->key);
+            diag_error(from_path, at, "prefix clash: the subsystem instance '%s' makes the %s '%s', which exists "
+                       "already", name, kind_word[kind], full);
+            diag_note(c->path, mark_loc(other->start_mark), "the %s '%s' is defined here", kind_word[kind], full);
+            g.ok = false;
+            clash = true; /* one message per instance */
+          }
+        int keyn = add_scalar_like(c->doc, yaml_document_get_node(&src, q.key), NULL, full);
+        free(full);
+        int value = copy_node(c, &src, q.value, copied);
+        if (kind == KIND_PARAM && params != NULL) { /* the instance's value wins */
+          ek = yaml_document_get_node(&src, q.key);
+          params = yaml_document_get_node(from_doc, params_index); /* c->doc's nodes may have moved */
+          for (int a = 0; a < npairs(params); a++) {
+            yaml_node_pair_t o = params->data.mapping.pairs.start[a];
+            if (!same_scalar(yaml_document_get_node(from_doc, o.key), ek)) continue;
+            int over = copied_from ? copy_node(c, from_doc, o.value, copied_from) : o.value;
+            yaml_node_item_t *slot = value_slot(c->doc, value, "value");
+            if (slot != NULL) *slot = over;
+            else value = over;
+          }
+        }
+        if (kind != KIND_PARAM) {
+          /* a fresh mapping: copies of one anchor would otherwise share the renaming */
+          yaml_node_t *vn = yaml_document_get_node(c->doc, value);
+          if (vn->type == YAML_MAPPING_NODE) {
+            int fresh = yaml_document_add_mapping(c->doc, vn->tag, vn->data.mapping.style);
+            if (!fresh) out_of_memory();
+            vn = yaml_document_get_node(c->doc, value);
+            int count = npairs(vn);
+            yaml_mark_t sm = vn->start_mark, em = vn->end_mark;
+            for (int a = 0; a < count; a++) {
+              vn = yaml_document_get_node(c->doc, value);
+              yaml_node_pair_t vp = vn->data.mapping.pairs.start[a];
+              if (!yaml_document_append_mapping_pair(c->doc, fresh, vp.key, vp.value)) out_of_memory();
+            }
+            yaml_node_t *f = yaml_document_get_node(c->doc, fresh);
+            f->start_mark = sm;
+            f->end_mark = em;
+            value = fresh;
+            if (kind == KIND_JOINT || kind == KIND_FORCE) {
+              rename_key(&g, value, "bodies", KIND_BODY);
+              rename_nodes(&g, value);
+            }
+            if (kind == KIND_FORCE) rename_key(&g, value, "body", KIND_BODY);
+            if (kind == KIND_DRIVER) rename_key(&g, value, "joint", KIND_JOINT);
+            if (s.mirror) mirror_element(&g, kind, value);
+          }
+        }
+        if (!yaml_document_append_mapping_pair(c->doc, target, keyn, value)) out_of_memory();
+      }
+    }
+    free(copied);
+    free(copied_from);
+  }
+  /* what the instance made, named in the enclosing scope */
+  if (parent != NULL)
+    for (int kind = 0; kind < KIND_COUNT; kind++)
+      for (int i = 0; i < s.local[kind].count; i++) {
+        const char *own = s.prefix + s.own_prefix;
+        char *made = xcalloc(strlen(own) + strlen(s.local[kind].name[i]) + 1, 1);
+        strcpy(made, own);
+        strcat(made, s.local[kind].name[i]);
+        names_add(&parent->local[kind], made, strlen(made));
+        free(made);
+      }
+  free(c->stack[--c->depth]);
+  yaml_document_delete(&src);
+  for (int kind = 0; kind < KIND_COUNT; kind++) names_free(&s.local[kind]);
+  for (int a = 0; a < s.attach.count; a++) free(s.attach_to[a]);
+  free(s.attach_to);
+  names_free(&s.attach);
+  free((char *)s.path);
+  free(s.prefix);
+  free(name);
+  if (!g.ok) c->ok = false;
+}
+
 static bool compose_into(includer *c, const char *path, yaml_document_t *doc) {
   bool ok = expand_merges(path, doc);
   include_files(c, path, doc);
@@ -412,10 +1151,11 @@ bool compose_document(const char *path, yaml_document_t *doc, compose_files *fil
   if (!expand_merges(path, doc)) return false;
   yaml_node_t *root = yaml_document_get_root_node(doc);
   if (root == NULL || root->type != YAML_MAPPING_NODE) return true; /* the reader says what is wrong */
-  includer c = {.doc = doc, .files = files, .ok = true};
+  includer c = {.path = path, .doc = doc, .files = files, .ok = true};
   c.stack[0] = realpath(path, NULL);
   c.depth = c.stack[0] != NULL;
   include_files(&c, path, doc);
+  instantiate_all(&c, NULL, path, doc);
   while (c.depth > 0) free(c.stack[--c.depth]);
   return c.ok;
 }

@@ -13,6 +13,14 @@
 
 #define LIMIT_INCLUDE_DEPTH 16
 
+/* A scalar whose sign a mirrored subsystem instance flips (y -> -y) carries
+ * this tag; the reader's numbers (yaml_map.c to_number, params.c) negate it,
+ * so that messages still point at the text as written. */
+#define COMPOSE_MIRROR_TAG "tag:mbcc:mirrored"
+bool compose_is_mirrored(const yaml_node_t *n);
+/* -v, but +0 for 0 (a mirrored 0 is written 0, not -0) */
+double compose_mirror_value(double v);
+
 /* the files included (for the input hash) */
 typedef struct {
   char *path[DIAG_MAX_FILES];

@@ -28,10 +28,49 @@ static bool muted;
 void diag_mute(int on) { muted = on != 0; }
 static char *registered[DIAG_MAX_FILES + 1];
 static int nregistered;
+/* per registered file: the subsystem instance it holds (NULL name: none) */
+static struct {
+  char *name, *prefix, *from_file;
+  ir_loc from;
+  int parent;
+} instance[DIAG_MAX_FILES + 1];
+
+static char *copy_text(const char *s) {
+  size_t length = strlen(s);
+  char *copy = malloc(length + 1);
+  if (copy != NULL) memcpy(copy, s, length + 1);
+  return copy;
+}
+
+int diag_register_instance(const char *path, const char *name, const char *prefix, ir_loc from,
+                           const char *from_file) {
+  if (nregistered == DIAG_MAX_FILES) return 0;
+  char *copy = copy_text(path);
+  if (copy == NULL) return 0;
+  registered[++nregistered] = copy;
+  int parent = from.line > 0 ? from.line / DIAG_FILE_LINES : 0;
+  instance[nregistered].name = copy_text(name);
+  instance[nregistered].prefix = copy_text(prefix);
+  instance[nregistered].from_file = copy_text(diag_loc_file(from, from_file ? from_file : "mbcc"));
+  instance[nregistered].from = diag_loc_in_file(from);
+  instance[nregistered].parent = parent >= 1 && parent < nregistered && instance[parent].name ? parent : 0;
+  return nregistered;
+}
+
+int diag_loc_instance(ir_loc loc) {
+  int k = loc.line > 0 ? loc.line / DIAG_FILE_LINES : 0;
+  return k >= 1 && k <= nregistered && instance[k].name ? k : 0;
+}
+
+const char *diag_instance_prefix(int k) {
+  return k >= 1 && k <= nregistered && instance[k].prefix ? instance[k].prefix : "";
+}
+
+int diag_instance_parent(int k) { return k >= 1 && k <= nregistered ? instance[k].parent : 0; }
 
 int diag_register_file(const char *path) {
   for (int k = 1; k <= nregistered; k++)
-    if (strcmp(registered[k], path) == 0) return k;
+    if (instance[k].name == NULL && strcmp(registered[k], path) == 0) return k;
   if (nregistered == DIAG_MAX_FILES) return 0;
   size_t length = strlen(path);
   char *copy = malloc(length + 1);
@@ -56,6 +95,7 @@ static void print(const char *file, ir_loc loc, const char *severity,
                   const char *fmt, va_list ap) {
   if (muted) return;
   char line[2048];
+  ir_loc loc_in = loc;
   file = diag_loc_file(loc, file);
   loc = diag_loc_in_file(loc);
   int n = snprintf(line, sizeof line, "%s", file == NULL ? "mbcc" : file);
@@ -73,6 +113,10 @@ static void print(const char *file, ir_loc loc, const char *severity,
   }
   fputs(line, stderr);
   fputc('\n', stderr);
+  /* like a C compiler's "in expansion of": where the instance came from */
+  for (int k = severity[0] == 'n' ? 0 : diag_loc_instance(loc_in); k != 0; k = instance[k].parent)
+    fprintf(stderr, "%s:%d:%d: note: in the subsystem '%s' instantiated here\n", instance[k].from_file,
+            instance[k].from.line, instance[k].from.col > 0 ? instance[k].from.col : 1, instance[k].name);
 }
 
 void diag_verror(const char *file, ir_loc loc, const char *fmt, va_list ap) {

@@ -43,6 +43,20 @@ int diag_register_file(const char *path);
 const char *diag_loc_file(ir_loc loc, const char *file);
 ir_loc diag_loc_in_file(ir_loc loc);
 
+/* A subsystem instance (compose.c) is registered as a file of its own,
+ * even when another instance reads the same file: its lines then carry the
+ * instance, whose parameter names are looked up with 'prefix' first (then in
+ * the enclosing instance 'parent', 0 for the model), and every message in
+ * it is followed by a note "in the subsystem 'name' instantiated from
+ * <from>".  Returns the number k as diag_register_file, or 0. */
+int diag_register_instance(const char *path, const char *name, const char *prefix, ir_loc from,
+                           const char *from_file);
+/* the instance of a location's file (0: the model or an included file), its
+ * full name prefix ("" for 0) and its enclosing instance */
+int diag_loc_instance(ir_loc loc);
+const char *diag_instance_prefix(int k);
+int diag_instance_parent(int k);
+
 int diag_errors(void);   /* errors reported so far (shown or not) */
 int diag_warnings(void); /* warnings reported so far */
 void diag_reset(void);

@@ -401,6 +401,8 @@ typedef struct {
   int state;          /* while reading: 0 not evaluated, 1 being evaluated, 2 done, 3 failed */
 } ir_param;
 
+typedef enum { RULE_ANY, RULE_NONNEGATIVE, RULE_POSITIVE } ir_value_rule;
+
 /* A numeric field of the model written as an expression that names parameters. */
 typedef struct {
   ir_loc loc;
@@ -408,6 +410,11 @@ typedef struct {
   double value;
   bool uses_runtime;
   bool pruned;        /* in a body, joint, driver or force that the scene removed */
+  /* the rule the reader checks the field's value against, recorded where it
+     checks it (params_note_rule), so that a run-time value is checked the
+     same way (--set, sweeps, the generated set_params) */
+  ir_value_rule rule;
+  char field[40];     /* the field's key as the message names it, e.g. 'stiffness' */
 } ir_expr_use;
 
 /* --- the model ------------------------------------------------------------------------- */

@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "bounds.h"
+#include "compose.h"
 
 static const struct {
   const char *name;
@@ -247,7 +248,15 @@ static int parse_primary(parser *p, int depth) {
     }
     const ir_model *m = p->r->model;
     char suggest[128];
-    int param = find_length(m, name, n, suggest, sizeof suggest);
+    /* in a subsystem instance, its own (prefixed) parameters hide the
+       enclosing ones' (compose.c) */
+    int param = -1;
+    for (int in = diag_loc_instance(loc_of(p->scalar)); param < 0 && in != 0; in = diag_instance_parent(in)) {
+      char scoped[256];
+      int length = snprintf(scoped, sizeof scoped, "%s%.*s", diag_instance_prefix(in), (int)n, name);
+      if (length > 0 && (size_t)length < sizeof scoped) param = find_length(m, scoped, (size_t)length, NULL, 0);
+    }
+    if (param < 0) param = find_length(m, name, n, suggest, sizeof suggest);
     if (param < 0) {
       if (is_reserved(name, n))
         fail(p, start, false, "'%s' is a function: write %s(...)", show_text(p->r, name, n),
@@ -453,6 +462,25 @@ static void record_use(reader *r, const yaml_node_t *n, ir_expr *e, double value
   u->uses_runtime = runtime;
 }
 
+void params_note_rule(reader *r, ir_loc loc, ir_value_rule rule, const char *field) {
+  ir_model *m = r->model;
+  if (m == NULL) return;
+  for (int i = m->nuses - 1; i >= 0; i--)
+    if (m->uses[i].loc.line == loc.line && m->uses[i].loc.col == loc.col) {
+      m->uses[i].rule = rule;
+      snprintf(m->uses[i].field, sizeof m->uses[i].field, "%s", field);
+      return;
+    }
+}
+
+const char *params_rule_text(ir_value_rule rule) {
+  return rule == RULE_NONNEGATIVE ? "must be >= 0" : rule == RULE_POSITIVE ? "must be positive" : "";
+}
+
+bool params_rule_holds(ir_value_rule rule, double v) {
+  return rule == RULE_NONNEGATIVE ? v >= 0 : rule == RULE_POSITIVE ? v > 0 : true;
+}
+
 int expr_number(reader *r, yaml_node_t *n, const char *label, double *out) {
   if (n->type != YAML_SCALAR_NODE || scalar_length(n) == 0 || r->model == NULL) return 0;
   ir_expr e;
@@ -470,6 +498,15 @@ int expr_number(reader *r, yaml_node_t *n, const char *label, double *out) {
     /* without 'parameters:', not an expression: the caller says "must be a
        number"; with, a parameter it names failed and was reported there */
     return r->params_block ? -1 : 0;
+  }
+  if (compose_is_mirrored(n)) {
+    if (runtime) {
+      error_at(r, loc_of(n), "%s is mirrored (a subsystem instance with 'mirror: true') and cannot use a run-time "
+               "parameter", label);
+      free(e.node);
+      return -1;
+    }
+    value = compose_mirror_value(value);
   }
   *out = value;
   if (names_any(&e)) record_use(r, n, &e, value, runtime);
@@ -638,6 +675,44 @@ void parse_parameters(reader *r, yaml_node_t *n) {
 /* ---------------------------------------------------------------------------
  * C text
  * ------------------------------------------------------------------------- */
+
+static double eval_runtime(const ir_model *m, const ir_expr *e, int k, const double *p) {
+  const ir_expr_node *n = &e->node[k];
+  double a = n->a >= 0 ? eval_runtime(m, e, n->a, p) : 0, b = n->b >= 0 ? eval_runtime(m, e, n->b, p) : 0;
+  switch (n->op) {
+  case EXPR_NUMBER: return n->number;
+  case EXPR_PARAM: {
+    const ir_param *P = &m->params[n->param];
+    if (P->runtime) return p[params_runtime_index(m, n->param)];
+    if (P->uses_runtime && P->expr) return eval_runtime(m, P->expr, P->expr->root, p);
+    return P->value;
+  }
+  case EXPR_NEG: return -a;
+  case EXPR_ADD: return a + b;
+  case EXPR_SUB: return a - b;
+  case EXPR_MUL: return a * b;
+  case EXPR_DIV: return a / b;
+  case EXPR_POW: return pow(a, b);
+  case EXPR_CALL:
+    switch (n->param) {
+    case FN_SQRT: return sqrt(a);
+    case FN_SIN: return sin(a);
+    case FN_COS: return cos(a);
+    case FN_TAN: return tan(a);
+    case FN_ATAN2: return atan2(a, b);
+    case FN_EXP: return exp(a);
+    case FN_LOG: return log(a);
+    case FN_ABS: return fabs(a);
+    case FN_MIN: return fmin(a, b);
+    case FN_MAX: return fmax(a, b);
+    }
+  }
+  return NAN;
+}
+
+double expr_eval_runtime(const ir_model *m, const ir_expr *e, const double *p) {
+  return eval_runtime(m, e, e->root, p);
+}
 
 static void print_number(FILE *f, double v) {
   char text[40];

@@ -30,10 +30,21 @@ int params_find(const ir_model *m, const char *name, char *suggest, size_t size)
 /* the expression as C over the run-time parameter vector 'vector' (p[i] for
  * run-time parameter i, in the order of run-time parameters among params) */
 void expr_print_c(FILE *f, const ir_model *m, const ir_expr *e, const char *vector);
+/* the expression's value with run-time parameter i at p[i] (as the
+ * generated code computes it; NaN out of a function's domain) */
+double expr_eval_runtime(const ir_model *m, const ir_expr *e, const double *p);
 /* index among run-time parameters of params[k], or -1 */
 int params_runtime_index(const ir_model *m, int k);
 /* whether e names params[k] directly */
 bool expr_names(const ir_expr *e, int k);
+
+/* The field at 'loc' (if written as an expression over parameters) obeys
+ * 'rule': recorded in its use (ir_expr_use.rule) for run-time values. */
+void params_note_rule(reader *r, ir_loc loc, ir_value_rule rule, const char *field);
+/* " must be >= 0" and the like, "" for RULE_ANY */
+const char *params_rule_text(ir_value_rule rule);
+/* whether v obeys the rule */
+bool params_rule_holds(ir_value_rule rule, double v);
 
 void params_free(ir_model *m);
 

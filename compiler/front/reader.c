@@ -2032,7 +2032,7 @@ static void parse_model(reader *r, yaml_node_t *root, const char *chosen_scene_n
   map_open(&top, r, root, file_start, "the model");
   static const char *const keys[] = {"name",    "gravity", "bodies",     "joints", "drivers",
                                      "forces",  "outputs", "simulation", "scenes", "parameters",
-                                     "include", "templates", "roads", NULL};
+                                     "include", "templates", "roads", "subsystems", NULL};
   map_check_keys(&top, keys);
   /* first: every numeric field may name parameters */
   parse_parameters(r, map_get(&top, "parameters"));

@@ -5,6 +5,7 @@
  * parsers of compiler/elements/ and fe.c. */
 #include "yaml_map.h"
 #include "bounds.h"
+#include "compose.h"
 #include "params.h"
 
 #include <errno.h>
@@ -309,7 +310,7 @@ bool to_number(reader *r, yaml_node_t *n, const char *label, double *out) {
     double value = blank_start ? 0 : strtod(text, &end);
     if (!blank_start && end == text + scalar_length(n)) {
       if (isfinite(value) && fabs(value) <= LIMIT_MAGNITUDE) {
-        *out = value;
+        *out = compose_is_mirrored(n) ? compose_mirror_value(value) : value;
         return true;
       }
       if (isfinite(value)) {
@@ -453,10 +454,19 @@ bool get_number(mapping *m, const char *key, bool required, double *out) {
   return n != NULL && to_number(m->r, n, label, out);
 }
 
+/* the rule of field 'key' of m noted for a value written as an expression */
+static void note_rule(mapping *m, const char *key, ir_value_rule rule) {
+  yaml_node_t *n = map_get(m, key);
+  char label[64];
+  quote_key(label, sizeof label, key);
+  if (n != NULL) params_note_rule(m->r, loc_of(n), rule, label);
+}
+
 bool get_positive(mapping *m, const char *key, bool required, double *out) {
   double value;
   if (!get_number(m, key, required, &value))
     return false;
+  note_rule(m, key, RULE_POSITIVE);
   if (!(value > 0)) {
     error_at(m->r, m->last_loc, "'%s' must be positive (got %g)", key, value);
     return false;
@@ -469,6 +479,7 @@ bool get_nonnegative(mapping *m, const char *key, bool required, double *out) {
   double value;
   if (!get_number(m, key, required, &value))
     return false;
+  note_rule(m, key, RULE_NONNEGATIVE);
   if (!(value >= 0)) {
     error_at(m->r, m->last_loc, "'%s' must be >= 0 (got %g)", key, value);
     return false;

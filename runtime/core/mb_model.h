@@ -182,11 +182,14 @@ typedef struct mb_model {
    * of the generated code, changed without recompiling (the simulator's --set
    * NAME=VALUE).  set_params(m, p) writes the force pools from the vector p of
    * nparam values (defaults param_value, bounds param_min..param_max) before a
-   * run; not safe while another thread evaluates the model.  0 / NULL: none. */
+   * run and returns NULL; when a value a field takes breaks the field's rule
+   * (a stiffness >= 0, ...) it writes nothing and returns the rule, naming
+   * the force, the field and its place in the model.  Not safe while another
+   * thread evaluates the model.  0 / NULL: none. */
   int nparam;
   const char *const *param_name;
   const mb_real *param_value, *param_min, *param_max;
-  void (*set_params)(const struct mb_model *m, const mb_real *p);
+  const char *(*set_params)(const struct mb_model *m, const mb_real *p);
   /* force-element tangents on the pattern (models compiled for an implicit
    * method; NULL otherwise): force_tslot[e] is the first of force e's slots
    * in tangent_slot, or -1 when it has none.  Its slots are four blocks of

@@ -286,8 +286,14 @@ static int apply_sets(const mb_model *m, const char *prog, int nsets, const char
     }
     p[k] = (mb_real)v;
   }
-  m->set_params(m, p);
+  const char *broken = m->set_params(m, p);
   free(p);
+  if (broken) {
+    fprintf(stderr, "%s: error: --set", prog);
+    for (int i = 0; i < nsets; i++) fprintf(stderr, " %s", sets[i]);
+    fprintf(stderr, ": %s\n", broken);
+    return 2;
+  }
   return 0;
 }
 
