@@ -26,7 +26,7 @@
 
 #include "emit_split.h"
 
-#define DEFAULT_PART_BYTES 0L /* 0: one function */
+#define DEFAULT_PART_BYTES 24000L /* measured: docs/benchmarks.md, "Evaluation in parts" */
 
 long eval_part_bytes(void) {
   const char *e = getenv("MBCC_EVAL_PART_BYTES");
