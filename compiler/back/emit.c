@@ -22,6 +22,7 @@
 #include "emit_ldl.h"
 #include "emit_force.h"
 #include "emit_rows.h"
+#include "emit_split.h"
 #include "element.h"
 #include "emit_util.h"
 #include "sym.h"
@@ -633,12 +634,18 @@ static void emit_flex_contract(emit_ctx *cx, int b) {
   free(idx);
 }
 
+/* the evaluation's body is written to a memory stream with its elements
+ * marked; emit_split.c writes it as one function or, when large, in parts */
 static void emit_eval(emit_ctx *cx) {
-  FILE *f = cx->f;
+  FILE *out = cx->f;
+  eval_split sp;
+  if (eval_split_begin(&sp)) { cx->failed = 1; return; }
+  FILE *f = sp.body;
   const lmodel *L = cx->L;
   const char *nm = cx->nm;
   const mb_model *m = &L->m;
-  fprintf(f,
+  char head[1024];
+  snprintf(head, sizeof head,
           "\n/* Fill the varying entries of K, rhs = [f; gamma], phi and phid = D v - nu at (t, q, v). */\n"
           "void %s_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,\n"
           "    mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *phid, void *work) {\n"
@@ -647,14 +654,18 @@ static void emit_eval(emit_ctx *cx) {
           "  (void)m; (void)work; (void)t; (void)x; (void)c; (void)r; (void)zero3;\n"
           "  (void)Kx; (void)phi; (void)phid;\n",
           nm);
+  eval_split_mark(&sp, "the body frames");
   /* frames and markers are separate variables, not arrays: the C compiler
      then drops the fields no row reads and keeps the rest compact, where an
      array of markers had to live whole in the stack frame (about a kilobyte
      more of L1 per evaluation on the flexible slider-crank) */
   fprintf(f, "\n  /* body frames */\n");
-  for (int b = 0; b < m->nbody; b++)
+  for (int b = 0; b < m->nbody; b++) {
+    if (b) eval_split_mark(&sp, "the frame of body '%s'", L->body[b].name);
     fprintf(f, "  mb_frame f%d;\n  mb_frame_rigid(q + %d, v + %d, &f%d); /* body '%s' */\n", b,
             L->body[b].qadr, L->body[b].vadr, b, L->body[b].name);
+  }
+  eval_split_mark(&sp, "the markers");
   fprintf(f, "\n  /* markers */\n");
   /* use[k]: 0 no row or force element reads marker k (a joint whose rows were
      all removed as redundant): not computed; 1 only the spherical and dot-1
@@ -662,7 +673,7 @@ static void emit_eval(emit_ctx *cx) {
      its body's frame: then it is not stored); 2 forces or other rows pass it
      to kernels by address */
   char *use = calloc(m->nmarker ? (size_t)m->nmarker : 1, 1);
-  if (!use) { cx->failed = 1; return; }
+  if (!use) { cx->failed = 1; eval_split_finish(&sp, NULL, nm, head); return; }
   for (int i = 0; i < m->nforce; i++) {
     use[L->force[i].m0] = 2;
     if (L->force[i].m1 >= 0) use[L->force[i].m1] = 2;
@@ -674,6 +685,7 @@ static void emit_eval(emit_ctx *cx) {
   }
   for (int k = 0; k < m->nmarker; k++) {
     const mb_markerdef *d = &L->marker[k];
+    if (k) eval_split_mark(&sp, "marker %d (%s)", k, L->marker_desc[k]);
     fprintf(f, "  /* %s */\n", L->marker_desc[k]);
     if (!use[k]) {
       fputs("  /* read by no row or force element: not computed */\n", f);
@@ -697,9 +709,11 @@ static void emit_eval(emit_ctx *cx) {
     }
   }
   free(use);
+  eval_split_mark(&sp, "the body forces");
   fprintf(f, "\n  /* body forces: gravity and the quadratic-velocity (gyroscopic) terms */\n");
   for (int b = 0; b < m->nbody; b++) {
     const mb_body *B = &L->body[b];
+    if (b) eval_split_mark(&sp, "the forces of body '%s'", B->name);
     fprintf(f, "  /* body '%s' */\n", B->name);
     if (B->kind == MB_BODY_FLEXIBLE) {
       int nbk = 6 + B->nm;
@@ -734,20 +748,28 @@ static void emit_eval(emit_ctx *cx) {
       fprintf(f, ", f%d.wl, rhs + %d);\n", b, B->vadr + 3);
     }
   }
+  if (m->nforce) eval_split_mark(&sp, "the force elements");
   if (m->nforce) fprintf(f, "\n  /* force elements */\n");
   for (int k = 0; k < m->nforce; k++) {
     const ir_force *F = &L->ir->forces[L->force_ir[k]];
+    if (k) eval_split_mark(&sp, "force '%s'", F->name);
     fprintf(f, "  { /* force '%s' (", F->name);
     loc_comment(f, L, F->loc);
     fputs(") */\n", f);
     force_element(F->kind)->emit_eval(f, L, k);
     fputs("  }\n", f);
   }
+  eval_split_mark(&sp, "the constraint rows");
   fprintf(f, "\n  /* constraint rows: D in both triangles of K, gamma, phi, phid */\n");
+  fflush(f);
+  long shared_from = ftell(f);
   if (emit_rows_shared(f, L)) cx->failed = 1;
+  /* its blocks, one per pair of bodies, are independent (emit_rows.c) */
+  eval_split_mark_lines(&sp, shared_from, "  /* relative rotation", "the relative rotations of a pair of bodies");
   static const char *prim[] = {"", "sph", "dot1", "dot2", "dist", "rot", "trans"};
   for (int r = 0; r < m->nrow; r++) {
     const mb_rowdef *R = &L->row[r];
+    eval_split_mark(&sp, "row %d (%s)", r, L->row_desc[r]);
     fprintf(f, "  /* row %d: %s (", r, L->row_desc[r]);
     loc_comment(f, L, L->row_loc[r]);
     fputs(") */\n", f);
@@ -784,7 +806,7 @@ static void emit_eval(emit_ctx *cx) {
       emit_row_stores(f, L, r, s, cs, "  ");
     }
   }
-  fputs("}\n", f);
+  if (eval_split_finish(&sp, out, nm, head) < 0) cx->failed = 1;
 }
 
 static void emit_init(emit_ctx *cx) {

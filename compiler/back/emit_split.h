@@ -1,0 +1,39 @@
+/* emit_split.h: the generated evaluation split into functions of bounded size
+ * (emit_split.c).  emit_eval writes its body into an eval_split's memory
+ * stream and marks the boundaries between elements (a frame, a marker, a body
+ * force, a force element, a row); eval_split_finish writes the body either as
+ * one function, as before, or, when it is large, as parts of about
+ * eval_part_bytes() each plus a function that calls them in order. */
+#ifndef MBCC_EMIT_SPLIT_H
+#define MBCC_EMIT_SPLIT_H
+
+#include <stdio.h>
+
+typedef struct {
+  FILE *body;  /* where emit_eval writes the function body */
+  char *text;  /* the body's text once closed */
+  size_t len;
+  long *mark;  /* offsets where a part may start, ascending */
+  char **label; /* what starts there (a comment text) */
+  int nmark, cap;
+  int failed;
+} eval_split;
+
+/* open the body stream; 0, or -1 out of memory */
+int eval_split_begin(eval_split *s);
+/* the text written from here on belongs to a new element 'label' (printf style) */
+void eval_split_mark(eval_split *s, const char *fmt, ...);
+/* a new element 'label' at each line written since offset 'from' that starts
+ * with 'prefix' (a block of independent statements, e.g. one per pair of
+ * bodies, that may go to different parts) */
+void eval_split_mark_lines(eval_split *s, long from, const char *prefix, const char *label);
+/* about this many bytes of body text per part; the body is split when it is
+ * larger than two parts (MBCC_EVAL_PART_BYTES overrides it, for measurement) */
+long eval_part_bytes(void);
+/* write the evaluation 'nm'_eval to out: 'head' is the monolithic function's
+ * signature and locals (written as they were before the split); the parts get
+ * the same scratch locals.  Returns the number of parts (1: one function), or
+ * -1 out of memory.  Frees s. */
+int eval_split_finish(eval_split *s, FILE *out, const char *nm, const char *head);
+
+#endif
