@@ -291,7 +291,7 @@ static int cmd_check(const options *o) {
   for (int k = 0; k < ir->nparams; k++) {
     const ir_param *P = &ir->params[k];
     printf("    %-16s %.15g%s%s %s", P->name, P->value, P->unit ? " " : "", P->unit ? P->unit : "",
-           P->runtime ? "run-time" : P->uses_runtime ? "compile-time (follows a run-time parameter)" : "compile-time");
+           P->input ? "run-time, input" : P->runtime ? "run-time" : P->uses_runtime ? "compile-time (follows a run-time parameter)" : "compile-time");
     if (P->runtime && (isfinite(P->min) || isfinite(P->max))) printf(" [%g, %g]", P->min, P->max);
     int nused = 0;
     for (int i = 0; i < ir->nuses; i++) {
