@@ -418,6 +418,7 @@ static int embedded_package(const options *o, const mbc_unit *u, const char *dir
  * embedded: the package into -o DIR or generated/<name>-embedded. */
 static int cmd_compile(const options *o, char *dir_out, size_t n, mbc_unit *up) {
   mbc_unit u;
+  if (o->embedded) ldl_set_default_budget(LDL_FLOP_BUDGET_EMBEDDED); /* flash over speed */
   if (build(o, &u, 0)) return 2;
   const char *name = u.lowered->m.name;
   if (o->embedded) {

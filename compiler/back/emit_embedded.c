@@ -85,13 +85,25 @@ static int rename_model_init(const char *path, const char *nm) {
   return 0;
 }
 
-/* a float package fixes the precision in its mb_types.h, which every source
- * includes: no object of it can be built in double by mistake (an ABI mismatch) */
-static int fix_precision(const char *path) {
+static int has_power_law(const lmodel *L) {
+  for (int k = 0; k < L->m.nforce_law; k++)
+    if (L->force_law[k].kind == MB_LAW_POWER) return 1;
+  return 0;
+}
+
+/* The package's settings go into its mb_types.h, which every source includes.
+ * A float package fixes the precision: no object of it can be built in double
+ * by mistake (an ABI mismatch).  A model without power laws compiles their
+ * kernel out (mb_spring.h: no powf, no newlib errno and reentrancy data). */
+static int package_settings(const char *path, const mbc_unit *u) {
   FILE *f = fopen(path, "a");
   if (!f) return 2;
-  fputs("\n/* this package is single precision (mbcc --real float): every file computes in float */\n"
-        "#ifndef MB_REAL_FLOAT\n#error \"compile this package with -DMB_REAL_FLOAT (its Makefile does)\"\n#endif\n", f);
+  if (u->real_float)
+    fputs("\n/* this package is single precision (mbcc --real float): every file computes in float */\n"
+          "#ifndef MB_REAL_FLOAT\n#error \"compile this package with -DMB_REAL_FLOAT (its Makefile does)\"\n#endif\n", f);
+  if (!has_power_law(u->lowered))
+    fputs("\n/* the model has no power-law spring: its kernel (and powf) is left out */\n"
+          "#define MB_NO_POWER_LAW 1\n", f);
   return fclose(f) ? 2 : 0;
 }
 
@@ -266,7 +278,7 @@ static int write_package(const mbc_unit *u, const char *dir, const char *tmp, in
   for (size_t i = 0; i < sizeof core_files / sizeof core_files[0]; i++) {
     snprintf(src, sizeof src, "%s/runtime/core/%s", root, core_files[i]);
     if (join(path, sizeof path, tmp, core_files[i]) || copy_file(src, path, NULL, NULL, NULL)) return 2;
-    if (u->real_float && !strcmp(core_files[i], "mb_types.h") && fix_precision(path)) return 2;
+    if (!strcmp(core_files[i], "mb_types.h") && package_settings(path, u)) return 2;
   }
   for (size_t i = 0; i < sizeof template_files / sizeof template_files[0]; i++) {
     snprintf(src, sizeof src, "%s/templates/embedded/%s", root, template_files[i]);
