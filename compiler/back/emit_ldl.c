@@ -66,8 +66,9 @@ static void ml_max(const ldl_plan *p, int *rmax, long *dmax) {
   }
 }
 
-/* offset of the block pivots' workspace: after Lx, 1/d, x, r, t, best x, K', d */
-static long block_base(const ldl_plan *p) { return p->nnzL + 5L * p->n + p->nnzR + p->n; }
+/* offset of the block pivots' workspace: after Lx, 1/d, x, r, t, best x, K', d
+ * (K' only with block pivots: LDL_DD follows LDL_KR directly without them) */
+static long block_base(const ldl_plan *p) { return p->nnzL + 5L * p->n + (p->nelim ? p->nnzR : 0) + p->n; }
 
 /* offset of the massless bodies' part of the workspace: K1, r1, D scratch, blocks */
 static long ml_base(const ldl_plan *p) {
