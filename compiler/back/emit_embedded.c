@@ -94,8 +94,16 @@ static int has_power_law(const lmodel *L) {
 /* The package's settings go into its mb_types.h, which every source includes.
  * A float package fixes the precision: no object of it can be built in double
  * by mistake (an ABI mismatch).  A model without power laws compiles their
- * kernel out (mb_spring.h: no powf, no newlib errno and reentrancy data). */
-static int package_settings(const char *path, const mbc_unit *u) {
+ * kernel out (mb_spring.h: no powf, no newlib errno and reentrancy data), one
+ * without tyres the tyre (mb_tyre.h: no asinf), and mb_step.c keeps only the
+ * package's integrator. */
+static int has_tyre(const lmodel *L) {
+  for (int k = 0; k < L->m.nforce; k++)
+    if (L->force[k].kind == MB_FORCE_TYRE) return 1;
+  return 0;
+}
+
+static int package_settings(const char *path, const mbc_unit *u, int integrator) {
   FILE *f = fopen(path, "a");
   if (!f) return 2;
   if (u->real_float)
@@ -104,6 +112,11 @@ static int package_settings(const char *path, const mbc_unit *u) {
   if (!has_power_law(u->lowered))
     fputs("\n/* the model has no power-law spring: its kernel (and powf) is left out */\n"
           "#define MB_NO_POWER_LAW 1\n", f);
+  if (!has_tyre(u->lowered))
+    fputs("\n/* the model has no tyre: the element (and asinf) is left out */\n"
+          "#define MB_NO_TYRE 1\n", f);
+  fprintf(f, "\n/* the package steps with one integrator: mb_step.c leaves the other out */\n"
+             "#define MB_STEP_INTEGRATOR_ONLY %d\n", integrator == 2 ? 2 : 0);
   return fclose(f) ? 2 : 0;
 }
 
@@ -278,7 +291,7 @@ static int write_package(const mbc_unit *u, const char *dir, const char *tmp, in
   for (size_t i = 0; i < sizeof core_files / sizeof core_files[0]; i++) {
     snprintf(src, sizeof src, "%s/runtime/core/%s", root, core_files[i]);
     if (join(path, sizeof path, tmp, core_files[i]) || copy_file(src, path, NULL, NULL, NULL)) return 2;
-    if (!strcmp(core_files[i], "mb_types.h") && package_settings(path, u)) return 2;
+    if (!strcmp(core_files[i], "mb_types.h") && package_settings(path, u, integrator)) return 2;
   }
   for (size_t i = 0; i < sizeof template_files / sizeof template_files[0]; i++) {
     snprintf(src, sizeof src, "%s/templates/embedded/%s", root, template_files[i]);

@@ -98,13 +98,13 @@ static mb_real *take(mb_real **p, long n) {
 int mb_step_init(mb_stepper **sp, void *mem, unsigned long bytes, const mb_model *m, int nin,
                  unsigned long frames, const mb_step_settings *set) {
   *sp = 0;
-  int ga = set->integrator == MB_STEP_GENALPHA;
+  int ga = MB_STEP_HAS(MB_STEP_GENALPHA) && set->integrator == MB_STEP_GENALPHA;
   unsigned long need = MB_STEP_BYTES((unsigned long)m->nq, (unsigned long)m->nv, (unsigned long)m->nc,
                                      (unsigned long)m->n, (unsigned long)m->nnz, m->ldl_worksize,
                                      (unsigned long)nin, frames, ga);
   if (!mem || ((unsigned long)mem & 7u) || bytes < need || !m->ldl_factor || !m->ldl_solve)
     return MB_ERR_INVALID;
-  if (set->integrator != MB_STEP_RK4 && !ga) return MB_ERR_INVALID;
+  if (!ga && !(MB_STEP_HAS(MB_STEP_RK4) && set->integrator == MB_STEP_RK4)) return MB_ERR_INVALID;
   if (ga && (set->newton_iterations < 1 || !(set->rho_inf >= 0 && set->rho_inf <= 1)))
     return MB_ERR_INVALID;
   if (set->projection_iterations < 0) return MB_ERR_INVALID;
@@ -125,9 +125,8 @@ int mb_step_init(mb_stepper **sp, void *mem, unsigned long bytes, const mb_model
   s->dv = take(&p, m->n);
   s->phi = take(&p, m->nc);
   s->nu = take(&p, m->nc);
-  s->ldl = take(&p, (long)m->ldl_worksize);
+  s->ldl = s->frames = take(&p, (long)(m->ldl_worksize > frames ? m->ldl_worksize : frames));
   s->u = take(&p, nin);
-  s->frames = take(&p, (long)frames);
   if (ga) {
     s->vd = take(&p, m->nv);
     s->a = take(&p, m->nv);
@@ -259,7 +258,9 @@ static int step_genalpha(mb_stepper *s, mb_real h) {
 int mb_step(mb_stepper *s, mb_real h) {
   const mb_model *m = s->m;
   if (!(h > 0)) return MB_ERR_INVALID;
-  int st = s->set.integrator == MB_STEP_GENALPHA ? step_genalpha(s, h) : step_rk4(s, h);
+  int st = MB_STEP_HAS(MB_STEP_GENALPHA) && (!MB_STEP_HAS(MB_STEP_RK4) || s->set.integrator == MB_STEP_GENALPHA)
+               ? step_genalpha(s, h)
+               : step_rk4(s, h);
   if (st) return st;
   s->t += h;
   s->steps++;

@@ -14,6 +14,14 @@
 
 /* the integrators (numbered as the hosted MB_RK4 / MB_GENALPHA) */
 enum { MB_STEP_RK4 = 0, MB_STEP_GENALPHA = 2 };
+/* A package built for one integrator defines MB_STEP_INTEGRATOR_ONLY to it
+ * (in its mb_types.h): the other is compiled out (less flash; mb_step_init
+ * then refuses it with MB_ERR_INVALID). */
+#ifdef MB_STEP_INTEGRATOR_ONLY
+#define MB_STEP_HAS(k) ((k) == MB_STEP_INTEGRATOR_ONLY)
+#else
+#define MB_STEP_HAS(k) 1
+#endif
 
 typedef struct {
   int integrator;            /* MB_STEP_RK4 or MB_STEP_GENALPHA */
@@ -38,9 +46,12 @@ typedef struct {
 } mb_stepper;
 
 /* mb_real elements after the mb_stepper (each array has one spare element,
- * as the hosted workspaces: the emitted code may read one past the end) */
+ * as the hosted workspaces: the emitted code may read one past the end).
+ * The outputs' and the force tangent's frames share the LDL^T workspace:
+ * each is used between an evaluation and the next factorization only. */
+#define MB_STEP_MAX_(A, B) ((A) > (B) ? (A) : (B))
 #define MB_STEP_REALS(NQ, NV, NC, N, NNZ, LDLW, NIN, FRAMES, GA)                                  \
-  ((NQ) + (NV) + (NNZ) + 3 * (N) + 2 * (NC) + (LDLW) + (NIN) + (FRAMES) + 11 +                    \
+  ((NQ) + (NV) + (NNZ) + 3 * (N) + 2 * (NC) + MB_STEP_MAX_(LDLW, FRAMES) + (NIN) + 10 +           \
    ((GA) ? 5 * (NV) + (NC) + (NQ) + (NNZ) + 8 : 4 * ((NQ) + (NV) + 1)))
 /* bytes of the data block: the mb_stepper, padded to 8, and the arrays */
 #define MB_STEP_BYTES(NQ, NV, NC, N, NNZ, LDLW, NIN, FRAMES, GA)                                  \
