@@ -4,9 +4,11 @@
 #   - runtime/core's step code and a float generated model compile freestanding
 #     under -Wdouble-promotion -Wconversion -Werror -DMB_REAL_FLOAT;
 #   - the package's RK4 (runtime/core/mb_step.c) against the hosted RK4 of
-#     mbcc run (runtime/hosted/integrate.c, an independent implementation) on
-#     the rigid and the flexible slider-crank, same step: within 1e-9 of each
-#     output's size (the CSV has 12 digits);
+#     mbcc run (runtime/hosted/integrate.c: the same step arithmetic,
+#     mb_rk4_step, but its own workspaces, solver calls, projection and
+#     output timing; test_solvers checks that RK4 against DOPRI5) on the rigid
+#     and the flexible slider-crank, same step: within 1e-9 of each output's
+#     size (the CSV has 12 digits);
 #   - the package's generalized-alpha (fixed 3 Newton iterations) converges to
 #     that RK4 solution at second order: halving the step divides the error by
 #     more than 3;
