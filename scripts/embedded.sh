@@ -74,13 +74,15 @@ single-precision functions (`-Wdouble-promotion -Werror`; `make check-double` fa
 | generalized-α (`MB_STEP_GENALPHA`) | none: `newton_iterations` (3) evaluations and solves, one factorization of the iteration matrix (modified Newton) | fixed |
 | position projection (after every step) | Newton on φ(q) = 0 until max\|φ\| ≤ `projection_tol` (1e-10 double, 1e-5 float) | at most `projection_iterations` (8) corrections: 9 evaluations + factorizations and 8 solves; then `MB_ERR_PROJECTION` |
 | velocity projection | none: one solve | fixed |
-| emitted LDLᵀ | none: every index is a compile-time constant; models with weighted (massless-body) rows refine once | fixed |
+| emitted LDLᵀ | none: every index is a compile-time constant (straight-line code, or loops over constant tables above 2000 flops per factorization); a massless body's elimination pivots over its at most 8 rows; the core solves in one pass (no refinement) | fixed |
 
 In steady state the projection takes 0 or 1 correction per step (the step's drift is below the
 tolerance or one Newton step removes it), so a deadline should allow for the worst case of
 RK4 + 9 evaluation/factorizations. The hosted integrators keep their adaptive steps and error
-control; the embedded core keeps the same algorithms with the adaptivity taken out (the test
-checks the core's RK4 against the hosted RK4 to 1e-9).
+control around the same step arithmetic: the hosted fixed-step RK4 calls `mb_rk4_step` and the
+hosted generalized-α calls `mb_ga_method_init`, `mb_ga_predict` and `mb_ga_iteration_matrix`
+of `runtime/core/mb_step.c` (the test checks the core's RK4 run against `mbcc run`'s to 1e-9;
+test_solvers checks that RK4 against DOPRI5).
 
 ## Footprint, accuracy and cost of the shipped models
 
@@ -108,17 +110,22 @@ rigid model and about 2e-6 for the flexible one, where newlib's and glibc's `sin
 differ by an ulp and the flexible modes carry it on).
 
 **Aim and status.** The aim was the flexible slider-crank in float under 8 KiB of RAM and
-64 KiB of flash. No `__aeabi_d*` is linked (met). Flash: 70,460 B (it was 99,820 B; 64,932 B,
-under the aim, before main's new output kinds and elements grew the core):
-the embedded target emits the LDLᵀ as loops over tables above 2000 flops per factorization
-(straight-line code costs about 10 B of flash per flop; `MBCC_LDL_BUDGET` overrides it:
-the flexible slider-crank's 2118 flops gave 31.6 KB), a package of a model without
-power-law springs compiles that kernel out (`MB_NO_POWER_LAW` in its `mb_types.h`: no
-`powf`), and `sqrt`/`fabs` are the compiler's builtins (with `-ffreestanding` they were
-calls, and newlib's `sqrtf` wrapper linked errno and its 1 KB reentrancy data). RAM:
-10,400 B (was 11,480 B), still above the aim: the emitted LDLᵀ's workspace
-(`<M>_LDL_WORK` = 1357 reals: factors, refinement vectors and the massless-body blocks)
-is about half of the data block; sharing it with the integrator's scratch is what is left.
+64 KiB of flash with no `__aeabi_d*` linked: met (its row above; test_embedded holds all three).
+The steps, flash / RAM of its float package: 99,820 B / 11,480 B at first; the LDLᵀ emitted as
+loops over tables above 2000 flops per factorization (straight-line code costs about 10 B of
+flash per flop; `MBCC_LDL_BUDGET` overrides it) 68,364 B; no power-law kernel in a package of
+a model without power-law springs (`MB_NO_POWER_LAW` in its `mb_types.h`: no `powf`) 66,396 B;
+`sqrt`/`fabs` as the compiler's builtins (with `-ffreestanding` they were calls, and newlib's
+`sqrtf` wrapper linked errno and its 1 KB reentrancy data) 64,932 B / 10,400 B. Main's new
+output kinds and the tyre then grew it to 75,036 B / 11,480 B (the tyre's `asinf` linked the
+reentrancy data again). Then: the LDLᵀ workspace no longer reserves the block pivots' K'
+(316 reals) in a model that has none (`<M>_LDL_WORK` 1357 -> 1041 reals); the frames of the
+outputs and the force tangent share the LDLᵀ workspace (each is used between an evaluation and
+the next factorization only); a model without tyres leaves the tyre out (`MB_NO_TYRE`); a
+package keeps only its integrator (`MB_STEP_INTEGRATOR_ONLY`): 67,988 B / 7,824 B; the looped
+LDLᵀ's index tables as `short` (they fit): 64,916 B. The shared step functions added 48 B.
+The vehicle (`sports_car`, 200 unknowns, four tyres) is in the table too: it compiles and runs
+on qemu, but its footprint asks for a larger part than a 64 KiB Cortex-M4F.
 
 ## Inputs
 
