@@ -159,7 +159,9 @@ static inline int mb_tyre_contact(const mb_real *road, const mb_real C[3], const
  * step reports (MB_ERR_NONFINITE). */
 static inline mb_real mb_tyre(const mb_marker *mk, const mb_real *prm, mb_real F[3], mb_real T[3],
                               mb_tyre_state *st, mb_real *tangent) {
-  (void)mk, (void)prm, (void)st, (void)tangent;
+  static const mb_tyre_state none;
+  (void)mk, (void)prm, (void)tangent;
+  if (st) *st = none;
   for (int k = 0; k < 3; k++) F[k] = T[k] = (mb_real)NAN;
   return (mb_real)NAN;
 }
