@@ -134,12 +134,12 @@ for model in slider_crank slider_crank_flexible; do
       size=$(cd $d && make -s size | tr '\n' ' ')
       echo "$model float on Cortex-M4F: $size"
       # the aim: under 64 KiB of flash and 8 KiB of RAM (data block included);
-      # measured 64,916 B and 7,824 B.  This guards the looped LDL^T with short
+      # measured 64,940 B and 7,824 B.  This guards the looped LDL^T with short
       # tables, no powf, no tyre (asinf), builtin sqrtf, one integrator and the
       # frames sharing the LDL^T workspace (without them 100 KB and 11.5 KB)
       flash=$(echo "$size" | awk '{ print $2 }')
       ram=$(echo "$size" | sed 's/.*ram \([0-9]*\).*/\1/')
-      [ "${flash:-999999}" -lt 65536 ] || err "$d: flash $flash B (> 64 KiB; measured 64,916 B)"
+      [ "${flash:-999999}" -lt 65536 ] || err "$d: flash $flash B (> 64 KiB; measured 64,940 B)"
       [ "${ram:-999999}" -lt 8192 ] || err "$d: RAM $ram B (> 8 KiB; measured 7,824 B)"
     fi
     host_log $d 200 20
