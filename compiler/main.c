@@ -346,7 +346,7 @@ static int cmd_check(const options *o) {
   for (int k = 0; k < ir->nparams; k++) {
     const ir_param *P = &ir->params[k];
     printf("    %-16s %.15g%s%s %s", P->name, P->value, P->unit ? " " : "", P->unit ? P->unit : "",
-           P->runtime ? "run-time" : P->uses_runtime ? "compile-time (follows a run-time parameter)" : "compile-time");
+           P->input ? "run-time, input" : P->runtime ? "run-time" : P->uses_runtime ? "compile-time (follows a run-time parameter)" : "compile-time");
     if (P->runtime && (isfinite(P->min) || isfinite(P->max))) printf(" [%g, %g]", P->min, P->max);
     int nused = 0;
     for (int i = 0; i < ir->nuses; i++) {
@@ -700,6 +700,7 @@ static int embedded_package(const options *o, const mbc_unit *u, const char *dir
  * embedded: the package into -o DIR or generated/<name>-embedded. */
 static int cmd_compile(const options *o, char *dir_out, size_t n, mbc_unit *up) {
   mbc_unit u;
+  if (o->embedded) ldl_set_default_budget(LDL_FLOP_BUDGET_EMBEDDED); /* flash over speed */
   if (build(o, &u, 0)) return 2;
   const char *name = u.lowered->m.name;
   if (o->embedded) {

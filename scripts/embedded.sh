@@ -74,13 +74,15 @@ single-precision functions (`-Wdouble-promotion -Werror`; `make check-double` fa
 | generalized-α (`MB_STEP_GENALPHA`) | none: `newton_iterations` (3) evaluations and solves, one factorization of the iteration matrix (modified Newton) | fixed |
 | position projection (after every step) | Newton on φ(q) = 0 until max\|φ\| ≤ `projection_tol` (1e-10 double, 1e-5 float) | at most `projection_iterations` (8) corrections: 9 evaluations + factorizations and 8 solves; then `MB_ERR_PROJECTION` |
 | velocity projection | none: one solve | fixed |
-| emitted LDLᵀ | none: every index is a compile-time constant; models with weighted (massless-body) rows refine once | fixed |
+| emitted LDLᵀ | none: every index is a compile-time constant (straight-line code, or loops over constant tables above 2000 flops per factorization); a massless body's elimination pivots over its at most 8 rows; the core solves in one pass (no refinement) | fixed |
 
 In steady state the projection takes 0 or 1 correction per step (the step's drift is below the
 tolerance or one Newton step removes it), so a deadline should allow for the worst case of
 RK4 + 9 evaluation/factorizations. The hosted integrators keep their adaptive steps and error
-control; the embedded core keeps the same algorithms with the adaptivity taken out (the test
-checks the core's RK4 against the hosted RK4 to 1e-9).
+control around the same step arithmetic: the hosted fixed-step RK4 calls `mb_rk4_step` and the
+hosted generalized-α calls `mb_ga_method_init`, `mb_ga_predict` and `mb_ga_iteration_matrix`
+of `runtime/core/mb_step.c` (the test checks the core's RK4 run against `mbcc run`'s to 1e-9;
+test_solvers checks that RK4 against DOPRI5).
 
 ## Footprint, accuracy and cost of the shipped models
 
@@ -108,10 +110,49 @@ rigid model and about 2e-6 for the flexible one, where newlib's and glibc's `sin
 differ by an ulp and the flexible modes carry it on).
 
 **Aim and status.** The aim was the flexible slider-crank in float under 8 KiB of RAM and
-64 KiB of flash. No `__aeabi_d*` is linked (met). Flash and RAM are above the aim: the
-straight-line LDLᵀ and evaluation of that model dominate the flash, and the emitted LDLᵀ's
-workspace (`<M>_LDL_WORK` reals: factors, refinement and massless-body blocks) is most of the
-data block. The looped LDLᵀ (`MBCC_LDL_BUDGET=0 mbcc compile ...`) trades speed for flash.
+64 KiB of flash with no `__aeabi_d*` linked: met (its row above; test_embedded holds all three).
+The steps, flash / RAM of its float package: 99,820 B / 11,480 B at first; the LDLᵀ emitted as
+loops over tables above 2000 flops per factorization (straight-line code costs about 10 B of
+flash per flop; `MBCC_LDL_BUDGET` overrides it) 68,364 B; no power-law kernel in a package of
+a model without power-law springs (`MB_NO_POWER_LAW` in its `mb_types.h`: no `powf`) 66,396 B;
+`sqrt`/`fabs` as the compiler's builtins (with `-ffreestanding` they were calls, and newlib's
+`sqrtf` wrapper linked errno and its 1 KB reentrancy data) 64,932 B / 10,400 B. Main's new
+output kinds and the tyre then grew it to 75,036 B / 11,480 B (the tyre's `asinf` linked the
+reentrancy data again). Then: the LDLᵀ workspace no longer reserves the block pivots' K'
+(316 reals) in a model that has none (`<M>_LDL_WORK` 1357 -> 1041 reals); the frames of the
+outputs and the force tangent share the LDLᵀ workspace (each is used between an evaluation and
+the next factorization only); a model without tyres leaves the tyre out (`MB_NO_TYRE`); a
+package keeps only its integrator (`MB_STEP_INTEGRATOR_ONLY`): 67,988 B / 7,824 B; the looped
+LDLᵀ's index tables as `short` (they fit): 64,916 B; with the shared step functions 64,940 B.
+The vehicle (`sports_car`, 200 unknowns, four tyres) is in the table too: it compiles and runs
+on qemu, but its footprint asks for a larger part than a 64 KiB Cortex-M4F.
+
+## Inputs
+
+A model names its inputs in `parameters:` with `input: true` (a run-time parameter,
+[docs/model-format.md](model-format.md#parameters)): a drive torque, a force on a slider,
+a spring's stiffness, anything a run-time parameter may set.
+
+```yaml
+parameters:
+  drive: {value: 0, input: true, min: -50, max: 50, unit: N m}
+forces:
+  motor: {type: torque, body: bob, value: [0, 0, drive]}
+```
+
+The package's `<m>_api.h` numbers them in file order (`<M>_NINPUT`, names in
+`<m>_input_names`); `<m>_set_input(&data, k, value)` takes effect from the next
+`<m>_step` or `<m>_outputs` on and holds until set again (a step change at a step's
+start: the integrator sees a constant value within a step). A value outside the
+parameter's `min`..`max`, a NaN or an unknown `k` returns `MB_ERR_INVALID` and changes
+nothing. The values live in the instance's data block (`<M>_NPARAM` reals, every
+run-time parameter of the model), and each call that evaluates the model first writes
+them into the model's force pools (`set_params`), so several instances may run side by
+side as long as they do not run concurrently. `<m>_init` restores the model's values.
+The test (tests/test_embedded.sh, tests/embedded/input_drive.yaml) checks a torque set
+through `<m>_set_input` against `mbcc run --set drive=3.5` (measured 3e-12), a step
+change of a force on a block against the closed form (2e-16 in double, 1e-6 in float),
+and the float package under qemu against the host.
 
 ## Into a firmware project
 

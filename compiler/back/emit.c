@@ -217,7 +217,9 @@ static void emit_runtime_params(emit_ctx *cx) {
     fputs(" */\n  ", f);
     if (b->pool == BIND_PRM) fprintf(f, "force_prm[%d] = (mb_real)", b->index);
     else fprintf(f, "force_laws[%d].%s = (mb_real)", b->index, b->pool == BIND_LAW_COEF ? "coef" : "exponent");
-    expr_print_c(f, ir, use->expr, "(double)p");
+    /* in float the expression stays float: a (double) would compute it in
+     * double (software double on a single-precision FPU) */
+    expr_print_c(f, ir, use->expr, u->real_float ? "p" : "(double)p");
     fputs(";\n", f);
   }
   fputs("  return NULL;\n}\n", f);

@@ -38,6 +38,18 @@
 #include "emit_util.h"
 #include "order.h"
 
+/* A table of the looped form that only the emitted code indexes: short when
+ * every entry fits (half the flash of int; the sizes of an embedded model's
+ * K are far below 32767), else int. */
+static void idx_array(FILE *f, const char *name, const int *x, long n) {
+  int fits = 1;
+  for (long i = 0; i < n; i++) fits &= x[i] >= -32767 && x[i] <= 32767;
+  fprintf(f, "static const %s %s[%ld] = {", fits ? "short" : "int", name, n > 0 ? n : 1);
+  if (n <= 0) fputs("0", f);
+  for (long i = 0; i < n; i++) fprintf(f, "%s%d", i % 16 ? ", " : (i ? ",\n  " : "\n  "), x[i]);
+  fprintf(f, "\n};\n");
+}
+
 /* the comment above ldl_block_rhs (both forms) */
 #define BLOCK_RHS_COMMENT                                                                      \
   "/* the right side of K' from r, in place: g'_s = g_s - W g_r, f'_x = f_x - Dx^T Du^-T f_u.\n" \
@@ -66,8 +78,9 @@ static void ml_max(const ldl_plan *p, int *rmax, long *dmax) {
   }
 }
 
-/* offset of the block pivots' workspace: after Lx, 1/d, x, r, t, best x, K', d */
-static long block_base(const ldl_plan *p) { return p->nnzL + 5L * p->n + p->nnzR + p->n; }
+/* offset of the block pivots' workspace: after Lx, 1/d, x, r, t, best x, K', d
+ * (K' only with block pivots: LDL_DD follows LDL_KR directly without them) */
+static long block_base(const ldl_plan *p) { return p->nnzL + 5L * p->n + (p->nelim ? p->nnzR : 0) + p->n; }
 
 /* offset of the massless bodies' part of the workspace: K1, r1, D scratch, blocks */
 static long ml_base(const ldl_plan *p) {
@@ -1452,7 +1465,7 @@ static void emit_massless(emit_ctx *cx, const lmodel *L, const ldl_plan *p) {
   fputs("/* K1 from Kx: a Kx slot, or -1: 0, -2: 1 (eliminated column), -3: -1 (decoupled row),\n"
         " * -4: computed below */\n", f);
   fprintf(f, "#define LDL_NK1 %d\n", p->nnz1);
-  if (!p->straight) int_array(f, "ldl_K1src", p->K1map, p->nnz1);
+  if (!p->straight) idx_array(f, "ldl_K1src", p->K1map, p->nnz1);
   emit_inv6(cx);
   fputs("/* where a body's factors came from: 1 its compile-time rows (ldl_mlN_static), 0 pivoting */\n"
         "#define LDL_ML_FIXED(B, ws) ws[(B)->r + 36 + 6 * ((B)->r - 6)]\n\n", f);
@@ -1900,29 +1913,29 @@ int emit_ldl(emit_ctx *cx) {
   } else {
     const mb_model *m = &L->m;
     fputs("/* pivot order (original unknowns) */\n", f);
-    int_array(f, "ldl_perm", p->perm, n);
+    idx_array(f, "ldl_perm", p->perm, n);
     fputs("/* K_aug, upper triangle of the permuted matrix: rows, Kx slots (-1: none), and the\n"
           " * products w_r D_ri D_rj of the weighted rows (weights, Kx slots) */\n", f);
-    int_array(f, "ldl_Up", p->Up, n + 1);
-    int_array(f, "ldl_Ui", p->Ui, p->nnzA);
-    int_array(f, "ldl_Us", p->Us, p->nnzA);
+    idx_array(f, "ldl_Up", p->Up, n + 1);
+    idx_array(f, "ldl_Ui", p->Ui, p->nnzA);
+    idx_array(f, "ldl_Us", p->Us, p->nnzA);
     int nt = p->Tp[p->nnzA];
     if (nt > 0) {
       double *tw = malloc(sizeof(double) * (size_t)(nt + 1));
       if (!tw) { cx->failed = 1; return 0; }
       for (int t = 0; t < nt; t++) tw[t] = p->w[p->Tw[t]];
-      int_array(f, "ldl_Tp", p->Tp, p->nnzA + 1);
+      idx_array(f, "ldl_Tp", p->Tp, p->nnzA + 1);
       real_array(f, "ldl_Tw", tw, nt);
-      int_array(f, "ldl_Ta", p->Ta, nt);
-      int_array(f, "ldl_Tb", p->Tb, nt);
+      idx_array(f, "ldl_Ta", p->Ta, nt);
+      idx_array(f, "ldl_Tb", p->Tb, nt);
       free(tw);
     }
     fputs("/* L: columns (strictly lower, rows ascending) and rows (columns ascending, positions) */\n", f);
-    int_array(f, "ldl_Lp", p->Lp, n + 1);
-    int_array(f, "ldl_Li", p->Li, p->nnzL);
-    int_array(f, "ldl_Rp", p->Rp, n + 1);
-    int_array(f, "ldl_Rj", p->Rj, p->nnzL);
-    int_array(f, "ldl_Rpos", p->Rpos, p->nnzL);
+    idx_array(f, "ldl_Lp", p->Lp, n + 1);
+    idx_array(f, "ldl_Li", p->Li, p->nnzL);
+    idx_array(f, "ldl_Rp", p->Rp, n + 1);
+    idx_array(f, "ldl_Rj", p->Rj, p->nnzL);
+    idx_array(f, "ldl_Rpos", p->Rpos, p->nnzL);
     fputs("/* D entries of the weighted rows: target (permuted), weight, Kx slot, row in b */\n", f);
     if (p->nw) {
       int nd = p->Dp[p->nw];
@@ -1936,10 +1949,10 @@ int emit_ldl(emit_ctx *cx) {
           dw[q] = p->w[k];
         }
       fprintf(f, "#define LDL_ND %d\n", nd);
-      int_array(f, "ldl_Dt", dt, nd);
+      idx_array(f, "ldl_Dt", dt, nd);
       real_array(f, "ldl_Dw", dw, nd);
-      int_array(f, "ldl_Ds", p->Ds, nd);
-      int_array(f, "ldl_Dr", dr, nd);
+      idx_array(f, "ldl_Ds", p->Ds, nd);
+      idx_array(f, "ldl_Dr", dr, nd);
       free(dt); free(dr); free(dw);
     }
     fputs("/* the pattern of K (for the residual and ||K||) */\n", f);

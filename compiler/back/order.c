@@ -1163,6 +1163,9 @@ done:
   return nsets;
 }
 
+static double default_budget = LDL_FLOP_BUDGET;
+void ldl_set_default_budget(double flops) { default_budget = flops; }
+
 int ldl_plan_build(const lmodel *L, ldl_plan *p) {
   const mb_model *m = &L->m;
   memset(p, 0, sizeof *p);
@@ -1171,7 +1174,7 @@ int ldl_plan_build(const lmodel *L, ldl_plan *p) {
   p->nv = nv;
   p->nc = m->nc;
   const char *env = getenv("MBCC_LDL_BUDGET");
-  p->budget = env && *env ? atof(env) : LDL_FLOP_BUDGET;
+  p->budget = env && *env ? atof(env) : default_budget;
   const char *ord = getenv("MBCC_LDL_ORDER"); /* "bodies-first" or "tree": force one */
   int *Ap = NULL, *Ai = NULL, *C2 = NULL, *Ct = NULL;
   double *Kx = kx_at_start(m), *Kr = NULL;

@@ -30,6 +30,13 @@
 /* default flop budget for straight-line code (above it: loops over tables);
  * the environment variable MBCC_LDL_BUDGET overrides it */
 #define LDL_FLOP_BUDGET 20000.0
+/* the embedded target's: straight-line LDL^T costs about 10 bytes of Cortex-M4F
+ * flash per flop (the flexible slider-crank's 2118 + 923 flops: 31.6 KB more
+ * than its loops), so above 2000 flops per factorization the loops keep a
+ * package near a 64 KiB flash */
+#define LDL_FLOP_BUDGET_EMBEDDED 2000.0
+/* the budget of the plans built from now on when MBCC_LDL_BUDGET is not set */
+void ldl_set_default_budget(double flops);
 
 typedef struct {
   int n, nv, nc;

@@ -394,6 +394,7 @@ typedef struct {
   ir_loc loc;         /* its key in 'parameters:' */
   double value;       /* the default (or the --set override) */
   bool runtime;       /* an input of the generated code (mbcc run --set) */
+  bool input;         /* runtime, and an input of the embedded API (<m>_set_input) */
   double min, max;    /* bounds of a run-time value (-inf, inf when not given) */
   char *unit;         /* documentation only, or NULL */
   ir_expr *expr;      /* its definition when not a plain number, else NULL */

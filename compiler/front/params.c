@@ -570,7 +570,7 @@ static bool param_value(reader *r, int k, const parser *from, size_t pos, double
   if (n->type == YAML_MAPPING_NODE) {
     mapping m;
     map_open(&m, r, n, loc_of(n), "parameter '%s'", P->name);
-    static const char *const keys[] = {"value", "runtime", "min", "max", "unit", NULL};
+    static const char *const keys[] = {"value", "runtime", "input", "min", "max", "unit", NULL};
     map_check_keys(&m, keys);
     yaml_node_t *value = map_require(&m, "value", true, "a number or an expression");
     ok = value != NULL && definition_value(r, k, value, &P->value);
@@ -579,6 +579,20 @@ static bool param_value(reader *r, int k, const parser *from, size_t pos, double
       if (scalar_equals(runtime, "true")) P->runtime = P->uses_runtime = true;
       else if (!scalar_equals(runtime, "false")) {
         error_at(r, loc_of(runtime), "'runtime' must be true or false (got %s)", show_node(r, runtime));
+        ok = false;
+      }
+    }
+    /* an input (the embedded package's <m>_set_input) is a run-time parameter */
+    yaml_node_t *input = map_get(&m, "input");
+    if (input != NULL) {
+      if (scalar_equals(input, "true")) {
+        if (runtime != NULL && scalar_equals(runtime, "false")) {
+          error_at(r, loc_of(input), "an input is set at run time: 'input: true' needs 'runtime: true' (or no 'runtime')");
+          ok = false;
+        }
+        P->input = P->runtime = P->uses_runtime = true;
+      } else if (!scalar_equals(input, "false")) {
+        error_at(r, loc_of(input), "'input' must be true or false (got %s)", show_node(r, input));
         ok = false;
       }
     }

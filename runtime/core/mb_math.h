@@ -52,6 +52,23 @@
 #define MB_NEARBYINT(x) nearbyint(x)
 #endif
 
+/* -ffreestanding (the embedded package's flags) implies -fno-builtin: sqrt
+ * and fabs would be library calls, and newlib's sqrtf wrapper sets errno,
+ * which links its reentrancy data (1 KB of RAM).  The builtins are the FPU's
+ * instructions (with -fno-math-errno), with the same correctly rounded values;
+ * a hosted build already treats the plain names as these builtins. */
+#if defined(__GNUC__)
+#undef MB_SQRT
+#undef MB_FABS
+#ifdef MB_REAL_FLOAT
+#define MB_SQRT(x) __builtin_sqrtf(x)
+#define MB_FABS(x) __builtin_fabsf(x)
+#else
+#define MB_SQRT(x) __builtin_sqrt(x)
+#define MB_FABS(x) __builtin_fabs(x)
+#endif
+#endif
+
 /* isfinite is type-generic (a macro of <math.h>): no promotion either way */
 #define MB_ISFINITE(x) isfinite(x)
 

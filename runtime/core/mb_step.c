@@ -29,6 +29,13 @@ static int all_finite(const mb_real *a, int n) {
   return finite;
 }
 
+void mb_ga_method_init(mb_ga_method *g, mb_real rho_inf) {
+  g->am = (2 * rho_inf - 1) / (rho_inf + 1);
+  g->af = rho_inf / (rho_inf + 1);
+  g->gamma = MB_R(0.5) - g->am + g->af;
+  g->beta = MB_R(0.25) * (g->gamma + MB_R(0.5)) * (g->gamma + MB_R(0.5));
+}
+
 /* evaluate at (t, q, v) and factor K */
 static int eval_factor(mb_stepper *s, mb_real t, const mb_real *q, const mb_real *v) {
   const mb_model *m = s->m;
@@ -98,13 +105,13 @@ static mb_real *take(mb_real **p, long n) {
 int mb_step_init(mb_stepper **sp, void *mem, unsigned long bytes, const mb_model *m, int nin,
                  unsigned long frames, const mb_step_settings *set) {
   *sp = 0;
-  int ga = set->integrator == MB_STEP_GENALPHA;
+  int ga = MB_STEP_HAS(MB_STEP_GENALPHA) && set->integrator == MB_STEP_GENALPHA;
   unsigned long need = MB_STEP_BYTES((unsigned long)m->nq, (unsigned long)m->nv, (unsigned long)m->nc,
                                      (unsigned long)m->n, (unsigned long)m->nnz, m->ldl_worksize,
                                      (unsigned long)nin, frames, ga);
   if (!mem || ((unsigned long)mem & 7u) || bytes < need || !m->ldl_factor || !m->ldl_solve)
     return MB_ERR_INVALID;
-  if (set->integrator != MB_STEP_RK4 && !ga) return MB_ERR_INVALID;
+  if (!ga && !(MB_STEP_HAS(MB_STEP_RK4) && set->integrator == MB_STEP_RK4)) return MB_ERR_INVALID;
   if (ga && (set->newton_iterations < 1 || !(set->rho_inf >= 0 && set->rho_inf <= 1)))
     return MB_ERR_INVALID;
   if (set->projection_iterations < 0) return MB_ERR_INVALID;
@@ -125,9 +132,8 @@ int mb_step_init(mb_stepper **sp, void *mem, unsigned long bytes, const mb_model
   s->dv = take(&p, m->n);
   s->phi = take(&p, m->nc);
   s->nu = take(&p, m->nc);
-  s->ldl = take(&p, (long)m->ldl_worksize);
+  s->ldl = s->frames = take(&p, (long)(m->ldl_worksize > frames ? m->ldl_worksize : frames));
   s->u = take(&p, nin);
-  s->frames = take(&p, (long)frames);
   if (ga) {
     s->vd = take(&p, m->nv);
     s->a = take(&p, m->nv);
@@ -137,11 +143,7 @@ int mb_step_init(mb_stepper **sp, void *mem, unsigned long bytes, const mb_model
     s->lam = take(&p, m->nc);
     s->q1 = take(&p, m->nq);
     s->Kmod = take(&p, m->nnz);
-    mb_real rho = set->rho_inf;
-    s->am = (2 * rho - 1) / (rho + 1);
-    s->af = rho / (rho + 1);
-    s->gamma = MB_R(0.5) - s->am + s->af;
-    s->beta = MB_R(0.25) * (s->gamma + MB_R(0.5)) * (s->gamma + MB_R(0.5));
+    mb_ga_method_init(&s->ga, set->rho_inf);
   } else {
     s->y0 = take(&p, ny);
     s->ytmp = take(&p, ny);
@@ -174,40 +176,79 @@ static int deriv(mb_stepper *s, mb_real t, const mb_real *y, mb_real *dy) {
   return MB_OK;
 }
 
-/* classic RK4: y1 = y0 + h (k1 + 2 k2 + 2 k3 + k4) / 6, summed as the hosted
- * RK4 (integrate.c: combine) sums it */
-static int step_rk4(mb_stepper *s, mb_real h) {
-  const mb_model *m = s->m;
-  int nq = m->nq, ny = m->nq + m->nv;
+int mb_rk4_step(int ny, mb_real h, const mb_real *y0, const mb_real *k1, mb_rk4_deriv deriv, void *ctx,
+                mb_real *ytmp, mb_real *k, mb_real *ksum, mb_real *y1) {
   static const mb_real c[4] = {0, MB_R(0.5), MB_R(0.5), 1};
   static const mb_real b[4] = {MB_R(1.0) / 6, MB_R(1.0) / 3, MB_R(1.0) / 3, MB_R(1.0) / 6};
-  copy(s->y0, s->q, nq);
-  copy(s->y0 + nq, s->v, m->nv);
-  for (int j = 0; j < 4; j++) {
-    if (j == 0) copy(s->ytmp, s->y0, ny);
-    else
-      for (int i = 0; i < ny; i++) s->ytmp[i] = s->y0[i] + h * (c[j] * s->kst[i]);
-    int st = deriv(s, s->t + c[j] * h, s->ytmp, s->kst);
+  for (int i = 0; i < ny; i++) ksum[i] = b[0] * k1[i];
+  for (int j = 1; j < 4; j++) {
+    const mb_real *kp = j == 1 ? k1 : k; /* read before deriv writes k: k1 may be k */
+    for (int i = 0; i < ny; i++) ytmp[i] = y0[i] + h * (c[j] * kp[i]);
+    int st = deriv(ctx, c[j], ytmp, k);
     if (st) return st;
-    for (int i = 0; i < ny; i++) s->ksum[i] = j ? s->ksum[i] + b[j] * s->kst[i] : b[0] * s->kst[i];
+    for (int i = 0; i < ny; i++) ksum[i] = ksum[i] + b[j] * k[i];
   }
-  for (int i = 0; i < nq; i++) s->q[i] = s->y0[i] + h * s->ksum[i];
-  for (int i = 0; i < m->nv; i++) s->v[i] = s->y0[nq + i] + h * s->ksum[nq + i];
+  for (int i = 0; i < ny; i++) y1[i] = y0[i] + h * ksum[i];
   return MB_OK;
 }
 
-/* q1, v1, a1 from the iterate vd1 = x[0..nv) (generalized-alpha recurrences) */
-static void ga_predict(mb_stepper *s, mb_real h) {
+/* the stepper's stage derivative at s->t + c h (mb_rk4_step's callback) */
+typedef struct {
+  mb_stepper *s;
+  mb_real h;
+} rk4_ctx;
+
+static int rk4_deriv(void *ctx, mb_real c, const mb_real *y, mb_real *dy) {
+  rk4_ctx *r = (rk4_ctx *)ctx;
+  return deriv(r->s, r->s->t + c * r->h, y, dy);
+}
+
+static int step_rk4(mb_stepper *s, mb_real h) {
   const mb_model *m = s->m;
+  int nq = m->nq, ny = m->nq + m->nv;
+  rk4_ctx ctx = {s, h};
+  copy(s->y0, s->q, nq);
+  copy(s->y0 + nq, s->v, m->nv);
+  int st = deriv(s, s->t, s->y0, s->kst);
+  if (st) return st;
+  if ((st = mb_rk4_step(ny, h, s->y0, s->kst, rk4_deriv, &ctx, s->ytmp, s->kst, s->ksum, s->ytmp))) return st;
+  copy(s->q, s->ytmp, nq);
+  copy(s->v, s->ytmp + nq, m->nv);
+  return MB_OK;
+}
+
+void mb_ga_predict(const mb_model *m, const mb_ga_method *g, mb_real h, const mb_real *q, const mb_real *v,
+                   const mb_real *vd, const mb_real *a, const mb_real *x, mb_real *q1, mb_real *v1,
+                   mb_real *a1, mb_real *dq) {
   for (int i = 0; i < m->nv; i++) {
-    mb_real a1 = ((1 - s->af) * s->x[i] + s->af * s->vd[i] - s->am * s->a[i]) / (1 - s->am);
-    s->a1[i] = a1;
-    s->dq[i] = h * s->v[i] + h * h * ((MB_R(0.5) - s->beta) * s->a[i] + s->beta * a1);
-    s->v1[i] = s->v[i] + h * ((1 - s->gamma) * s->a[i] + s->gamma * a1);
+    mb_real ai = ((1 - g->af) * x[i] + g->af * vd[i] - g->am * a[i]) / (1 - g->am);
+    a1[i] = ai;
+    dq[i] = h * v[i] + h * h * ((MB_R(0.5) - g->beta) * a[i] + g->beta * ai);
+    v1[i] = v[i] + h * ((1 - g->gamma) * a[i] + g->gamma * ai);
   }
-  copy(s->q1, s->q, m->nq);
-  mb_model_qincrement(m, s->q1, s->dq);
-  mb_model_normalize(m, s->q1);
+  copy(q1, q, m->nq);
+  mb_model_qincrement(m, q1, dq);
+  mb_model_normalize(m, q1);
+}
+
+void mb_ga_iteration_matrix(const mb_model *m, const mb_real *Kx, mb_real kfac, mb_real cfac, mb_real *Kmod,
+                            mb_real t, const mb_real *q, const mb_real *v, void *work) {
+  copy(Kmod, Kx, m->nnz);
+  for (int b = 0; b < m->nbody; b++) {
+    const mb_body *B = &m->body[b];
+    if (B->kind != MB_BODY_FLEXIBLE || !B->flex || !B->mslotf) continue;
+    int nb = 6 + B->nm;
+    for (int j = 0; j < B->nm; j++) {
+      int slot = B->mslotf[(6 + j) * nb + 6 + j];
+      if (slot >= 0) Kmod[slot] += kfac * B->flex->stiffness[j] + cfac * B->flex->damping[j];
+    }
+  }
+  mb_model_force_tangent(m, t, q, v, kfac, cfac, Kmod, work);
+}
+
+/* q1, v1, a1 from the iterate vd1 = x[0..nv) */
+static void ga_predict(mb_stepper *s, mb_real h) {
+  mb_ga_predict(s->m, &s->ga, h, s->q, s->v, s->vd, s->a, s->x, s->q1, s->v1, s->a1, s->dq);
 }
 
 /* generalized-alpha (as genalpha.c) with newton_iterations modified-Newton
@@ -215,8 +256,8 @@ static void ga_predict(mb_stepper *s, mb_real h) {
 static int step_genalpha(mb_stepper *s, mb_real h) {
   const mb_model *m = s->m;
   int nv = m->nv, nc = m->nc, n = m->n;
-  mb_real bp = (1 - s->am) / (h * h * s->beta * (1 - s->af)); /* beta' */
-  mb_real gp = s->gamma / (h * s->beta);                      /* gamma' */
+  mb_real bp = (1 - s->ga.am) / (h * h * s->ga.beta * (1 - s->ga.af)); /* beta' */
+  mb_real gp = s->ga.gamma / (h * s->ga.beta);                         /* gamma' */
   copy(s->x, s->vd, nv);
   copy(s->x + nv, s->lam, nc);
   for (int it = 0; it < s->set.newton_iterations; it++) {
@@ -228,19 +269,8 @@ static int step_genalpha(mb_stepper *s, mb_real h) {
       for (int p = m->Kp[j]; p < m->Kp[j + 1]; p++)
         if (m->Ki[p] < nv) s->dv[m->Ki[p]] -= s->Kx[p] * s->x[j];
     for (int r = 0; r < nc; r++) s->dv[nv + r] = -bp * s->phi[r];
-    if (it == 0) { /* K with the modal stiffness and damping on the modal diagonal */
-      copy(s->Kmod, s->Kx, m->nnz);
-      for (int b = 0; b < m->nbody; b++) {
-        const mb_body *B = &m->body[b];
-        if (B->kind != MB_BODY_FLEXIBLE || !B->flex || !B->mslotf) continue;
-        int nb = 6 + B->nm;
-        for (int j = 0; j < B->nm; j++) {
-          int slot = B->mslotf[(6 + j) * nb + 6 + j];
-          if (slot >= 0) s->Kmod[slot] += B->flex->stiffness[j] / bp + gp / bp * B->flex->damping[j];
-        }
-      }
-      /* and the force elements' stiffness and damping (models compiled for genalpha) */
-      mb_model_force_tangent(m, s->t + h, s->q1, s->v1, 1 / bp, gp / bp, s->Kmod, s->frames);
+    if (it == 0) { /* modified Newton: the iteration matrix of the first iterate */
+      mb_ga_iteration_matrix(m, s->Kx, 1 / bp, gp / bp, s->Kmod, s->t + h, s->q1, s->v1, s->frames);
       if (m->ldl_factor(m, s->Kmod, s->ldl)) return MB_ERR_SINGULAR;
     }
     int st = solve(s, s->Kmod, s->dv);
@@ -259,7 +289,9 @@ static int step_genalpha(mb_stepper *s, mb_real h) {
 int mb_step(mb_stepper *s, mb_real h) {
   const mb_model *m = s->m;
   if (!(h > 0)) return MB_ERR_INVALID;
-  int st = s->set.integrator == MB_STEP_GENALPHA ? step_genalpha(s, h) : step_rk4(s, h);
+  int st = MB_STEP_HAS(MB_STEP_GENALPHA) && (!MB_STEP_HAS(MB_STEP_RK4) || s->set.integrator == MB_STEP_GENALPHA)
+               ? step_genalpha(s, h)
+               : step_rk4(s, h);
   if (st) return st;
   s->t += h;
   s->steps++;

@@ -14,6 +14,14 @@
 
 /* the integrators (numbered as the hosted MB_RK4 / MB_GENALPHA) */
 enum { MB_STEP_RK4 = 0, MB_STEP_GENALPHA = 2 };
+/* A package built for one integrator defines MB_STEP_INTEGRATOR_ONLY to it
+ * (in its mb_types.h): the other is compiled out (less flash; mb_step_init
+ * then refuses it with MB_ERR_INVALID). */
+#ifdef MB_STEP_INTEGRATOR_ONLY
+#define MB_STEP_HAS(k) ((k) == MB_STEP_INTEGRATOR_ONLY)
+#else
+#define MB_STEP_HAS(k) 1
+#endif
 
 typedef struct {
   int integrator;            /* MB_STEP_RK4 or MB_STEP_GENALPHA */
@@ -24,11 +32,16 @@ typedef struct {
   mb_real rho_inf;           /* genalpha: spectral radius at infinite step, 0..1 */
 } mb_step_settings;
 
+/* the generalized-alpha method's constants (Chung & Hulbert) */
+typedef struct {
+  mb_real am, af, gamma, beta;
+} mb_ga_method;
+
 typedef struct {
   const mb_model *m;
   mb_step_settings set;
   mb_real t;
-  mb_real am, af, gamma, beta;                 /* genalpha constants */
+  mb_ga_method ga;                             /* genalpha constants */
   int nin;                                     /* inputs (u) */
   mb_real *q, *v, *Kx, *rhs, *x, *dv, *phi, *nu, *ldl, *u, *frames;
   mb_real *y0, *ytmp, *ksum, *kst;             /* RK4 */
@@ -38,9 +51,12 @@ typedef struct {
 } mb_stepper;
 
 /* mb_real elements after the mb_stepper (each array has one spare element,
- * as the hosted workspaces: the emitted code may read one past the end) */
+ * as the hosted workspaces: the emitted code may read one past the end).
+ * The outputs' and the force tangent's frames share the LDL^T workspace:
+ * each is used between an evaluation and the next factorization only. */
+#define MB_STEP_MAX_(A, B) ((A) > (B) ? (A) : (B))
 #define MB_STEP_REALS(NQ, NV, NC, N, NNZ, LDLW, NIN, FRAMES, GA)                                  \
-  ((NQ) + (NV) + (NNZ) + 3 * (N) + 2 * (NC) + (LDLW) + (NIN) + (FRAMES) + 11 +                    \
+  ((NQ) + (NV) + (NNZ) + 3 * (N) + 2 * (NC) + MB_STEP_MAX_(LDLW, FRAMES) + (NIN) + 10 +           \
    ((GA) ? 5 * (NV) + (NC) + (NQ) + (NNZ) + 8 : 4 * ((NQ) + (NV) + 1)))
 /* bytes of the data block: the mb_stepper, padded to 8, and the arrays */
 #define MB_STEP_BYTES(NQ, NV, NC, N, NNZ, LDLW, NIN, FRAMES, GA)                                  \
@@ -63,5 +79,32 @@ int mb_step_init(mb_stepper **sp, void *mem, unsigned long bytes, const mb_model
 int mb_step(mb_stepper *s, mb_real h);
 /* the model's output columns at the current state (m->ncols values) */
 int mb_step_outputs(mb_stepper *s, mb_real *y);
+
+/* Classic RK4's step, shared by mb_step and the hosted fixed-step RK4
+ * (runtime/hosted/integrate.c): from y0 and its derivative k1,
+ * y1 = y0 + h (k1 + 2 k2 + 2 k3 + k4) / 6, the weights summed in this order.
+ * deriv(ctx, c, y, dy) gives the derivative at t_n + c h (c = 1/2, 1/2, 1);
+ * a nonzero return ends the step with it.  ytmp, k, ksum: ny reals of
+ * scratch; k1 may be k and y1 may be ytmp. */
+typedef int (*mb_rk4_deriv)(void *ctx, mb_real c, const mb_real *y, mb_real *dy);
+int mb_rk4_step(int ny, mb_real h, const mb_real *y0, const mb_real *k1, mb_rk4_deriv deriv, void *ctx,
+                mb_real *ytmp, mb_real *k, mb_real *ksum, mb_real *y1);
+
+/* Generalized-alpha's step arithmetic, shared by mb_step and the hosted
+ * adaptive genalpha (runtime/hosted/genalpha.c). */
+/* the constants for a spectral radius rho_inf at infinite step (0..1) */
+void mb_ga_method_init(mb_ga_method *g, mb_real rho_inf);
+/* from the state (q, v, vd, a) at t_n and the iterate x = [vd1; lambda1] at
+ * t_n + h: the algorithmic accelerations a1, the velocity-space increment dq,
+ * v1 and q1 = q (+) dq, normalized (the rotations on their Lie group) */
+void mb_ga_predict(const mb_model *m, const mb_ga_method *g, mb_real h, const mb_real *q, const mb_real *v,
+                   const mb_real *vd, const mb_real *a, const mb_real *x, mb_real *q1, mb_real *v1,
+                   mb_real *a1, mb_real *dq);
+/* the iteration matrix scaled by 1/beta': K (Kx) with kfac * stiffness +
+ * cfac * damping on the modal diagonal and the force elements' tangents at
+ * (t, q, v) on their coupling blocks (models compiled for an implicit
+ * method); work: mb_model_worksize bytes (the frames) */
+void mb_ga_iteration_matrix(const mb_model *m, const mb_real *Kx, mb_real kfac, mb_real cfac, mb_real *Kmod,
+                            mb_real t, const mb_real *q, const mb_real *v, void *work);
 
 #endif

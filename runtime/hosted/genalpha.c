@@ -16,10 +16,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include "mb_sim.h"
+#include "mb_step.h" /* the generalized-alpha step arithmetic it shares with the core */
 
 typedef struct {
   /* method constants */
-  double am, af, gamma, beta;
+  mb_ga_method ga; /* shared with the embedded core (mb_step.h) */
   /* state at t_n: accelerations vd and algorithmic accelerations a */
   mb_real *vd, *a, *lam;
   /* the iterate at t_n+1 */
@@ -74,18 +75,10 @@ static void error_weights(const mb_model *m, const mb_settings *set, const mb_re
   }
 }
 
-/* q1, v1, a1 from the iterate vd1 = x[0..nv) (generalized-alpha recurrences) */
+/* q1, v1, a1 from the iterate vd1 = x[0..nv) (generalized-alpha recurrences,
+ * runtime/core/mb_step.c: the embedded core's step arithmetic) */
 static void ga_predict(const mb_sim *s, const ga_work *g, double h) {
-  const mb_model *m = s->m;
-  for (int i = 0; i < m->nv; i++) {
-    double a1 = ((1 - g->af) * g->x[i] + g->af * g->vd[i] - g->am * g->a[i]) / (1 - g->am);
-    g->a1[i] = (mb_real)a1;
-    g->dq[i] = (mb_real)(h * s->v[i] + h * h * ((0.5 - g->beta) * g->a[i] + g->beta * a1));
-    g->v1[i] = (mb_real)(s->v[i] + h * ((1 - g->gamma) * g->a[i] + g->gamma * a1));
-  }
-  memcpy(g->q1, s->q, sizeof(mb_real) * (size_t)m->nq);
-  mb_model_qincrement(m, g->q1, g->dq);
-  mb_model_normalize(m, g->q1);
+  mb_ga_predict(s->m, &g->ga, (mb_real)h, s->q, s->v, g->vd, g->a, g->x, g->q1, g->v1, g->a1, g->dq);
 }
 
 /* the iteration matrix: K with kfac * stiffness + cfac * damping on the modal
@@ -94,17 +87,7 @@ static void ga_predict(const mb_sim *s, const ga_work *g, double h) {
 static void iteration_matrix(const mb_model *m, const mb_real *Kx, double kfac, double cfac,
                              mb_real *Kmod, double t, const mb_real *q, const mb_real *v,
                              void *work) {
-  memcpy(Kmod, Kx, sizeof(mb_real) * (size_t)m->nnz);
-  for (int b = 0; b < m->nbody; b++) {
-    const mb_body *B = &m->body[b];
-    if (B->kind != MB_BODY_FLEXIBLE || !B->flex || !B->mslotf) continue;
-    int nb = 6 + B->nm;
-    for (int j = 0; j < B->nm; j++) {
-      int slot = B->mslotf[(6 + j) * nb + 6 + j];
-      if (slot >= 0) Kmod[slot] += (mb_real)(kfac * B->flex->stiffness[j] + cfac * B->flex->damping[j]);
-    }
-  }
-  mb_model_force_tangent(m, (mb_real)t, q, v, (mb_real)kfac, (mb_real)cfac, Kmod, work);
+  mb_ga_iteration_matrix(m, Kx, (mb_real)kfac, (mb_real)cfac, Kmod, (mb_real)t, q, v, work);
 }
 
 /* r_top = K x - f over the dynamic rows (the constraint rows are phi) */
@@ -132,8 +115,8 @@ enum { GA_CONVERGED = 0, GA_DIVERGED = 1, GA_FAILED = 2 };
 static int ga_newton(mb_sim *s, ga_work *g, double h, int *st, double *rate_out) {
   const mb_model *m = s->m;
   int nv = m->nv, nc = m->nc, n = m->n;
-  double bp = (1 - g->am) / (h * h * g->beta * (1 - g->af)); /* beta' */
-  double gp = g->gamma / (h * g->beta);                      /* gamma' */
+  double bp = (1 - g->ga.am) / (h * h * g->ga.beta * (1 - g->ga.af)); /* beta' */
+  double gp = g->ga.gamma / (h * g->ga.beta);                         /* gamma' */
   double eta_prev = 0;
   int factored = 0;
   /* predictor: the accelerations and multipliers of t_n */
@@ -332,10 +315,7 @@ int mb_genalpha_run(mb_sim *s, mb_output_fn out, void *user) {
   if (!ga_alloc(&g, m)) { ga_free(&g); return MB_ERR_NOMEM; }
   double rho = set->rho_inf;
   if (!(rho >= 0 && rho <= 1)) { ga_free(&g); return MB_ERR_INVALID; }
-  g.am = (2 * rho - 1) / (rho + 1);
-  g.af = rho / (rho + 1);
-  g.gamma = 0.5 - g.am + g.af;
-  g.beta = 0.25 * (g.gamma + 0.5) * (g.gamma + 0.5);
+  mb_ga_method_init(&g.ga, (mb_real)rho);
   int st = MB_OK;
   s->t = 0;
   long nout = (long)floor(set->end_time / set->output_step + 1e-9), iout = 0;
@@ -387,7 +367,7 @@ int mb_genalpha_run(mb_sim *s, mb_output_fn out, void *user) {
       /* local error of the positions: h^2 (beta - 1/6) (vd1 - vd0) */
       for (int i = 0; i < nv; i++) g.r[i] = g.x[i] - g.vd[i];
       error_weights(m, set, s->q, g.q1, g.sc);
-      double err = weighted_rms(g.r, g.sc, nv, hh * hh * fabs(g.beta - 1.0 / 6));
+      double err = weighted_rms(g.r, g.sc, nv, hh * hh * fabs((double)g.ga.beta - 1.0 / 6));
       if (!isfinite(err)) err = 1e10;
       double fac = err > 0 ? 0.9 * pow(err, -1.0 / 3) : 2;
       fac = fmin(2, fmax(0.2, fac));

@@ -7,6 +7,7 @@
 #include <string.h>
 #include <time.h>
 #include "mb_sim.h"
+#include "mb_step.h" /* the fixed-step RK4 it shares with the core */
 
 double mb_sim_clock(void) {
   struct timespec ts;
@@ -189,6 +190,17 @@ static int deriv(mb_sim *s, double t, const mb_real *y, mb_real *dy) {
   return MB_OK;
 }
 
+/* mb_rk4_step's stage derivative at t + c h (the time in double) */
+typedef struct {
+  mb_sim *s;
+  double t, h;
+} rk4_stage_ctx;
+
+static int rk4_stage_deriv(void *ctx, mb_real c, const mb_real *y, mb_real *dy) {
+  const rk4_stage_ctx *r = (const rk4_stage_ctx *)ctx;
+  return deriv(r->s, r->t + (double)c * r->h, y, dy);
+}
+
 /* after a step: stabilize and check the state */
 int mb_sim_finish_step(mb_sim *s, double t) {
   const mb_model *m = s->m;
@@ -221,18 +233,8 @@ static const double DP_A[7][6] = {
 static const double DP_E[7] = {71.0 / 57600, 0, -71.0 / 16695, 71.0 / 1920, -17253.0 / 339200,
                                22.0 / 525, -1.0 / 40};
 
-/* one explicit stage combination: ytmp = y + h sum a_j k_j */
-static void combine(int ny, const mb_real *y, double h, const double *a, mb_real *const *k, int nk,
-                    mb_real *out) {
-  for (int i = 0; i < ny; i++) {
-    double acc = 0;
-    for (int j = 0; j < nk; j++) acc += a[j] * k[j][i];
-    out[i] = y[i] + h * acc;
-  }
-}
-
-/* Dormand-Prince stage j (1..6): combine() with the tableau's row as
- * constants and its zero dropped, summed in the same order (the same bits).
+/* Dormand-Prince stage j (1..6): ytmp = y + h sum a_j k_j with the tableau's
+ * row as constants and its zeros dropped, summed in the row's order.
  * A loop over the stages for every state costs about three times as many
  * instructions.  The states go in pairs, two like statements that the C
  * compiler turns into one two-wide vector operation each (SLP at -O2); with
@@ -611,15 +613,11 @@ int mb_sim_run(mb_sim *s, mb_output_fn out, void *user) {
       double hs = set->output_step / nsub;
       h = hs < hmax * (1 + 1e-12) ? hs : hmax;
       if (hmax - h < 1e-9 * hs) h = hmax;
-      static const double a2[1] = {0.5}, a3[2] = {0, 0.5}, a4[3] = {0, 0, 1};
-      combine(ny, s->y, h, a2, s->k, 1, s->ytmp);
-      if ((st = deriv(s, s->t + h / 2, s->ytmp, s->k[1]))) goto done;
-      combine(ny, s->y, h, a3, s->k, 2, s->ytmp);
-      if ((st = deriv(s, s->t + h / 2, s->ytmp, s->k[2]))) goto done;
-      combine(ny, s->y, h, a4, s->k, 3, s->ytmp);
-      if ((st = deriv(s, s->t + h, s->ytmp, s->k[3]))) goto done;
-      static const double b[4] = {1.0 / 6, 1.0 / 3, 1.0 / 3, 1.0 / 6};
-      combine(ny, s->y, h, b, s->k, 4, s->ytmp);
+      /* the step arithmetic is the embedded core's (runtime/core/mb_step.c) */
+      rk4_stage_ctx ctx = {s, s->t, h};
+      if ((st = mb_rk4_step(ny, (mb_real)h, s->y, s->k[0], rk4_stage_deriv, &ctx, s->ytmp, s->k[1], s->k[2],
+                            s->ytmp)))
+        goto done;
       memcpy(s->q, s->ytmp, sizeof(mb_real) * (size_t)nq);
       memcpy(s->v, s->ytmp + nq, sizeof(mb_real) * (size_t)nv);
       s->t = (h == hmax) ? tout : s->t + h;

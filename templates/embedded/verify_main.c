@@ -11,6 +11,16 @@
 #define VERIFY_EVERY 20
 #endif
 
+/* an input schedule (models with inputs): input VERIFY_INPUT is set to
+ * VERIFY_INPUT_FIRST before the first step and to VERIFY_INPUT_THEN before
+ * step VERIFY_INPUT_AT */
+#ifdef VERIFY_INPUT
+#ifndef VERIFY_INPUT_AT
+#define VERIFY_INPUT_AT VERIFY_STEPS
+#define VERIFY_INPUT_THEN 0
+#endif
+#endif
+
 #ifdef MB_HOST
 #include <stdio.h>
 static void emb_write(const char *s) { fputs(s, stdout); }
@@ -38,7 +48,11 @@ int main(void) {
   static mb_real y[@UMODEL@_NOUTPUT + 1];
   int st = @MODEL@_init(&data);
   for (int k = 0; !st && k <= VERIFY_STEPS; k++) {
-    if (k % VERIFY_EVERY == 0) {
+#ifdef VERIFY_INPUT
+    if (!st && k == 0) st = @MODEL@_set_input(&data, VERIFY_INPUT, (mb_real)VERIFY_INPUT_FIRST);
+    if (!st && k == VERIFY_INPUT_AT) st = @MODEL@_set_input(&data, VERIFY_INPUT, (mb_real)VERIFY_INPUT_THEN);
+#endif
+    if (!st && k % VERIFY_EVERY == 0) {
       st = @MODEL@_outputs(&data, y);
       put_real(@MODEL@_time(&data));
       for (int c = 0; c < @UMODEL@_NOUTPUT; c++) put_real(y[c]);

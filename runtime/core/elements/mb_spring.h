@@ -33,6 +33,16 @@ static inline int mb_law_segment(const mb_law *l, mb_real x) {
   return k;
 }
 
+/* An embedded package of a model without power laws defines MB_NO_POWER_LAW
+ * (in its mb_types.h): no powf, and with it none of newlib's errno and
+ * reentrancy data (about 1 KB of RAM, 3 KB of flash).  A power law reaching
+ * the kernel then gives NaN, which the step reports (MB_ERR_NONFINITE). */
+#ifdef MB_NO_POWER_LAW
+#define MB_LAW_POW(x, y) ((void)(x), (void)(y), (mb_real)NAN)
+#else
+#define MB_LAW_POW(x, y) MB_POW(x, y)
+#endif
+
 /* F(x) of a force law, and its integral from 0 to x (for potential energy) */
 static inline mb_real mb_law_eval(const mb_law *l, mb_real x, mb_real *energy) {
   mb_real F = 0, E = 0;
@@ -44,7 +54,7 @@ static inline mb_real mb_law_eval(const mb_law *l, mb_real x, mb_real *energy) {
     E = MB_R(0.5) * l->coef * x * x;
     break;
   case MB_LAW_POWER: {
-    mb_real ax = MB_FABS(x), pw = MB_POW(ax, l->exponent);
+    mb_real ax = MB_FABS(x), pw = MB_LAW_POW(ax, l->exponent);
     F = (x < 0 ? -1 : 1) * l->coef * pw;
     E = l->coef * pw * ax / (l->exponent + 1);
     break;
@@ -77,7 +87,7 @@ static inline mb_real mb_law_slope(const mb_law *l, mb_real x) {
   switch (l->kind) {
   case MB_LAW_NONE: return 0;
   case MB_LAW_LINEAR: return l->coef;
-  case MB_LAW_POWER: return l->coef * l->exponent * MB_POW(MB_FABS(x), l->exponent - 1);
+  case MB_LAW_POWER: return l->coef * l->exponent * MB_LAW_POW(MB_FABS(x), l->exponent - 1);
   case MB_LAW_TABLE: {
     const mb_real *d = l->table;
     int k = mb_law_segment(l, x);

@@ -152,6 +152,20 @@ static inline int mb_tyre_contact(const mb_real *road, const mb_real C[3], const
  * K xi^2 (exact at free rolling and in pure slip at constant friction),
  * and the change of the friction, the aligning moment and the contact
  * point's move are left out (docs/formulation.md). */
+#ifdef MB_NO_TYRE
+/* An embedded package of a model without tyres defines MB_NO_TYRE (in its
+ * mb_types.h): the element is left out (its asinf linked newlib's errno and
+ * reentrancy data, 1 KB of RAM).  A tyre reaching it gives NaN, which the
+ * step reports (MB_ERR_NONFINITE). */
+static inline mb_real mb_tyre(const mb_marker *mk, const mb_real *prm, mb_real F[3], mb_real T[3],
+                              mb_tyre_state *st, mb_real *tangent) {
+  static const mb_tyre_state none;
+  (void)mk, (void)prm, (void)tangent;
+  if (st) *st = none;
+  for (int k = 0; k < 3; k++) F[k] = T[k] = (mb_real)NAN;
+  return (mb_real)NAN;
+}
+#else
 static inline mb_real mb_tyre(const mb_marker *mk, const mb_real *prm, mb_real F[3], mb_real T[3],
                               mb_tyre_state *st, mb_real *tangent) {
   const mb_real *road = prm + MB_TYRE_ROAD;
@@ -296,5 +310,6 @@ static inline mb_real mb_tyre(const mb_marker *mk, const mb_real *prm, mb_real F
   }
   return E;
 }
+#endif /* MB_NO_TYRE */
 
 #endif
