@@ -30,6 +30,9 @@ $(B)/rt/%.o: runtime/%.c
 	@mkdir -p $(@D)
 	$(CC) $(STD) $(WARN) $(CFLAGS) $(DEPFLAGS) $(RT_INC) -c $< -o $@
 
+# SUNDIALS' KLU header includes <klu.h>, which Debian keeps in suitesparse/
+$(B)/rt/hosted/ida.o: RT_INC += -I/usr/include/suitesparse
+
 $(B)/libmbrt.a: $(patsubst runtime/%.c,$(B)/rt/%.o,$(RT_SRC))
 	rm -f $@ && ar rcs $@ $^
 
