@@ -22,7 +22,7 @@ CC_SRC  := $(wildcard compiler/*.c) $(foreach d,$(CC_DIRS),$(wildcard $(d)/*.c))
 B       ?= build
 DEPFLAGS = -MMD -MP
 
-.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser embedded man release-check  install scaling chassis vehicle sweeps
+.PHONY: all test demo clean sanitize docs bench peers trade extremes web test-browser embedded man release-check  install scaling chassis vehicle sweeps
 all: $(B)/mbcc $(B)/libmbrt.a $(B)/libmbrt_float.a
 
 # objects keep the source's folders: $(B)/rt/core/x.o, $(B)/cc/front/x.o
@@ -73,6 +73,10 @@ chassis:
 # the timing comparison of every path (scripts/bench.sh): writes docs/benchmarks.md
 bench: all
 	MBCC=$(B)/mbcc sh scripts/bench.sh
+
+# only the MuJoCo peer of make bench (scripts/peers.sh): prints its section
+peers: all
+	MBCC=$(B)/mbcc sh scripts/peers.sh
 
 # build and run time against model size on pendulum chains (scripts/scaling.sh):
 # writes docs/scaling.md; SIZES="5 10 20" for a quick one
