@@ -1,7 +1,8 @@
 #!/bin/sh
 # peers.sh: mbcc's emitted evaluation against MuJoCo's mj_forward / mj_step on
 # the same rigid mechanisms (bench/peers/README.md): the 4-revolute four-bar
-# (bench/peers/four_bar_4r.yaml) and the 17-body car (models/sports_car.yaml).
+# (bench/peers/four_bar_4r.yaml) and the 17-body car with its rigid chassis
+# (bench/peers/sports_car_rigid.yaml).
 # For each: `mbcc compile`, the MJCF from scripts/mjcf_from_yaml.py, the peer
 # program bench/peers/mujoco_peer.c linked with the generated code, one
 # interleaved timing run (exit 1 if the accelerations at rest disagree), and
@@ -21,7 +22,7 @@ case $MBCC in /*) ;; *) MBCC=$ROOT/$MBCC ;; esac
 RTLIB=$(dirname "$MBCC")/libmbrt.a
 CC=${CC:-cc}
 ROUNDS=${PEER_ROUNDS:-31}
-MODELS=${PEER_MODELS:-"bench/peers/four_bar_4r.yaml models/sports_car.yaml"}
+MODELS=${PEER_MODELS:-"bench/peers/four_bar_4r.yaml bench/peers/sports_car_rigid.yaml"}
 W=${PEER_DIR:-$ROOT/build/peers}
 CG=${PEER_CACHEGRIND:-1}
 say() { echo "peers: $*" >&2; }
@@ -74,7 +75,7 @@ for model in $MODELS; do
     { cat "$W/$name.cc.log" >&2; die "building the peer of $name failed"; }
   # calls per round: about 2 ms of mj_forward each
   reps=200
-  case $name in sports_car) reps=100 ;; esac
+  case $name in sports_car*) reps=100 ;; esac
   say "$name: $ROUNDS interleaved rounds of $reps calls"
   "$W/${name}_peer" "$W/$name.xml" --rounds "$ROUNDS" --reps "$reps" --csv "$W/$name.csv" >"$W/$name.txt" ||
     { cat "$W/$name.txt" >&2; die "$name: MuJoCo and mbcc disagree (or the peer failed)"; }
