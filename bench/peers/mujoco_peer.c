@@ -24,8 +24,8 @@
  * car's difference, 2.6e-3, scales with 1 - impedance) of the largest.  Then the timing: ROUNDS rounds, each
  * timing REPS calls of mbcc's evaluation, of mj_forward and of mj_step (state
  * restored before each), in turn; medians of the per-call times and of the
- * per-round ratios.  With --only mbcc|forward N it runs N calls of one of them
- * and nothing else (for valgrind --tool=cachegrind's instruction counts). */
+ * per-round ratios.  With --only mbcc|eval|forward N it runs N calls of one of
+ * them (eval: mbcc's evaluation without the factor and solve) and nothing else (for valgrind --tool=cachegrind's instruction counts). */
 #define _POSIX_C_SOURCE 199309L
 #include <math.h>
 #include <stdio.h>
@@ -225,7 +225,7 @@ int main(int argc, char **argv) {
   }
   if (!xml || reps < 1 || rounds < 1) {
     fprintf(stderr, "usage: mujoco_peer MODEL.xml [--reps N] [--rounds R] [--seed S] [--tol T] "
-                    "[--vscale V] [--csv FILE] [--only mbcc|forward N]\n");
+                    "[--vscale V] [--csv FILE] [--only mbcc|eval|forward N]\n");
     return 2;
   }
   const mb_model *m = peer_model;
@@ -285,6 +285,7 @@ int main(int argc, char **argv) {
   if (only) { /* N calls of one side, for cachegrind */
     for (int k = 0; k < only_n; k++) {
       if (!strcmp(only, "mbcc")) mbcc_accel(&e, q, v);
+      else if (!strcmp(only, "eval")) m->eval(m, 0, q, v, e.Kx, e.rhs, e.phi, e.phid, e.work);
       else mj_forward(mj, d);
     }
     return 0;
