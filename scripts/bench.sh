@@ -128,9 +128,10 @@ bench chain "$ROOT/tests/models/hinged_chain20_rigid.yaml"
 bench flex0 "$ROOT/models/slider_crank_flexible.yaml"
 bench flex1 "$ROOT/models/slider_crank_flexible.yaml" --scene virtual1
 bench flex2 "$ROOT/models/slider_crank_flexible.yaml" --scene virtual2
-# the general DAE peer on the other mechanisms: the four-bar and the 17-body car
+# the general DAE peer on the 17-body car.  (Not on the driven four-bar: there both
+# IDA paths stop with "step size fell below the minimum" (ida+klu at t = 0.58 s, ida at
+# 1.42 s): the index-1 DAE has no projection, and the positions drift off the loop.)
 IDA_PATHS=generated+ldl,generic+klu,ida,ida+klu
-bench fourbar "$ROOT/models/four_bar.yaml" --paths $IDA_PATHS
 bench car "$ROOT/models/sports_car.yaml" --scene rigid --end 1 --paths $IDA_PATHS
 agree tight_rigid "$ROOT/models/slider_crank.yaml"
 agree tight_chain "$ROOT/tests/models/hinged_chain20_rigid.yaml"
@@ -374,7 +375,7 @@ tmp=$OUT.part
   echo "| model | n | steps generated+ldl / ida / ida+klu | run [s] generated+ldl | ida | ida+klu | generated+ldl / ida+klu | ida+klu / ida | positions: ida+klu vs generated+ldl |"
   echo "|---|--:|--:|--:|--:|--:|--:|--:|--:|"
   for v in "rigid:rigid slider-crank" "chain:20-segment chain" "flex0:flexible slider-crank" \
-           "flex2:same, 2 virtual bodies" "fourbar:four-bar (models/four_bar.yaml)" "car:17-body car (models/sports_car.yaml, scene rigid, 1 s)"; do
+           "flex2:same, 2 virtual bodies" "car:17-body car (models/sports_car.yaml, scene rigid, 1 s)"; do
     name=${v%%:*}
     g=$(val "$name" generated+ldl run_s) i=$(val "$name" ida run_s) k=$(val "$name" ida+klu run_s)
     printf '| %s | %s | %s / %s / %s | %s | %s | %s | %s | %s | %s |\n' "${v#*:}" \
@@ -403,7 +404,7 @@ tmp=$OUT.part
   echo
   echo "## The tables as printed"
   echo
-  for name in rigid chain flex0 flex1 flex2 fourbar car; do
+  for name in rigid chain flex0 flex1 flex2 car; do
     echo '```'
     cat "$W/$name.txt"
     echo '```'
