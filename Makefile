@@ -74,9 +74,9 @@ chassis:
 bench: all
 	MBCC=$(B)/mbcc sh scripts/bench.sh
 
-# only the MuJoCo peer of make bench (scripts/peers.sh): prints its section
+# only the MuJoCo peer of make bench (scripts/peers.sh): writes docs/peers.md
 peers: all
-	MBCC=$(B)/mbcc sh scripts/peers.sh
+	MBCC=$(B)/mbcc PEER_DOC=docs/peers.md sh scripts/peers.sh
 
 # build and run time against model size on pendulum chains (scripts/scaling.sh):
 # writes docs/scaling.md; SIZES="5 10 20" for a quick one
