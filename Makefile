@@ -22,13 +22,16 @@ CC_SRC  := $(wildcard compiler/*.c) $(foreach d,$(CC_DIRS),$(wildcard $(d)/*.c))
 B       ?= build
 DEPFLAGS = -MMD -MP
 
-.PHONY: all test demo clean sanitize docs bench trade extremes web test-browser embedded man release-check  install scaling chassis vehicle sweeps slurm-check
+.PHONY: all test demo clean sanitize docs bench peers trade extremes web test-browser embedded man release-check  install scaling chassis vehicle sweeps slurm-check
 all: $(B)/mbcc $(B)/libmbrt.a $(B)/libmbrt_float.a
 
 # objects keep the source's folders: $(B)/rt/core/x.o, $(B)/cc/front/x.o
 $(B)/rt/%.o: runtime/%.c
 	@mkdir -p $(@D)
 	$(CC) $(STD) $(WARN) $(CFLAGS) $(DEPFLAGS) $(RT_INC) -c $< -o $@
+
+# SUNDIALS' KLU header includes <klu.h>, which Debian keeps in suitesparse/
+$(B)/rt/hosted/ida.o: RT_INC += -I/usr/include/suitesparse
 
 $(B)/libmbrt.a: $(patsubst runtime/%.c,$(B)/rt/%.o,$(RT_SRC))
 	rm -f $@ && ar rcs $@ $^
@@ -70,6 +73,10 @@ chassis:
 # the timing comparison of every path (scripts/bench.sh): writes docs/benchmarks.md
 bench: all
 	MBCC=$(B)/mbcc sh scripts/bench.sh
+
+# only the MuJoCo peer of make bench (scripts/peers.sh): writes docs/peers.md
+peers: all
+	MBCC=$(B)/mbcc PEER_DOC=docs/peers.md sh scripts/peers.sh
 
 # build and run time against model size on pendulum chains (scripts/scaling.sh):
 # writes docs/scaling.md; SIZES="5 10 20" for a quick one

@@ -74,7 +74,7 @@ static const help_command commands[] = {
     {"bench", "mbcc bench M.yaml [--scene S] [--csv FILE] [--reps N] [--paths a,b,...] [OPTIONS]",
      "time every solution path of a model against SUNDIALS IDA",
      "Compiles a benchmark with every path (generated+ldl, generated+klu, generated+dense, "
-     "generic+klu, generic+dense, ida) and prints the CPU time of each and its error against a "
+     "generic+klu, generic+dense, ida, ida+klu) and prints the CPU time of each and its error against a "
      "tight reference.",
      {{"--scene S", "apply scene S of the model file"},
       {"--csv FILE", "also write the table as CSV"},

@@ -1087,7 +1087,8 @@ static int cmd_bench(const options *o) {
   char exe[8400], src_main[8400];
   snprintf(exe, sizeof exe, "%s/%s_bench", dir, L->m.name);
   snprintf(src_main, sizeof src_main, "%s/bench_main.c", dir);
-  char *ida_libs[] = {"-lsundials_ida", "-lsundials_nvecserial", NULL};
+  char *ida_libs[] = {"-lsundials_ida", "-lsundials_nvecserial", "-lsundials_sunlinsolklu",
+                      "-lsundials_sunmatrixsparse", NULL};
   rc = emit_template(&u, "bench_main.c.in", src_main);
   if (!rc && o->real_float) {
     fprintf(stderr, "mbcc: error: bench runs double-precision paths only (drop '--real float')\n");

@@ -36,7 +36,12 @@ present() {
     libblas-dev)        links blas ;;
     libcmocka-dev)      [ -e /usr/include/cmocka.h ] && links cmocka ;;
     libarpack2-dev)     links arpack ;;
-    libsundials-dev)    [ -e /usr/include/ida/ida.h ] && links sundials_ida && links sundials_nvecserial ;;
+    libsundials-dev)    [ -e /usr/include/ida/ida.h ] && links sundials_ida && links sundials_nvecserial &&
+                        [ -e /usr/include/sunlinsol/sunlinsol_klu.h ] && links sundials_sunlinsolklu &&
+                        links sundials_sunmatrixsparse ;;
+    libmujoco-dev)      [ -e /usr/include/mujoco/mujoco.h ] && links mujoco ;;
+    python3-yaml)       python3 -c 'import yaml' ;;
+    valgrind)           command -v valgrind ;;
     gnuplot-nox)        gnuplot -e 'set terminal pngcairo' ;;
     clang)              command -v clang ;;
     nodejs)             command -v node ;;
@@ -67,11 +72,14 @@ present() {
 # library only) for make chassis and tests/test_chassis.sh; GNU parallel runs
 # the variants of mbcc sweep (tests/test_sweep.sh), which also runs them over
 # ssh to a private sshd on localhost (openssh-server, openssh-client; the
-# service itself is not needed).
+# service itself is not needed).  make bench's peers: SUNDIALS IDA with KLU
+# (libsundials-dev's sunlinsol_klu and sparse matrix), MuJoCo 2.2 (libmujoco-dev,
+# the mj_forward peer, scripts/peers.sh), python3-yaml (scripts/mjcf_from_yaml.py
+# reads the model) and valgrind (cachegrind's instruction counts).
 packages=(build-essential libyaml-dev libsuitesparse-dev liblapack-dev libblas-dev
           libcmocka-dev libsundials-dev libarpack2-dev gnuplot-nox clang nodejs npm chromium
           gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm pkgconf libclang-rt-14-dev time python3
-          parallel openssh-server openssh-client)
+          parallel openssh-server openssh-client libmujoco-dev python3-yaml valgrind)
 missing=()
 for p in "${packages[@]}"; do
   present "$p" || missing+=("$p")

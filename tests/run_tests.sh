@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 B=${B:-build}
 CFLAGS=${CFLAGS:--O2 -g}
 CC=${CC:-cc}
-LIBS="-lcholmod -larpack -lcmocka -lsundials_ida -lsundials_nvecserial -lyaml -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig -llapack -lblas -lm"
+LIBS="-lcholmod -larpack -lcmocka -lsundials_ida -lsundials_nvecserial -lsundials_sunlinsolklu -lsundials_sunmatrixsparse -lyaml -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig -llapack -lblas -lm"
 mkdir -p "$B/gen" "$B/tests"
 export MBCC="$B/mbcc" B
 passed=0; failed=0

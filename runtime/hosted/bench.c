@@ -19,7 +19,8 @@ static double now(void) {
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-enum { EVAL_GENERATED, EVAL_GENERIC, EVAL_IDA };
+enum { EVAL_GENERATED, EVAL_GENERIC, EVAL_IDA, EVAL_IDA_KLU };
+#define IS_IDA(e) ((e) == EVAL_IDA || (e) == EVAL_IDA_KLU)
 
 typedef struct {
   const char *name;    /* as in the table and the CSV: generated+ldl, ..., ida */
@@ -31,6 +32,7 @@ static const path_def PATHS[] = {
     {"generated+ldl", EVAL_GENERATED, "ldl"},  {"generated+klu", EVAL_GENERATED, "klu"},
     {"generated+dense", EVAL_GENERATED, "dense"}, {"generic+klu", EVAL_GENERIC, "generic-klu"},
     {"generic+dense", EVAL_GENERIC, "generic-dense"},  {"ida", EVAL_IDA, NULL},
+    {"ida+klu", EVAL_IDA_KLU, NULL},
 };
 #define NPATH ((int)(sizeof PATHS / sizeof PATHS[0]))
 
@@ -90,14 +92,15 @@ static int run_once(const path_def *p, const mb_model *m, const mb_settings *set
   detail[0] = 0;
   int st;
   double t0 = now();
-  if (p->eval == EVAL_IDA) {
+  if (p->eval == EVAL_IDA || p->eval == EVAL_IDA_KLU) {
     mb_stats stats;
     mb_settings ida_set = *set;
     if (ida_rtol > 0) { /* tighter (or looser) BDF tolerances, atol scaled alike */
       ida_set.atol = set->atol * ida_rtol / set->rtol;
       ida_set.rtol = ida_rtol;
     }
-    st = mb_ida_simulate(m, &ida_set, record, rec, &stats, fail_time);
+    st = mb_ida_run(m, &ida_set, p->eval == EVAL_IDA_KLU ? MB_IDA_KLU : MB_IDA_DENSE, record, rec, &stats,
+                    fail_time);
     *wall = now() - t0;
     *setup = stats.t_setup;
     *steps = stats.steps;
@@ -184,7 +187,7 @@ static void usage(const char *prog) {
           "usage: %s [--reps N] [--csv FILE] [--paths a,b,...] [--quiet] [--ida-rtol R]\n"
           "          [--integrator rk4|dopri5] [--stabilization projection|baumgarte|none]\n"
           "          [--end T] [--output-step H] [--step H] [--rtol R] [--atol A]\n"
-          "paths: generated+ldl generated+klu generated+dense generic+klu generic+dense ida\n",
+          "paths: generated+ldl generated+klu generated+dense generic+klu generic+dense ida ida+klu\n",
           prog);
 }
 
@@ -275,8 +278,8 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
     path_result *r = &res[p];
     if (!selected(paths, pd->name)) continue;
     const mb_model *pm = pd->eval == EVAL_GENERIC ? &generic : m;
-    r->n = pd->eval == EVAL_IDA ? mb_ida_size(m) : m->n;
-    r->nnz = pd->eval == EVAL_IDA ? r->n * r->n : m->nnz;
+    r->n = IS_IDA(pd->eval) ? mb_ida_size(m) : m->n;
+    r->nnz = pd->eval == EVAL_IDA ? r->n * r->n : pd->eval == EVAL_IDA_KLU ? mb_ida_klu_nnz(m) : m->nnz;
     if (pd->solver) {
       mb_solver *probe = mb_solver_new(pd->solver, pm);
       if (!probe) {
@@ -354,7 +357,7 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
     if (res[p].state == 1) {
       best_run = fmin(best_run, res[p].run_med);
       best_step_all = fmin(best_step_all, res[p].step_med);
-      if (PATHS[p].eval != EVAL_IDA) best_step = fmin(best_step, res[p].step_med);
+      if (!IS_IDA(PATHS[p].eval)) best_step = fmin(best_step, res[p].step_med);
     }
   if (!isfinite(best_step)) best_step = best_step_all;
 
@@ -377,7 +380,7 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
     if (!r->state) continue;
     if (r->state != 1) { printf("%-16s %5d %7d %7s  %s\n", PATHS[p].name, r->n, r->nnz, "-", r->note); continue; }
     printf("%-16s %5d %7d %7s %8ld %13.4g %10.4g %10.3g %7.2f %7.2f %12.3g %10.3g", PATHS[p].name, r->n,
-           r->nnz, PATHS[p].eval == EVAL_IDA ? "-" : nl, r->steps, r->step_med, r->run_med, r->setup_med,
+           r->nnz, IS_IDA(PATHS[p].eval) ? "-" : nl, r->steps, r->step_med, r->run_med, r->setup_med,
            r->run_med / best_run, r->step_med / best_step, r->max_rel, r->max_rel_pos);
     if (p == ref) printf("  (reference)");
     else if (r->worst_col >= 0 && r->max_rel > 0) {
@@ -398,7 +401,9 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
          "times, relative to the range of that output over the run (for a vector output, the largest\n"
          "range of its components).  positions: the same over the position, orientation, angle,\n"
          "deflection and modal outputs only.  ida: the DAE in y = [q; v; lambda] (n = nq + nv + nc), dense\n"
-         "Jacobian by difference quotients, generated eval; its BDF steps are not %s steps.\n",
+         "Jacobian by difference quotients, generated eval; its BDF steps are not %s steps.\n"
+         "ida+klu: the same DAE with KLU on a sparse Jacobian from the emitted K and the exact\n"
+         "rate and modal terms (nnz(K): the Jacobian's pattern).\n",
          set.integrator == MB_RK4 ? "rk4" : "dopri5", set.integrator == MB_RK4 ? "rk4" : "dopri5");
 
   if (csv_path) {
@@ -410,7 +415,7 @@ int mb_bench_main(int argc, char **argv, const mb_model *m, const mb_settings *d
     for (int p = 0; p < NPATH; p++) {
       const path_result *r = &res[p];
       if (!r->state) continue;
-      const char *l = PATHS[p].eval == EVAL_IDA ? "-" : nl;
+      const char *l = IS_IDA(PATHS[p].eval) ? "-" : nl;
       if (r->state == 1)
         fprintf(f, "%s,%d,%d,%s,%.6g,%.6g,%.4f,%ld,%.3g,%.4f,ok,%.3g,%s,%s,%.6g\n", PATHS[p].name, r->n,
                 r->nnz, l, r->step_med, r->run_med, r->run_med / best_run, r->steps, r->max_rel,

@@ -31,6 +31,31 @@
 int mb_ida_simulate(const mb_model *m, const mb_settings *s, mb_output_fn out, void *user,
                     mb_stats *stats, double *fail_time);
 
+/* The same with a choice of IDA's linear solver:
+ *   MB_IDA_DENSE: dense LU on a difference-quotient Jacobian (mb_ida_simulate);
+ *   MB_IDA_KLU: SuiteSparse KLU (SUNLinSol_KLU, a CSC SUNMatrix) on a sparse
+ *     Jacobian dF/dy + cj dF/dy' assembled from the model's analytic pieces:
+ *     the emitted K = [M D^T; D 0] (cj M, cj D, D^T), the exact derivatives of
+ *     qdot - G(q) v, and the flexible bodies' modal stiffness and damping.  The
+ *     q and v derivatives of the other terms (gyroscopic, D(q)^T lambda, force
+ *     elements, gamma), which mbcc does not emit, are left out: IDA's Newton
+ *     iteration converges with the approximate matrix, and the accuracy is set
+ *     by the residual, which is exact.  Needs -lsundials_sunlinsolklu
+ *     -lsundials_sunmatrixsparse and KLU. */
+enum { MB_IDA_DENSE = 0, MB_IDA_KLU = 1 };
+int mb_ida_run(const mb_model *m, const mb_settings *s, int linsol, mb_output_fn out, void *user,
+               mb_stats *stats, double *fail_time);
+
+/* For tests (allocate per call): the residual F(t, y, yp) into r (nq + n), and
+ * MB_IDA_KLU's Jacobian at (t, y) for cj as a dense column-major N x N matrix
+ * (N = nq + n) with the number of entries of its sparse pattern in *nnz. */
+int mb_ida_residual(const mb_model *m, double t, const double *y, const double *yp, double *r);
+int mb_ida_jacobian_dense(const mb_model *m, double t, const double *y, double cj, double *J,
+                          int *nnz);
+
+/* entries of MB_IDA_KLU's sparse Jacobian pattern (0: out of memory) */
+int mb_ida_klu_nnz(const mb_model *m);
+
 /* the DAE's dimension nq + nv + nc */
 int mb_ida_size(const mb_model *m);
 
