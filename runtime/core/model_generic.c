@@ -695,7 +695,7 @@ void mb_model_track_angles(const mb_model *m, const mb_real *q, const mb_real *v
 double mb_model_angle_step(const mb_model *m, const mb_real *q, const mb_real *v, void *work) {
   int any = 0;
   for (int k = 0; k < m->noutput; k++) any |= m->output[k].kind == MB_OUT_ANGLE || joint_angle_output(&m->output[k]);
-  if (!any) return INFINITY;
+  if (!any) return (double)INFINITY; /* INFINITY is a float: the cast keeps -Wdouble-promotion quiet */
   mb_frame *F = (mb_frame *)work;
   mb_marker *MK = (mb_marker *)(F + m->nbody);
   frames_and_markers(m, q, v, F, MK);
