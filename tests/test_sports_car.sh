@@ -41,6 +41,9 @@
 #      flexible_virtual) give the motion of the joints on the nodes;
 #   7. straight running on the flat road: the speed falls by the rolling
 #      resistance only, the course holds.
+# The variants (at rest, on a rig, on the flat road, a stiffer chassis)
+# include the model's car (models/sports_car/car.yaml) with their own
+# parameters, road, joints, outputs and scenes: no edit of the model's text.
 # About 15 s of CPU (generic path, no C compile).
 set -u
 cd "$(dirname "$0")/.."
@@ -52,20 +55,37 @@ run() { # run MODEL CSV [ARGS]: generic path, quiet; the log beside the CSV
   "$MBCC" run "$m" --path generic -o "$csv" --plot none "$@" > "$csv.log" 2>&1 ||
     { err "mbcc run $m $* failed: $(tail -3 "$csv.log")"; return 1; }
 }
-# the model without its outputs and simulation settings (a variant appends its
-# own), standing still on the flat road, its FE file named from anywhere
-base() {
-  awk '/^[A-Za-z_]/ { skip = ($0 ~ /^(outputs|simulation):/) } !skip' "$model" |
-    sed -e 's/angular_velocity: \[0, [0-9.]*, 0\]/angular_velocity: [0, 0, 0]/' \
-        -e 's/velocity: \[16.667, 0, 0\]/velocity: [0, 0, 0]/' -e 's/road: bump_road/road: flat_road/' \
-        -e "s|fe_file: sports_car_chassis.fe.yaml|fe_file: $root/models/sports_car_chassis.fe.yaml|"
+# the model's car (models/sports_car/car.yaml) with its parameters as given in
+# PARAMS (name=value ...; the others as the model has them, read from mbcc
+# check), on the road ROAD; the scenes 'rigid' (deactivating DEACTIVATE, a
+# comma-separated list) and 'flexible' as the model's.  A variant appends its
+# joints, drivers, outputs and simulation settings.
+car() { # car PARAMS ROAD [DEACTIVATE]
+  local p params=""
+  for p in v0 vz0 chassis_vz chassis_wy spin_front spin_rear tyre_slip; do   # the first value given wins
+    params="$params $p=$(printf '%s\n' $1 | awk -F= -v p="$p" '$1 == p { print $2; exit }')"
+    [ "${params%=}" = "$params" ] ||
+      params="$params$(awk -v p="$p" '$1 == p && $3 ~ /^compile-time/ { print $2; exit }' check.log)"
+  done
+  cat <<EOF
+name: sports_car
+gravity: [0, 0, -9.81]
+parameters: {$(printf '%s\n' $params | sed 's/=/: /' | paste -sd, - | sed 's/,/, /g')}
+roads: {bump_road: $2}
+include: $root/models/sports_car/car.yaml
+scenes:
+  rigid: {bodies: {chassis: {coupling: rigid}}, deactivate: [${3:-}]}
+  flexible: {simulation: {joints_on_flexible: direct}}
+EOF
 }
+# standing still on the flat road
+base() { car "${1:-} v0=0 vz0=0 spin_front=0 spin_rear=0" '{type: flat}' "${2:-}"; }
 
 # 1. assembly and redundancy
 if "$MBCC" check "$model" --scene rigid > check.log 2>&1; then
   grep -q 'constraint rows   86 (2 redundant removed)' check.log || err "not 86 rows with 2 redundant removed: $(grep 'constraint rows' check.log)"
   grep -q 'degrees of freedom 16' check.log || err "not 16 DOF: $(grep 'degrees of freedom' check.log)"
-  for j in j19_RL_lower_ball j20_RR_lower_ball; do
+  for j in RL_lower_ball RR_lower_ball; do
     grep -q "redundant constraint removed: spherical '$j': coincident points, x" check.log || err "the x row of $j is not reported redundant"
   done
   [ "$(grep -c 'redundant constraint removed' check.log)" = 2 ] || err "other rows reported redundant: $(grep 'redundant' check.log)"
@@ -75,12 +95,12 @@ else
 fi
 # 2. mass and centre of mass: every body translating at v; momentum p = M v,
 #    angular momentum about the origin h = M r_cg x v (no rotation)
-mass_run() { # mass_run NAME VELOCITY
-  base | sed -e "s/\([^_]\)velocity: \[0, 0, 0\]/\1velocity: $2/" > "$1.yaml"
+mass_run() { # mass_run NAME PARAMS (every body's initial velocity)
+  base "$2" > "$1.yaml"
   printf 'outputs:\n  - {name: L, type: momentum}\nsimulation: {end_time: 0.001}\n' >> "$1.yaml"
   run "$1.yaml" "$1.csv" --scene rigid
 }
-if mass_run up '[0, 0, 1]' && mass_run fwd '[1, 0, 0]'; then
+if mass_run up 'vz0=1 chassis_vz=1' && mass_run fwd 'v0=1'; then
   # columns: t, px, py, pz, hx, hy, hz.  v = z: h = M (y, -x, 0); v = x: h = M (0, z, -y)
   read -r M xg yg <<< "$(awk -F, 'NR == 2 { printf "%.9g %.9g %.9g", $4, -$6 / $4, $5 / $4 }' up.csv)"
   zg=$(awk -F, 'NR == 2 { printf "%.9g", $6 / $2 }' fwd.csv)
@@ -102,10 +122,10 @@ outputs:
   - {name: RR_wheel_z, type: position, body: RR_wheel, component: z}
   - {name: pitch, type: angle, body: chassis, axis: [0, 1, 0]}
   - {name: roll, type: angle, body: chassis, axis: [1, 0, 0]}
-  - {name: FL_Fz, type: tyre, element: tyre_FL, component: Fz}
-  - {name: FR_Fz, type: tyre, element: tyre_FR, component: Fz}
-  - {name: RL_Fz, type: tyre, element: tyre_RL, component: Fz}
-  - {name: RR_Fz, type: tyre, element: tyre_RR, component: Fz}
+  - {name: FL_Fz, type: tyre, element: FL_tyre, component: Fz}
+  - {name: FR_Fz, type: tyre, element: FR_tyre, component: Fz}
+  - {name: RL_Fz, type: tyre, element: RL_tyre, component: Fz}
+  - {name: RR_Fz, type: tyre, element: RR_tyre, component: Fz}
 simulation: {end_time: 2.0, output_step: 0.005}
 EOF
 if run car.yaml car.csv --scene rigid; then
@@ -132,12 +152,13 @@ fi
 
 # 4. corner kinematics: chassis fixed, FL and RL lower arms turned by 0.26 sin(pi t / 2) rad
 # (the road 1 m down: no tyre touches it, so no tyre force steers the driven corners)
-base | sed -e '/^joints:/a\  rig_fix: {type: fixed, bodies: [ground, chassis], point: [-1.24, 0, 0.44]}' \
-           -e 's/flat_road: {type: flat}/flat_road: {type: flat, height: -1.0}/' > rig.yaml
+car "v0=0 vz0=0 spin_front=0 spin_rear=0" '{type: flat, height: -1.0}' > rig.yaml
 cat >> rig.yaml <<'EOF'
+joints:
+  rig_fix: {type: fixed, bodies: [ground, chassis], point: [-1.24, 0, 0.44]}
 drivers:
-  FL_travel: {joint: j01_FL_lower_pivot, motion: {type: sine, amplitude: 0.26, frequency: 0.25}}
-  RL_travel: {joint: j10_RL_lower_pivot, motion: {type: sine, amplitude: 0.26, frequency: 0.25}}
+  FL_travel: {joint: FL_lower_pivot, motion: {type: sine, amplitude: 0.26, frequency: 0.25}}
+  RL_travel: {joint: RL_lower_pivot, motion: {type: sine, amplitude: 0.26, frequency: 0.25}}
 outputs:   # camber, SAE sign (top outward +): minus the rotation about +x on the left
   - {name: FL_wz, type: position, body: FL_wheel, component: z}
   - {name: FL_camber, type: angle, body: FL_upright, axis: [1, 0, 0], scale: -57.29577951308232}
@@ -185,9 +206,9 @@ fi
 # 5. ride frequencies: dampers removed, chassis guided in heave or in pitch about
 #    its CG; the tyres radial springs only (at standstill their slip forces are
 #    stiff viscous dampers that hold the contact patches: not part of the ride rate)
-ride_run() { # ride_run NAME JOINT-LINE CHASSIS-VELOCITY-LINE
-  base | sed -e "/^joints:/a\\$2" -e "s/^    velocity: \[0, 0, 0\].*/$3/" -e '/_damper:/,/damping:/d' \
-             -e 's/^    \(longitudinal\|cornering\|camber\)_stiffness: .*/    \1_stiffness: 0/' > "$1.yaml"
+ride_run() { # ride_run NAME JOINT-LINE CHASSIS-START (the chassis's initial velocity)
+  base "tyre_slip=0 $3" FL_damper,FR_damper,RL_strut_damper,RR_strut_damper > "$1.yaml"
+  printf 'joints:\n%s\n' "$2" >> "$1.yaml"
   cat >> "$1.yaml" <<'EOF'
 outputs:
   - {name: z, type: position, body: chassis, component: z}
@@ -200,8 +221,8 @@ EOF
 freq() { awk -F, -v col="$2" 'NR == 2 { y0 = $col } NR > 2 { y = $col - y0
   if (py < 0 && y >= 0) { t = pt - py * ($1 - pt) / (y - py); if (!n) t0 = t; t1 = t; n++ } py = y; pt = $1 }
   END { if (n < 4) print "none"; else printf "%.5f", (n - 1) / (t1 - t0) }' "$1"; }
-if ride_run heave '  rig_heave: {type: prismatic, bodies: [ground, chassis], point: [-1.24, 0, 0.44], axis: [0, 0, 1]}' '    velocity: [0, 0, 0.05]' &&
-   ride_run pitch '  rig_pitch: {type: revolute, bodies: [ground, chassis], point: [-1.24, 0, 0.44], axis: [0, 1, 0]}' '    velocity: [0, 0, 0]\n    angular_velocity: [0, 0.05, 0]'; then
+if ride_run heave '  rig_heave: {type: prismatic, bodies: [ground, chassis], point: [-1.24, 0, 0.44], axis: [0, 0, 1]}' 'chassis_vz=0.05' &&
+   ride_run pitch '  rig_pitch: {type: revolute, bodies: [ground, chassis], point: [-1.24, 0, 0.44], axis: [0, 1, 0]}' 'chassis_wy=0.05'; then
   fh=$(freq heave.csv 2); fp=$(freq pitch.csv 3)
   # truth: ride rate per corner k = m_corner (2 pi f)^2; heave 2 (kf + kr) / m, pitch 2 (kf a^2 + kr b^2) / Iyy
   awk -v fh="$fh" -v fp="$fp" 'BEGIN { pi = 3.141592653589793
@@ -294,9 +315,11 @@ cols="chassis_az cm_az FL.Fz FR.Fz RL.Fz RR.Fz FL_travel RL_travel pitch roll"
 # (measured about 2e-5; the flexible chassis differs by 3e-3..9e-2); the CM
 # node's acceleration within 2 % (measured 0.3 %: the stiffened modes, now at
 # 0.2-1.6 kHz, are still rung by the tyres' landing; flexible: 53 %)
-sed 's/steel: {E: 2.1e+11, G: 8.08e+10,/steel: {E: 2.1e+14, G: 8.08e+13,/' "$root/models/sports_car_chassis.fe.yaml" > stiff_chassis.fe.yaml
-sed "s|fe_file: sports_car_chassis.fe.yaml|fe_file: $PWD/stiff_chassis.fe.yaml|" "$model" > stiff_car.yaml
-if grep -q 'E: 2.1e+14' stiff_chassis.fe.yaml && [ -s bump_rigid.csv ] && run stiff_car.yaml bump_stiff.csv --scene flexible --end 1.0; then
+# (the model's files copied as they are into stiff/, beside the stiffer FE file)
+mkdir -p stiff/sports_car stiff/subsystems
+cp "$model" stiff/ && cp "$root/models/sports_car/car.yaml" stiff/sports_car/ && cp "$root"/models/subsystems/*.yaml stiff/subsystems/
+sed 's/steel: {E: 2.1e+11, G: 8.08e+10,/steel: {E: 2.1e+14, G: 8.08e+13,/' "$root/models/sports_car_chassis.fe.yaml" > stiff/sports_car_chassis.fe.yaml
+if grep -q 'E: 2.1e+14' stiff/sports_car_chassis.fe.yaml && [ -s bump_rigid.csv ] && run stiff/sports_car.yaml bump_stiff.csv --scene flexible --end 1.0; then
   d=$(compare bump_rigid.csv bump_stiff.csv $cols)
   echo "flexible chassis x 1e3 stiffness against rigid (of the range): $d"
   awk -v d="$d" 'BEGIN { n = split(d, p, " "); if (n < 10) exit 1
@@ -323,17 +346,16 @@ fi
 #    R_e = R0 - delta/3 and the contact lever rho = R0 - delta (delta =
 #    Fz / K_z), within 0.5 %; the car holds its course (lateral drift below
 #    1 mm, yaw below 1e-4 rad: only the FE chassis's small asymmetry steers)
-awk '/^[A-Za-z_]/ { skip = ($0 ~ /^(outputs|simulation):/) } !skip' "$model" |
-  sed -e 's/road: bump_road/road: flat_road/' -e "s|fe_file: sports_car_chassis.fe.yaml|fe_file: $root/models/sports_car_chassis.fe.yaml|" > flat.yaml
+car "" '{type: flat}' > flat.yaml
 cat >> flat.yaml <<'EOF'
 outputs:
   - {name: vx, type: center_of_mass, quantity: velocity, component: x}
   - {name: y, type: position, body: chassis, component: y}
   - {name: yaw, type: angle, body: chassis, axis: [0, 0, 1]}
-  - {name: FL, type: tyre, element: tyre_FL, component: Fz}
-  - {name: FR, type: tyre, element: tyre_FR, component: Fz}
-  - {name: RL, type: tyre, element: tyre_RL, component: Fz}
-  - {name: RR, type: tyre, element: tyre_RR, component: Fz}
+  - {name: FL, type: tyre, element: FL_tyre, component: Fz}
+  - {name: FR, type: tyre, element: FR_tyre, component: Fz}
+  - {name: RL, type: tyre, element: RL_tyre, component: Fz}
+  - {name: RR, type: tyre, element: RR_tyre, component: Fz}
 simulation: {equilibrium: true, end_time: 1.0, output_step: 0.01}
 EOF
 for sc in rigid flexible; do

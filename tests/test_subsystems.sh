@@ -12,9 +12,10 @@
 #   3. errors inside a subsystem file point into it, with a note at the
 #      instance ("instantiated here"), and a nested instance resolves names
 #      and parameters through both levels;
-#   4. the sports car built from corner subsystems (tests/compose/
-#      sports_car_corners.yaml, models/subsystems/) gives the same CSV as
-#      models/sports_car.yaml, rigid and flexible chassis.
+#   4. the sports car built from corner and tyre subsystems
+#      (models/sports_car.yaml, models/sports_car/car.yaml, models/subsystems/)
+#      gives the same CSV as tests/compose/sports_car_flat.yaml, the same car
+#      written out by hand, rigid and flexible chassis.
 set -u
 cd "$(dirname "$0")/.."
 # shellcheck source=tests/shell_setup.sh
@@ -122,19 +123,22 @@ sed -i 's/^  m_wheel: .*/  m_wheel: 2 * q/' nest/parts/wheel.yaml
 grep -q "nest/parts/wheel.yaml:5:16: error: unknown parameter 'q'" bad.out || err "the error does not point into the subsystem file: $(cat bad.out)"
 grep -q "nest/parts/corner.yaml:10:3: note: in the subsystem 'w' instantiated here" bad.out || err "no note at the inner instance: $(cat bad.out)"
 grep -q "nest/car.yaml:7:3: note: in the subsystem 'fl' instantiated here" bad.out || err "no note at the outer instance: $(cat bad.out)"
-# 4. the sports car with its corners as subsystems (models/subsystems/: the
-#    front double wishbone and the rear McPherson strut, mirrored for the
-#    right side, mounted on the FE chassis's nodes through node attachments)
-#    moves exactly as models/sports_car.yaml with its corners written out:
-#    the same CSV, rigid and flexible chassis, through the bump (generic path)
+# 4. the sports car with its corners and tyres as subsystems (models/sports_car.yaml
+#    includes models/sports_car/car.yaml, which instantiates models/subsystems/:
+#    the front double wishbone, the rear McPherson strut and the tyre, mirrored
+#    for the right side, mounted on the FE chassis's nodes through node
+#    attachments) moves exactly as tests/compose/sports_car_flat.yaml, the car
+#    written out by hand (the joints there named j01_FL_lower_pivot ..., the
+#    tyres tyre_FL ...): the same CSV, rigid and flexible chassis, through the
+#    bump (generic path)
 for scene in rigid base; do
   args=(--end 0.7 --path generic --plot none --quiet)
   [ $scene = base ] || args+=(--scene $scene)
-  "$MBCC" run "$root/tests/compose/sports_car_corners.yaml" "${args[@]}" -o car_sub_$scene.csv > log 2>&1 ||
-    err "run sports_car_corners ($scene): $(grep error log | head -3)"
-  "$MBCC" run "$root/models/sports_car.yaml" "${args[@]}" -o car_hand_$scene.csv > log 2>&1 ||
+  "$MBCC" run "$root/models/sports_car.yaml" "${args[@]}" -o car_sub_$scene.csv > log 2>&1 ||
     err "run sports_car ($scene): $(grep error log | head -3)"
-  [ "$(wc -l < car_sub_$scene.csv)" -gt 600 ] || err "sports_car_corners ($scene): too few rows"
+  "$MBCC" run "$root/tests/compose/sports_car_flat.yaml" "${args[@]}" -o car_hand_$scene.csv > log 2>&1 ||
+    err "run sports_car_flat ($scene): $(grep error log | head -3)"
+  [ "$(wc -l < car_sub_$scene.csv)" -gt 600 ] || err "sports_car ($scene): too few rows"
   cmp -s car_sub_$scene.csv car_hand_$scene.csv ||
     err "the car with subsystem corners ($scene) moves otherwise than the car written out: $(diff car_sub_$scene.csv car_hand_$scene.csv | head -4)"
 done

@@ -19,8 +19,8 @@
 
 /* the sections an included file may supply; everything else belongs to the
  * including model */
-static const char *const included_sections[] = {"bodies", "joints", "drivers", "forces",
-                                                "outputs", "scenes", "parameters", NULL};
+static const char *const included_sections[] = {"bodies", "joints",     "drivers",    "forces", "outputs",
+                                                "scenes", "parameters", "subsystems", NULL};
 
 typedef struct {
   const char *path;   /* the file the document came from, for messages */
@@ -295,7 +295,7 @@ static void merge_sections(includer *c, const char *path, yaml_document_t *src) 
   if (root->type != YAML_MAPPING_NODE) {
     diag_error(path, mark_loc(root->start_mark),
                "an included file must be a mapping of sections (bodies, joints, drivers, forces, "
-               "outputs, scenes)");
+               "outputs, scenes, parameters, subsystems)");
     c->ok = false;
     return;
   }
@@ -309,7 +309,7 @@ static void merge_sections(includer *c, const char *path, yaml_document_t *src) 
     if (!allowed) {
       diag_error(path, mark_loc(key->start_mark),
                  "%s%.*s%s cannot come from an included file (it supplies parameters, bodies, joints, drivers, "
-                 "forces, outputs and scenes)", key->type == YAML_SCALAR_NODE ? "'" : "",
+                 "forces, outputs, scenes and subsystems)", key->type == YAML_SCALAR_NODE ? "'" : "",
                  key->type == YAML_SCALAR_NODE ? (int)key->data.scalar.length : 7,
                  key->type == YAML_SCALAR_NODE ? (const char *)key->data.scalar.value : "this key",
                  key->type == YAML_SCALAR_NODE ? "'" : "");
@@ -474,13 +474,16 @@ static char *resolve(const scope *s, int kind, const char *name, size_t length) 
 }
 
 
+/* a new scalar with the marks of 'like' (copied first: adding a node may move
+ * the document's nodes, 'like' among them) */
 static int add_scalar_like(yaml_document_t *doc, const yaml_node_t *like, const char *tag, const char *text) {
+  yaml_mark_t start = like->start_mark, end = like->end_mark;
   int to = yaml_document_add_scalar(doc, (yaml_char_t *)(uintptr_t)tag, (const yaml_char_t *)text, (int)strlen(text),
                                     YAML_PLAIN_SCALAR_STYLE);
   if (!to) out_of_memory();
   yaml_node_t *n = yaml_document_get_node(doc, to);
-  n->start_mark = like->start_mark;
-  n->end_mark = like->end_mark;
+  n->start_mark = start;
+  n->end_mark = end;
   return to;
 }
 
