@@ -92,6 +92,62 @@ static const char *runtime_name(const ir_model *ir, const ir_expr *e) {
 
 static bool same(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
 
+/* The attachment points of force elements written as expressions over
+ * run-time parameters (B: the model read with the parameters moved): each
+ * moved coordinate of a force's global point must equal, in both readings, a
+ * field of the model; its marker's body-frame offset then follows it at run
+ * time (set_params writes markers[k].s).  Markers on flexible nodes and tyres
+ * are not supported: a located error. */
+static int bind_force_points(mbc_unit *u, const ir_model *B, const lmodel *LB, bool *bound, const ir_param *first) {
+  const ir_model *A = u->ir;
+  lmodel *LA = u->lowered;
+  int rc = 0;
+  for (int k = 0; k < LA->m.nforce; k++) {
+    const mb_forcedef *d = &LA->force[k];
+    const ir_force *FA = &A->forces[LA->force_ir[k]], *FB = &B->forces[LB->force_ir[k]];
+    for (int side = 0; side < 2; side++) {
+      int mk = side ? d->m1 : d->m0;
+      if (mk < 0) continue;
+      for (int j = 0; j < 3; j++) {
+        double a = FA->point[side][j], b = FB->point[side][j];
+        if (same(a, b)) continue;
+        const mb_markerdef *M = &LA->marker[mk];
+        int use = -1;
+        for (int pass = 0; pass < 2 && use < 0; pass++)
+          for (int i = 0; i < A->nuses && use < 0; i++)
+            if (A->uses[i].uses_runtime && (pass || !bound[i]) && same(A->uses[i].value, a) && same(B->uses[i].value, b))
+              use = i;
+        const char *why = use < 0 ? "its point is derived from the parameter rather than written in its field"
+                          : M->node >= 0 ? "the point is on a flexible body's node"
+                          : d->kind == MB_FORCE_TYRE ? "a tyre's wheel centre is fixed at compile time" : NULL;
+        if (why) {
+          diag_error(u->path, FA->loc, "force '%s': run-time parameter '%s' moves its attachment point, but %s "
+                     "(run-time points are supported for force elements on rigid bodies and the ground, written "
+                     "as global coordinates in 'point' fields); make the parameter compile-time (drop 'runtime: "
+                     "true')", FA->name, first->name, why);
+          rc = 2;
+          continue;
+        }
+        bound[use] = true;
+        runtime_binding *bd = &u->bind[u->nbind++];
+        *bd = (runtime_binding){.pool = BIND_MARKER_POINT, .index = mk, .use = use, .force = k};
+        bd->component = j;
+        bd->side = side;
+        static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+        if (M->body < 0) {
+          memcpy(bd->frame_A, I3, sizeof I3);
+        } else {
+          const double *q = LA->q0 + LA->body[M->body].qadr;
+          mb_euler_to_A(q + 3, bd->frame_A);
+          memcpy(bd->frame_r, q, sizeof bd->frame_r);
+        }
+        LA->marker_runtime[mk] = 1;
+      }
+    }
+  }
+  return rc;
+}
+
 /* Which pool entries of the lowered model the run-time parameters set.  The
  * model is read and lowered a second time with every run-time parameter
  * moved a little (by a different fraction each); an entry of the force pools
@@ -109,9 +165,10 @@ static int bind_runtime(mbc_unit *u) {
   const char **names = calloc((size_t)nrt, sizeof *names);
   double *values = calloc((size_t)nrt, sizeof *values);
   bool *bound = calloc((size_t)A->nuses + 1, sizeof *bound);
-  u->bind = calloc((size_t)(LA->m.nforce_prm + 2 * LA->m.nforce_law) + 1, sizeof *u->bind);
+  u->bind = calloc((size_t)(LA->m.nforce_prm + 2 * LA->m.nforce_law + 6 * LA->m.nforce) + 1, sizeof *u->bind);
   u->lowered->prm_runtime = calloc((size_t)LA->m.nforce_prm + 1, 1);
-  if (!names || !values || !bound || !u->bind || !u->lowered->prm_runtime) {
+  u->lowered->marker_runtime = calloc((size_t)LA->m.nmarker + 1, 1);
+  if (!names || !values || !bound || !u->bind || !u->lowered->prm_runtime || !u->lowered->marker_runtime) {
     free(names); free(values); free(bound);
     diag_error(u->path, (ir_loc){0, 0}, "out of memory while binding run-time parameters");
     return 2;
@@ -173,15 +230,18 @@ static int bind_runtime(mbc_unit *u) {
       continue;
     }
     bound[use] = true;
-    u->bind[u->nbind++] = (runtime_binding){pool, index, use, force};
+    u->bind[u->nbind++] = (runtime_binding){.pool = pool, .index = index, .use = use, .force = force};
     if (pool == BIND_PRM) u->lowered->prm_runtime[index] = 1;
   }
+  if (!rc) rc = bind_force_points(u, B, LB, bound, first);
   for (int i = 0; i < A->nuses; i++)
     if (A->uses[i].uses_runtime && !A->uses[i].pruned && !bound[i] && !same(A->uses[i].value, B->uses[i].value)) {
       diag_error(u->path, A->uses[i].loc,
                  "this value depends on run-time parameter '%s', but the generated code fixes it at compile "
                  "time (run-time parameters can set force-element constants: stiffness, damping, preload, free "
-                 "length, force and torque values); make the parameter compile-time (drop 'runtime: true')",
+                 "length, force and torque values, and the attachment points of force elements on rigid bodies "
+                 "and the ground; not joint points, body positions, masses, inertia, flexible bodies or "
+                 "gravity); make the parameter compile-time (drop 'runtime: true')",
                  runtime_name(A, A->uses[i].expr));
       rc = 2;
     }
@@ -190,12 +250,13 @@ static int bind_runtime(mbc_unit *u) {
   for (int b = 0; b < LA->m.nbody && !moved; b++)
     moved = !same(LA->body[b].mass, LB->body[b].mass) || memcmp(LA->body[b].J, LB->body[b].J, sizeof LA->body[b].J);
   for (int k = 0; k < LA->m.nmarker && !moved; k++)
-    moved = memcmp(LA->marker[k].s, LB->marker[k].s, sizeof LA->marker[k].s) ||
+    moved = (!LA->marker_runtime[k] && memcmp(LA->marker[k].s, LB->marker[k].s, sizeof LA->marker[k].s)) ||
             memcmp(LA->marker[k].C, LB->marker[k].C, sizeof LA->marker[k].C);
   for (int k = 0; k < LA->m.nrow && !moved; k++) moved = !same(LA->row[k].L, LB->row[k].L);
   if (moved && !rc) {
     diag_error(u->path, first->loc, "run-time parameter '%s' changes the model's masses, geometry or gravity, which "
-               "the generated code fixes at compile time: make it compile-time (drop 'runtime: true')", first->name);
+               "the generated code fixes at compile time (of the geometry, only force elements' attachment points "
+               "can be run-time): make it compile-time (drop 'runtime: true')", first->name);
     rc = 2;
   }
 done:
@@ -249,6 +310,7 @@ void mbc_unit_free(mbc_unit *u) {
   free(u->bind);
   if (u->lowered) {
     free(u->lowered->prm_runtime);
+    free(u->lowered->marker_runtime);
     lower_free(u->lowered);
   }
   flex_product_free(&u->flex);

@@ -33,11 +33,18 @@ typedef struct mbc_unit {
 } mbc_unit;
 
 /* one pool entry of the lowered model set by an expression over run-time
- * parameters: force_prm[index], or force_law[index].coef / .exponent */
-typedef enum { BIND_PRM, BIND_LAW_COEF, BIND_LAW_EXPONENT } runtime_pool;
+ * parameters: force_prm[index], or force_law[index].coef / .exponent, or
+ * (BIND_MARKER_POINT) coordinate `component` of the global point at t = 0 of
+ * force marker `index`, whose body-frame offset markers[index].s follows it */
+typedef enum { BIND_PRM, BIND_LAW_COEF, BIND_LAW_EXPONENT, BIND_MARKER_POINT } runtime_pool;
 typedef struct runtime_binding {
   runtime_pool pool;
   int index;
+  int component; /* BIND_MARKER_POINT: x, y or z */
+  int side;      /* BIND_MARKER_POINT: which end of the force element */
+  /* BIND_MARKER_POINT: the body's frame the offset was taken in (A, r at the
+     lowered q0, before assembly: as lower.c's add_marker took it) */
+  double frame_A[9], frame_r[3];
   int use;      /* ir->uses[use]: its expression and location */
   int force;    /* the force element (lowered index) */
 } runtime_binding;

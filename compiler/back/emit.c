@@ -163,6 +163,48 @@ static void limit_literal(FILE *f, double x) {
   else num(f, x);
 }
 
+/* set_params's lines for a force marker whose global point at t = 0 has
+ * run-time coordinates (binding i, the marker's first): its offset in the
+ * body's frame, s = A^T (P - r), the arithmetic of lower.c's add_marker with
+ * P's run-time coordinates as expressions */
+static void emit_marker_point(FILE *f, const mbc_unit *u, int i) {
+  const ir_model *ir = u->ir;
+  const runtime_binding *b = &u->bind[i];
+  for (int e = 0; e < i; e++)
+    if (u->bind[e].pool == BIND_MARKER_POINT && u->bind[e].index == b->index) return; /* written already */
+  const ir_force *F = &ir->forces[u->lowered->force_ir[b->force]];
+  const bool on_ground = u->lowered->marker[b->index].body < 0;
+  const char *cast = u->real_float ? "p" : "(double)p";
+  for (int r = 0; r < 3; r++) {
+    fprintf(f, "  markers[%d].s[%d] = (mb_real)(", b->index, r); /* force 'F', point of side */
+    for (int j = 0; j < 3; j++) {
+      int use = -1;
+      for (int e = i; e < u->nbind; e++)
+        if (u->bind[e].pool == BIND_MARKER_POINT && u->bind[e].index == b->index && u->bind[e].component == j)
+          use = u->bind[e].use;
+      if (on_ground && j != r) continue;
+      if (!on_ground) {
+        if (j) fputs(" + ", f);
+        num(f, b->frame_A[3 * j + r]);
+        fputs(" * (", f);
+      }
+      if (use >= 0) {
+        fputc('(', f);
+        expr_print_c(f, ir, ir->uses[use].expr, cast);
+        fputc(')', f);
+      } else {
+        num(f, F->point[b->side][j]);
+      }
+      if (!on_ground) {
+        fputs(" - ", f);
+        num(f, b->frame_r[j]);
+        fputc(')', f);
+      }
+    }
+    fprintf(f, "); /* force '%s', point %d, %s */\n", F->name, b->side, r == 0 ? "x" : r == 1 ? "y" : "z");
+  }
+}
+
 /* the run-time parameters: names, defaults, bounds, and set_params, which
  * writes the pool entries they set (pipeline.c, bind_runtime) */
 static void emit_runtime_params(emit_ctx *cx) {
@@ -212,6 +254,10 @@ static void emit_runtime_params(emit_ctx *cx) {
     const runtime_binding *b = &u->bind[i];
     const ir_force *F = &ir->forces[L->force_ir[b->force]];
     const ir_expr_use *use = &ir->uses[b->use];
+    if (b->pool == BIND_MARKER_POINT) {
+      emit_marker_point(f, u, i);
+      continue;
+    }
     fprintf(f, "  /* force '%s', ", F->name); /* an included or subsystem file's line: that file's */
     loc_comment(f, L, use->loc);
     fputs(" */\n  ", f);
@@ -345,7 +391,9 @@ static void emit_tables(emit_ctx *cx) {
     fputs("};\n", f);
   }
   if (m->nmarker) {
-    fprintf(f, "static const mb_markerdef markers[%d] = {\n", m->nmarker);
+    bool runtime_markers = false; /* set_params writes their offsets: then not const */
+    for (int k = 0; L->marker_runtime && k < m->nmarker; k++) runtime_markers |= L->marker_runtime[k];
+    fprintf(f, "static %smb_markerdef markers[%d] = {\n", runtime_markers ? "" : "const ", m->nmarker);
     for (int k = 0; k < m->nmarker; k++) {
       const mb_markerdef *d = &L->marker[k];
       fprintf(f, "  /* %d: %s */\n  {.body = %d, .node = %d", k, L->marker_desc[k], d->body, d->node);

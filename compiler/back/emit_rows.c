@@ -198,6 +198,7 @@ int emit_marker_special(FILE *f, const lmodel *L, int k) {
   const double *s;
   if (!marker_rigid(L, k, &s)) return 0;
   const mb_markerdef *d = &L->marker[k];
+  const int runtime_s = L->marker_runtime && L->marker_runtime[k]; /* s read from markers[k] (set_params) */
   int b = d->body;
   /* mb_marker_rigid: u = A s, R = A C, P = r + u, V = rd + w x u, W = w,
      aP = w x (w x u), aW = 0 */
@@ -217,14 +218,15 @@ int emit_marker_special(FILE *f, const lmodel *L, int k) {
       fprintf(f, "  k%d.R[%d] = %s;\n", k, 3 * i + j, e);
     }
   svec u;
+  char sj[3][EXPR];
+  for (int j = 0; j < 3; j++)
+    if (runtime_s) snprintf(sj[j], EXPR, "markers[%d].s[%d]", k, j);
+    else lit(sj[j], s[j]);
   for (int i = 0; i < 3; i++) {
-    lit(c, s[0]);
-    s_mul(u.e[i], A[3 * i], c);
-    lit(c, s[1]);
-    s_mul(p, A[3 * i + 1], c);
+    s_mul(u.e[i], A[3 * i], sj[0]);
+    s_mul(p, A[3 * i + 1], sj[1]);
     s_add(u.e[i], u.e[i], p);
-    lit(c, s[2]);
-    s_mul(p, A[3 * i + 2], c);
+    s_mul(p, A[3 * i + 2], sj[2]);
     s_add(u.e[i], u.e[i], p);
   }
   int moving = !(is_zero(u.e[0]) && is_zero(u.e[1]) && is_zero(u.e[2]));
@@ -335,6 +337,7 @@ static int frame_axes(const lmodel *L, int k);
 int emit_marker_is_frame(const lmodel *L, int k) {
   const double *s;
   if (frame_axes(L, k) < 0 || !marker_rigid(L, k, &s)) return 0;
+  if (L->marker_runtime && L->marker_runtime[k]) return 0; /* its offset is set at run time */
   return s[0] == 0 && s[1] == 0 && s[2] == 0;
 }
 
@@ -368,7 +371,7 @@ static void mark_view(const lmodel *L, int k, smark *m) {
   if (marker_rigid(L, k, &s)) {
     m->rigid = 1;
     s_zero(&m->aW);
-    if (s[0] == 0 && s[1] == 0 && s[2] == 0) {
+    if (s[0] == 0 && s[1] == 0 && s[2] == 0 && !(L->marker_runtime && L->marker_runtime[k])) {
       m->at_origin = 1;
       s_zero(&m->aP);
     }

@@ -59,6 +59,9 @@ typedef struct {
    * then reads the pool instead of a literal); NULL when none does.  Owned by
    * the compilation unit (pipeline.c). */
   unsigned char *prm_runtime;
+  /* per marker: 1 when its offset s is set by run-time parameters (a force
+     element's attachment point): the emitted code reads markers[k].s */
+  unsigned char *marker_runtime;
 } lmodel;
 
 /* For the lowering hooks of the elements (compiler/elements/): the marker
