@@ -225,7 +225,8 @@ static int bind_runtime(mbc_unit *u) {
     if (use < 0) {
       diag_error(u->path, F->loc, "force '%s' uses a value derived from run-time parameter '%s' (only values written "
                  "in its fields can be run-time: stiffness, damping, preload, free length, force and torque "
-                 "values); make the parameter compile-time (drop 'runtime: true')", F->name, first->name);
+                 "values, attachment points; a spring's free length measured from run-time points must be "
+                 "written as 'free_length'); make the parameter compile-time (drop 'runtime: true')", F->name, first->name);
       rc = 2;
       continue;
     }
@@ -233,7 +234,7 @@ static int bind_runtime(mbc_unit *u) {
     u->bind[u->nbind++] = (runtime_binding){.pool = pool, .index = index, .use = use, .force = force};
     if (pool == BIND_PRM) u->lowered->prm_runtime[index] = 1;
   }
-  if (!rc) rc = bind_force_points(u, B, LB, bound, first);
+  if (bind_force_points(u, B, LB, bound, first)) rc = 2;
   for (int i = 0; i < A->nuses; i++)
     if (A->uses[i].uses_runtime && !A->uses[i].pruned && !bound[i] && !same(A->uses[i].value, B->uses[i].value)) {
       diag_error(u->path, A->uses[i].loc,

@@ -79,6 +79,40 @@ else
   err "mbcc run --set of the attachment points failed: $(cat set.log)"
 fi
 
+# 1b. a bushing's point (both its markers, on two bodies, one turned) and a
+#     point force's point, against the recompiled model and the generic path
+bushing() { # bx fx (numbers or parameter names), name, parameter lines
+  cat <<YAML
+name: $3
+gravity: [0, 0, -9.81]
+bodies:
+  arm: {type: rigid, mass: 3.0, inertia: [0.02, 0.5, 0.5], position: [0.6, 0, 0], orientation: {axis: [0, 0, 1], angle: 0.3}}
+  bob: {type: rigid, mass: 1.0, inertia: [0.01, 0.01, 0.01], position: [1.2, 0, 0]}
+joints:
+  hinge: {type: revolute, bodies: [ground, arm], point: [0, 0, 0], axis: [0, 1, 0]}
+forces:
+  bush: {type: bushing, bodies: [arm, bob], point: [$1, 0.1, 0], stiffness: [1e4, 1e4, 1e4, 50, 50, 50], damping: [10, 10, 10, 0.1, 0.1, 0.1]}
+  push: {type: force, body: arm, point: [$2, 0, 0], value: [0, 0, 20], frame: global}
+outputs:
+  - {name: bob_z, type: position, body: bob, point: [1.2, 0, 0], component: z}
+simulation: {end_time: 0.3, output_step: 0.01}
+YAML
+  [ $# -gt 3 ] && printf 'parameters:\n%s\n' "$4"
+}
+bushing bx fx bush_rt "  bx: {value: 1.2, runtime: true}
+  fx: {value: 0.5, runtime: true}" > bush_rt.yaml
+bushing 1.1 0.8 bush_fixed > bush_fixed.yaml
+if run bush_rt.yaml -o bset.csv --set bx=1.1 --set fx=0.8 > bset.log 2>&1 &&
+   run bush_fixed.yaml -o bfixed.csv > bfixed.log 2>&1 &&
+   run bush_rt.yaml -o bgeneric.csv --set bx=1.1 --set fx=0.8 --path generic > bgeneric.log 2>&1 &&
+   run bush_rt.yaml -o bdefault.csv > bdefault.log 2>&1; then
+  close bset.csv bfixed.csv || err "bushing and force points: --set and the recompiled model differ"
+  close bset.csv bgeneric.csv || err "bushing and force points: the generic path differs"
+  close bset.csv bdefault.csv && err "bushing and force points: --set changed nothing"
+else
+  err "the bushing model failed: $(cat bset.log bfixed.log bgeneric.log bdefault.log)"
+fi
+
 # 2. the closed form at t = 0: spring from (a, 0, 0.8) to (p, 0, 0) on the arm,
 #    length l = sqrt((a - p)^2 + 0.8^2), tension T = k (l - 0.7) (no velocity
 #    yet), its force on the arm T (a - p, 0, 0.8) / l at (p, 0, 0): torque

@@ -176,15 +176,17 @@ static void emit_marker_point(FILE *f, const mbc_unit *u, int i) {
   const bool on_ground = u->lowered->marker[b->index].body < 0;
   const char *cast = u->real_float ? "p" : "(double)p";
   for (int r = 0; r < 3; r++) {
-    fprintf(f, "  markers[%d].s[%d] = (mb_real)(", b->index, r); /* force 'F', point of side */
+    fprintf(f, "  markers[%d].s[%d] = (mb_real)(", b->index, r);
+    int written = 0;
     for (int j = 0; j < 3; j++) {
       int use = -1;
       for (int e = i; e < u->nbind; e++)
         if (u->bind[e].pool == BIND_MARKER_POINT && u->bind[e].index == b->index && u->bind[e].component == j)
           use = u->bind[e].use;
-      if (on_ground && j != r) continue;
+      /* a zero entry of A adds an exact zero: left out */
+      if (on_ground ? j != r : b->frame_A[3 * j + r] == 0) continue;
       if (!on_ground) {
-        if (j) fputs(" + ", f);
+        if (written++) fputs(" + ", f);
         num(f, b->frame_A[3 * j + r]);
         fputs(" * (", f);
       }
