@@ -243,7 +243,7 @@ released) FE model; why they differ: [model-format.md](model-format.md#flexible-
 
 | mode | 1 | 2 | 3 | 4 | 5 | 6 | 7 | 8 | 9 | 10 |
 |---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|
-| mbcc, Hz | $(echo "$freqs" | awk '{ for (i = 1; i <= NF; i++) printf "%s%.4g", i > 1 ? " | " : "", $i }') |
+| mbcc, Hz | $(echo "$freqs" | awk '{ for (i = 1; i <= NF; i++) printf "%s%.4g", (i > 1 ? " | " : ""), $i }') |
 | vehicle spec §10.3 (substitute frame), Hz | 7.72 | 9.05 | 18.15 | 21.22 | 22.87 | 24.83 | 27.57 | 29.09 | 33.75 | 38.79 |
 | seed 000 Table 5 (published model), Hz | 6.97 | 9.41 | 10.96 | 13.81 | 25.26 | 32.41 | 38.55 | 45.95 | 50.27 | 50.31 |
 
