@@ -259,7 +259,8 @@ F=$ROOT/models/slider_crank_flexible.yaml
 (cd "$W" && "$MBCC" check "$F") >"$W/flex_check.log" 2>&1 || { cat "$W/flex_check.log" >&2; die "mbcc check failed"; }
 flex_freq=$(sed -n 's/^ *frequencies (Hz): *//p' "$W/flex_check.log" | head -1)
 flex_nmodes=$(sed -n "s/^ *flexible body 'rod': .* \([0-9]*\) modes .*/\1/p" "$W/flex_check.log" | head -1)
-flex_damp=$(sed -n 's/^ *mass .*damping ratios: *//p' "$W/flex_check.log" | head -1)
+flex_damp=$(sed -n 's/^.*damping ratios: *//p' "$W/flex_check.log" | head -1)
+[ -n "$flex_damp" ] || die "mbcc check printed no modal damping ratios"
 rel2() { awk -v a="$1" -v b="$2" 'BEGIN { if (b > 0) printf "%.2f", a / b; else printf "—" }'; }
 FT=$W/flex_table.md
 : >"$FT"
