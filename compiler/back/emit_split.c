@@ -44,17 +44,22 @@ int eval_split_begin(eval_split *s) {
   return s->body ? 0 : -1;
 }
 
+/* one more mark fits (arrays doubled as needed); on failure the split is off */
+static int room_for_mark(eval_split *s) {
+  if (s->nmark < s->cap) return 0;
+  int cap = s->cap ? 2 * s->cap : 256;
+  long *mk = realloc(s->mark, sizeof *mk * (size_t)cap);
+  if (mk) s->mark = mk;
+  char **lb = realloc(s->label, sizeof *lb * (size_t)cap);
+  if (lb) s->label = lb;
+  if (!mk || !lb) { s->failed = 1; return -1; }
+  s->cap = cap;
+  return 0;
+}
+
 void eval_split_mark(eval_split *s, const char *fmt, ...) {
   if (s->failed) return;
-  if (s->nmark == s->cap) {
-    int cap = s->cap ? 2 * s->cap : 256;
-    long *mk = realloc(s->mark, sizeof *mk * (size_t)cap);
-    if (mk) s->mark = mk;
-    char **lb = realloc(s->label, sizeof *lb * (size_t)cap);
-    if (lb) s->label = lb;
-    if (!mk || !lb) { s->failed = 1; return; }
-    s->cap = cap;
-  }
+  if (room_for_mark(s)) return;
   char buf[256];
   va_list ap;
   va_start(ap, fmt);
@@ -76,15 +81,7 @@ void eval_split_mark_lines(eval_split *s, long from, const char *prefix, const c
   /* the stream's buffer is valid after fflush, up to ftell */
   for (long i = from + 1; i + (long)n <= end; i++)
     if (s->text[i - 1] == '\n' && !memcmp(s->text + i, prefix, n) && i > s->mark[s->nmark - 1]) {
-      if (s->nmark == s->cap) {
-        int cap = s->cap ? 2 * s->cap : 256;
-        long *mk = realloc(s->mark, sizeof *mk * (size_t)cap);
-        if (mk) s->mark = mk;
-        char **lb = realloc(s->label, sizeof *lb * (size_t)cap);
-        if (lb) s->label = lb;
-        if (!mk || !lb) { s->failed = 1; return; }
-        s->cap = cap;
-      }
+      if (room_for_mark(s)) return;
       s->mark[s->nmark] = i;
       s->label[s->nmark] = strdup(label);
       if (!s->label[s->nmark]) { s->failed = 1; return; }
