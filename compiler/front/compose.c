@@ -520,25 +520,42 @@ static yaml_node_item_t *value_slot(yaml_document_t *doc, int map, const char *k
   return NULL;
 }
 
+/* a fresh copy of the sequence in *slot (the original may be shared through
+ * anchors), each item passed through 'change'; returns the copy's node id */
+typedef void item_change(yaml_document_t *doc, int index, yaml_node_item_t *item, void *ctx);
+static int copy_sequence(yaml_document_t *doc, const yaml_node_item_t *slot, item_change *change, void *ctx) {
+  yaml_node_t *v = yaml_document_get_node(doc, *slot);
+  int list = yaml_document_add_sequence(doc, v->tag, v->data.sequence.style);
+  if (!list) out_of_memory();
+  v = yaml_document_get_node(doc, *slot); /* adding a node may move them all */
+  int count = (int)(v->data.sequence.items.top - v->data.sequence.items.start);
+  yaml_mark_t start = v->start_mark, end = v->end_mark;
+  for (int i = 0; i < count; i++) {
+    v = yaml_document_get_node(doc, *slot);
+    yaml_node_item_t item = v->data.sequence.items.start[i];
+    change(doc, i, &item, ctx);
+    if (!yaml_document_append_sequence_item(doc, list, item)) out_of_memory();
+  }
+  yaml_node_t *l = yaml_document_get_node(doc, list);
+  l->start_mark = start;
+  l->end_mark = end;
+  return list;
+}
+
+typedef struct { instancer *g; int kind; } rename_ctx;
+static void rename_item(yaml_document_t *doc, int index, yaml_node_item_t *item, void *ctx) {
+  (void)doc, (void)index;
+  const rename_ctx *r = ctx;
+  rename_ref(r->g, item, r->kind);
+}
+
 static void rename_key(instancer *g, int map, const char *key, int kind) {
   yaml_node_item_t *slot = value_slot(g->c->doc, map, key);
   if (slot == NULL) return;
   yaml_node_t *v = yaml_document_get_node(g->c->doc, *slot);
-  if (v->type == YAML_SEQUENCE_NODE) { /* a list of names: a fresh list (the original may be shared) */
-    int list = yaml_document_add_sequence(g->c->doc, v->tag, v->data.sequence.style);
-    if (!list) out_of_memory();
-    v = yaml_document_get_node(g->c->doc, *slot);
-    int count = (int)(v->data.sequence.items.top - v->data.sequence.items.start);
-    yaml_mark_t start = v->start_mark, end = v->end_mark;
-    for (int i = 0; i < count; i++) {
-      v = yaml_document_get_node(g->c->doc, *slot);
-      yaml_node_item_t item = v->data.sequence.items.start[i];
-      rename_ref(g, &item, kind);
-      if (!yaml_document_append_sequence_item(g->c->doc, list, item)) out_of_memory();
-    }
-    yaml_node_t *l = yaml_document_get_node(g->c->doc, list);
-    l->start_mark = start;
-    l->end_mark = end;
+  if (v->type == YAML_SEQUENCE_NODE) { /* a list of names */
+    rename_ctx r = {g, kind};
+    int list = copy_sequence(g->c->doc, slot, rename_item, &r);
     *value_slot(g->c->doc, map, key) = list;
   } else {
     rename_ref(g, slot, kind);
@@ -553,6 +570,11 @@ static void rename_node(yaml_document_t *doc, const scope *s, yaml_node_item_t *
   if (a >= s->nbody_attach) *slot = add_scalar_like(doc, n, NULL, s->attach_to[a]);
 }
 
+static void rename_node_item(yaml_document_t *doc, int index, yaml_node_item_t *item, void *ctx) {
+  (void)index;
+  rename_node(doc, ctx, item);
+}
+
 static void rename_nodes(instancer *g, int map) {
   yaml_document_t *doc = g->c->doc;
   if (g->s->nbody_attach == g->s->attach.count) return;
@@ -560,81 +582,48 @@ static void rename_nodes(instancer *g, int map) {
   if (one != NULL) rename_node(doc, g->s, one);
   yaml_node_item_t *slot = value_slot(doc, map, "nodes");
   if (slot == NULL || yaml_document_get_node(doc, *slot)->type != YAML_SEQUENCE_NODE) return;
-  yaml_node_t *v = yaml_document_get_node(doc, *slot);
-  int list = yaml_document_add_sequence(doc, v->tag, v->data.sequence.style); /* fresh: it may be shared */
-  if (!list) out_of_memory();
-  v = yaml_document_get_node(doc, *slot);
-  int count = (int)(v->data.sequence.items.top - v->data.sequence.items.start);
-  yaml_mark_t start = v->start_mark, end = v->end_mark;
-  for (int i = 0; i < count; i++) {
-    v = yaml_document_get_node(doc, *slot);
-    yaml_node_item_t item = v->data.sequence.items.start[i];
-    rename_node(doc, g->s, &item);
-    if (!yaml_document_append_sequence_item(doc, list, item)) out_of_memory();
-  }
-  yaml_node_t *l = yaml_document_get_node(doc, list);
-  l->start_mark = start;
-  l->end_mark = end;
-  *value_slot(doc, map, "nodes") = list;
+  *value_slot(doc, map, "nodes") = copy_sequence(doc, slot, rename_node_item, (void *)g->s);
 }
 
 /* mirror: the numbers at the set bits of 'mask' of the list in *slot change
  * sign (a fresh list and fresh scalars carrying COMPOSE_MIRROR_TAG: the
  * original nodes may be shared through anchors) */
+static void flip_item(yaml_document_t *doc, int index, yaml_node_item_t *item, void *ctx) {
+  unsigned mask = *(const unsigned *)ctx;
+  yaml_node_t *n = yaml_document_get_node(doc, *item);
+  if (index >= 32 || !(mask >> index & 1u) || n->type != YAML_SCALAR_NODE) return;
+  char *text = xstrndup((const char *)n->data.scalar.value, n->data.scalar.length);
+  n = yaml_document_get_node(doc, *item);
+  int to = add_scalar_like(doc, n, compose_is_mirrored(n) ? NULL : COMPOSE_MIRROR_TAG, text);
+  yaml_node_t *t = yaml_document_get_node(doc, to);
+  n = yaml_document_get_node(doc, *item);
+  t->data.scalar.style = n->data.scalar.style;
+  free(text);
+  *item = to;
+}
+
 static void flip(yaml_document_t *doc, yaml_node_item_t *slot, unsigned mask) {
   if (slot == NULL) return;
   yaml_node_t *v = yaml_document_get_node(doc, *slot);
   if (v == NULL || v->type != YAML_SEQUENCE_NODE) return;
-  int list = yaml_document_add_sequence(doc, v->tag, v->data.sequence.style);
-  if (!list) out_of_memory();
-  v = yaml_document_get_node(doc, *slot);
-  int count = (int)(v->data.sequence.items.top - v->data.sequence.items.start);
-  yaml_mark_t start = v->start_mark, end = v->end_mark;
-  for (int i = 0; i < count; i++) {
-    v = yaml_document_get_node(doc, *slot);
-    int item = v->data.sequence.items.start[i];
-    yaml_node_t *n = yaml_document_get_node(doc, item);
-    if (i < 32 && (mask >> i & 1u) && n->type == YAML_SCALAR_NODE) {
-      char *text = xstrndup((const char *)n->data.scalar.value, n->data.scalar.length);
-      n = yaml_document_get_node(doc, item);
-      int to = add_scalar_like(doc, n, compose_is_mirrored(n) ? NULL : COMPOSE_MIRROR_TAG, text);
-      yaml_node_t *t = yaml_document_get_node(doc, to);
-      n = yaml_document_get_node(doc, item);
-      t->data.scalar.style = n->data.scalar.style;
-      free(text);
-      item = to;
-    }
-    if (!yaml_document_append_sequence_item(doc, list, item)) out_of_memory();
-  }
-  yaml_node_t *l = yaml_document_get_node(doc, list);
-  l->start_mark = start;
-  l->end_mark = end;
-  *slot = list;
+  *slot = copy_sequence(doc, slot, flip_item, &mask);
 }
 
 enum { POLAR = 2u, AXIAL = 5u }; /* y flips for a position, x and z for a rotation axis */
+
+typedef struct { const unsigned *rows; int nrows; } row_masks;
+static void flip_row(yaml_document_t *doc, int index, yaml_node_item_t *item, void *ctx) {
+  const row_masks *m = ctx;
+  flip(doc, item, m->rows[index < m->nrows ? index : m->nrows - 1]);
+}
 
 /* flips every row of the list of lists in *slot by its mask (rows[i], or the last one) */
 static void flip_rows(yaml_document_t *doc, yaml_node_item_t *slot, const unsigned *rows, int nrows) {
   if (slot == NULL) return;
   yaml_node_t *v = yaml_document_get_node(doc, *slot);
   if (v == NULL || v->type != YAML_SEQUENCE_NODE) return;
-  /* a fresh outer list too */
-  int list = yaml_document_add_sequence(doc, v->tag, v->data.sequence.style);
-  if (!list) out_of_memory();
-  v = yaml_document_get_node(doc, *slot);
-  int count = (int)(v->data.sequence.items.top - v->data.sequence.items.start);
-  yaml_mark_t start = v->start_mark, end = v->end_mark;
-  for (int i = 0; i < count; i++) {
-    v = yaml_document_get_node(doc, *slot);
-    yaml_node_item_t item = v->data.sequence.items.start[i];
-    flip(doc, &item, rows[i < nrows ? i : nrows - 1]);
-    if (!yaml_document_append_sequence_item(doc, list, item)) out_of_memory();
-  }
-  yaml_node_t *l = yaml_document_get_node(doc, list);
-  l->start_mark = start;
-  l->end_mark = end;
-  *slot = list;
+  row_masks m = {rows, nrows};
+  *slot = copy_sequence(doc, slot, flip_row, &m); /* a fresh outer list too */
 }
 
 static bool value_is(yaml_document_t *doc, int map, const char *key, const char *text) {
