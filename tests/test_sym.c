@@ -3,7 +3,8 @@
  *   - folding: the identities of 0, 1 and -1, constants combined in double,
  *     association never changed;
  *   - hash-consing: the same expression built twice (also a + b and b + a)
- *     is one node; a shared subexpression is written once as a local;
+ *     is one node; a shared subexpression is written once as a local; a
+ *     graph that keeps the order (keep_order) prints b * a as built;
  *   - the literal printer on 200000 random doubles (random bit patterns,
  *     every exponent): strtod gives the same bits back, and no shorter
  *     precision of %.15g / %.16g would have;
@@ -91,6 +92,20 @@ static void test_hash_consing(void **state) {
   assert_int_equal(sym_print_block(f, &g, roots, lhs, 2, "t", "  "), 0);
   fclose(f);
   assert_string_equal(buf, "  const mb_real t0 = x[0] + x[1];\n  out[0] = t0 * 2;\n  out[1] = t0 / x[1];\n");
+  sym_free(&g);
+
+  /* keep_order: the operands stay as given, the same expression is still one node */
+  sym_init(&g);
+  g.keep_order = 1;
+  x = sym_symbol(&g, "x[0]");
+  y = sym_symbol(&g, "x[1]");
+  sym_id yx = sym_add(&g, sym_mul(&g, y, x), x);
+  assert_int_not_equal(sym_mul(&g, y, x), sym_mul(&g, x, y));
+  assert_int_equal(sym_add(&g, sym_mul(&g, y, x), x), yx);
+  f = fmemopen(buf, sizeof buf, "w");
+  sym_print(f, &g, yx);
+  fclose(f);
+  assert_string_equal(buf, "x[1] * x[0] + x[0]");
   sym_free(&g);
 }
 

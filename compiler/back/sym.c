@@ -105,7 +105,7 @@ sym_id sym_add(sym_graph *g, sym_id a, sym_id b) {
   if (sym_is_const(g, a, &x) && sym_is_const(g, b, &y)) return sym_const(g, x + y);
   if (is_value(g, a, 0)) return b;
   if (is_value(g, b, 0)) return a;
-  if (a > b) { sym_id t = a; a = b; b = t; }
+  if (a > b && !g->keep_order) { sym_id t = a; a = b; b = t; }
   return intern(g, SYM_ADD, a, b, 0, NULL);
 }
 
@@ -127,7 +127,7 @@ sym_id sym_mul(sym_graph *g, sym_id a, sym_id b) {
   if (is_value(g, b, 1)) return a;
   if (is_value(g, a, -1)) return sym_neg(g, b);
   if (is_value(g, b, -1)) return sym_neg(g, a);
-  if (a > b) { sym_id t = a; a = b; b = t; }
+  if (a > b && !g->keep_order) { sym_id t = a; a = b; b = t; }
   return intern(g, SYM_MUL, a, b, 0, NULL);
 }
 

@@ -12,9 +12,10 @@
  * Folding keeps the numbers of the unfolded expression for finite values: a
  * product with an exact 0 is 0, with 1 its other factor, with -1 its negation;
  * constants are combined in double.  Operands of + and * are put in a
- * canonical order (both are commutative in IEEE arithmetic); association is
- * never changed: (a + b) + c and a + (b + c) stay two expressions and print
- * with the parentheses that keep their order. */
+ * canonical order (both are commutative in IEEE arithmetic), unless the
+ * graph keeps the order it was given (keep_order); association is never
+ * changed: (a + b) + c and a + (b + c) stay two expressions and print with
+ * the parentheses that keep their order. */
 #ifndef MBCC_SYM_H
 #define MBCC_SYM_H
 
@@ -41,6 +42,9 @@ typedef struct {
   int *slot;      /* open addressing: node index + 1, 0 empty */
   int nslot;      /* a power of 2 */
   int failed;     /* an allocation failed: every later result is -1 */
+  int keep_order; /* set after sym_init: + and * keep their operands in the
+                     order given (the printed C reads as the runtime kernel
+                     it replaces; a + b and b + a are then two nodes) */
 } sym_graph;
 
 void sym_init(sym_graph *g);
