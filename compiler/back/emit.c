@@ -507,7 +507,7 @@ int emit_cols(FILE *f, const lmodel *L, int k, const char *P, const char *dV, co
   const mb_markerdef *d = &L->marker[k];
   const mb_body *B = &L->body[d->body];
   if (d->node >= 0 && !emit_node_static(B, d->node)) {
-    emit_node_cols(f, L, k, dV, dW, indent);
+    if (emit_node_cols(f, L, k, dV, dW, indent)) return -1;
     return 6 + B->nm;
   }
   fprintf(f, "%smb_rigid_cols(&f%d, %s, %s, %s, c);\n", indent, d->body, P, dV, dW);
@@ -752,12 +752,12 @@ static void emit_eval(emit_ctx *cx) {
       fprintf(f, "  mb_marker_ground(markers[%d].s, markers[%d].C, &k%d);\n", k, k, k);
     } else if (d->node >= 0 && emit_node_static(&L->body[d->body], d->node)) {
       fprintf(f, "  /* node %d: its mode shapes vanish: a rigid marker (mb_marker_rigid) */\n", d->node);
-      emit_marker_special(f, L, k);
+      if (emit_marker_special(f, L, k) < 0) cx->failed = 1;
     } else if (d->node >= 0) {
-      emit_marker_node(f, L, k);
+      if (emit_marker_node(f, L, k)) cx->failed = 1;
     } else {
       fputs("  /* mb_marker_rigid, its zeros and ones folded */\n", f);
-      emit_marker_special(f, L, k);
+      if (emit_marker_special(f, L, k) < 0) cx->failed = 1;
     }
   }
   free(use);
@@ -808,7 +808,7 @@ static void emit_eval(emit_ctx *cx) {
     fprintf(f, "  { /* force '%s' (", F->name);
     loc_comment(f, L, F->loc);
     fputs(") */\n", f);
-    force_element(F->kind)->emit_eval(f, L, k);
+    if (force_element(F->kind)->emit_eval(f, L, k)) cx->failed = 1;
     fputs("  }\n", f);
   }
   eval_split_mark(&sp, "the constraint rows");
@@ -825,7 +825,9 @@ static void emit_eval(emit_ctx *cx) {
     fprintf(f, "  /* row %d: %s (", r, L->row_desc[r]);
     loc_comment(f, L, L->row_loc[r]);
     fputs(") */\n", f);
-    if (emit_row_special(f, L, r)) continue;
+    int special = emit_row_special(f, L, r);
+    if (special < 0) cx->failed = 1;
+    if (special) continue;
     switch (R->kind) {
     case MB_PRIM_SPH: fprintf(f, "  mb_prim_sph(&k%d, &k%d, %d, &r);\n", R->m0, R->m1, R->a); break;
     case MB_PRIM_DOT1: fprintf(f, "  mb_prim_dot1(&k%d, &k%d, %d, %d, &r);\n", R->m0, R->m1, R->a, R->b); break;
@@ -854,8 +856,7 @@ static void emit_eval(emit_ctx *cx) {
       snprintf(P, sizeof P, "k%d.P", mk);
       snprintf(dV, sizeof dV, "r.dV[%d]", s);
       snprintf(dW, sizeof dW, "r.dW[%d]", s);
-      emit_cols(f, L, mk, P, dV, dW, "  ");
-      emit_row_stores(f, L, r, s, cs, "  ");
+      if (emit_cols(f, L, mk, P, dV, dW, "  ") < 0 || emit_row_stores(f, L, r, s, cs, "  ")) cx->failed = 1;
     }
   }
   if (eval_split_finish(&sp, out, nm, head) < 0) cx->failed = 1;

@@ -11,7 +11,8 @@
 /* a real as a reproducible literal (%.17g, no -0) */
 void emit_num(FILE *f, double x);
 /* c = the body columns of the pair (dV, dW) (names of 3-vectors) at marker k
- * whose point is the expression P; returns how many columns (6 or 6 + modes) */
+ * whose point is the expression P; returns how many columns (6 or 6 + modes),
+ * -1 out of memory (the element's emit_eval returns -1) */
 int emit_cols(FILE *f, const lmodel *L, int k, const char *P, const char *dV, const char *dW,
               const char *indent);
 /* rhs[vadr + j] += c[j], j < n */

@@ -13,167 +13,158 @@
  * keep the kernels' order of operations, so for finite values the numbers are
  * the kernels' own (up to the sign of a zero); test_generic and test_ldl
  * compare the two paths. */
-#include <ctype.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "emit_rows.h"
+#include "sym.h"
 
-#define EXPR 640 /* longest expression kept symbolic; longer ones go to locals */
+/* Every vector component is a node of the entry point's graph (sym.h):
+ * compile-time numbers are constants that fold, the frames' and markers'
+ * fields and run-time marker offsets are symbols that never fold.  The graph
+ * keeps the operands in the order given, so the printed C reads as the
+ * kernel it replaces.  An allocation that fails marks the graph (every later
+ * node is -1); the entry point returns -1 and emit_model discards the output. */
+typedef struct { sym_id e[3]; } svec;
 
-typedef struct { char e[3][EXPR]; } svec;
+static void rows_graph(sym_graph *g) {
+  sym_init(g);
+  g->keep_order = 1;
+}
+
+/* the symbol printf(fmt, ...): a field or local of the generated code */
+static sym_id named(sym_graph *g, const char *fmt, ...) {
+  char text[96];
+  va_list ap;
+  va_start(ap, fmt);
+  int n = vsnprintf(text, sizeof text, fmt, ap);
+  va_end(ap);
+  if (n < 0 || (size_t)n >= sizeof text) { g->failed = 1; return -1; } /* names are short: never */
+  return sym_symbol(g, text);
+}
+
+/* a compile-time number (no -0: it prints as 0 and stays 0 in products) */
+static sym_id lit(sym_graph *g, double x) { return sym_const(g, x == 0 ? 0 : x); }
+
+static int is_zero(const sym_graph *g, sym_id x) {
+  double c;
+  return sym_is_const(g, x, &c) && c == 0;
+}
+
+/* a number, a name or a negated one: kept in place, never given a local */
+static int is_atom(const sym_graph *g, sym_id x) {
+  if (x < 0) return 1;
+  sym_op op = g->node[x].op;
+  if (op == SYM_NEG) op = g->node[g->node[x].a].op;
+  return op == SYM_CONST || op == SYM_SYMBOL;
+}
+
+static void put(FILE *f, const sym_graph *g, sym_id x) {
+  if (x >= 0) sym_print(f, g, x); /* -1: the graph failed, the output is discarded */
+}
+
+/* 1 if expression x holds a floating literal (one with '.' or an exponent) */
+static int has_real_literal(const sym_graph *g, sym_id x) {
+  if (x < 0) return 0;
+  const sym_node *n = &g->node[x];
+  if (n->op == SYM_CONST) {
+    char t[40];
+    sym_literal(t, sizeof t, n->value);
+    return strpbrk(t, ".eE") != NULL;
+  }
+  return has_real_literal(g, n->a) || has_real_literal(g, n->b);
+}
 
 /* an element of a braced mb_real initializer, converted explicitly when it
  * holds a floating literal (a double: where mb_real is float, C converts the
  * value implicitly, C++ rejects the narrowing in braces); expressions of
  * mb_real variables and integers as they are */
-static void init_elem(FILE *f, const char *e) {
-  int real_literal = 0;
-  for (const char *c = e; *c; c++) {
-    int starts = isdigit((unsigned char)*c) &&
-                 (c == e || !(isalnum((unsigned char)c[-1]) || c[-1] == '_' || c[-1] == '.' || c[-1] == '['));
-    if (!starts) continue;
-    const char *t = c;
-    while (isalnum((unsigned char)*t) || *t == '.' || ((*t == '-' || *t == '+') && (t[-1] == 'e' || t[-1] == 'E'))) {
-      real_literal |= *t == '.' || *t == 'e' || *t == 'E';
-      t++;
-    }
-    c = t - 1;
-  }
-  if (real_literal) fprintf(f, "(mb_real)(%s)", e);
-  else fputs(e, f);
+static void init_elem(FILE *f, const sym_graph *g, sym_id x) {
+  int real_literal = has_real_literal(g, x);
+  if (real_literal) fputs("(mb_real)(", f);
+  put(f, g, x);
+  if (real_literal) fputc(')', f);
 }
 
 /* "{e0, e1, e2}" with init_elem's elements */
-static void init3(FILE *f, const svec *v) {
+static void init3(FILE *f, const sym_graph *g, const svec *v) {
   fputc('{', f);
   for (int i = 0; i < 3; i++) {
     if (i) fputs(", ", f);
-    init_elem(f, v->e[i]);
+    init_elem(f, g, v->e[i]);
   }
   fputc('}', f);
 }
 
-static int is_zero(const char *a) { return !strcmp(a, "0"); }
-static int is_one(const char *a) { return !strcmp(a, "1"); }
-static int is_mone(const char *a) { return !strcmp(a, "-1"); }
-static int is_atom(const char *a) { return !strchr(a, ' '); }
-
-static void lit(char *o, double x) {
-  if (x == 0) x = 0; /* no "-0" */
-  snprintf(o, EXPR, "%.17g", x);
-}
-
-/* an expression that did not fit its buffer becomes a token that no C
- * compiler accepts: the build fails loudly instead of compiling a cut
- * (and possibly still valid) expression */
-#define EXPR_TOO_LONG "@mbcc_internal_error_expression_longer_than_EXPR@"
-static void checked(char *t, int written) {
-  if (written < 0 || written >= EXPR) memcpy(t, EXPR_TOO_LONG, sizeof EXPR_TOO_LONG);
-}
-
-static void s_neg(char *o, const char *a) {
-  char t[EXPR];
-  if (is_zero(a)) checked(t, snprintf(t, sizeof t, "0"));
-  else if (is_atom(a) && a[0] == '-') checked(t, snprintf(t, sizeof t, "%s", a + 1));
-  else if (is_atom(a)) checked(t, snprintf(t, sizeof t, "-%s", a));
-  else checked(t, snprintf(t, sizeof t, "-(%s)", a));
-  memcpy(o, t, EXPR);
-}
-
-/* o = a * b */
-static void s_mul(char *o, const char *a, const char *b) {
-  char t[EXPR];
-  if (is_zero(a) || is_zero(b)) checked(t, snprintf(t, sizeof t, "0"));
-  else if (is_one(a)) checked(t, snprintf(t, sizeof t, "%s", b));
-  else if (is_one(b)) checked(t, snprintf(t, sizeof t, "%s", a));
-  else if (is_mone(a)) s_neg(t, b);
-  else if (is_mone(b)) s_neg(t, a);
-  else
-    checked(t, snprintf(t, sizeof t, "%s%s%s * %s%s%s", is_atom(a) ? "" : "(", a, is_atom(a) ? "" : ")",
-             is_atom(b) ? "" : "(", b, is_atom(b) ? "" : ")"));
-  memcpy(o, t, EXPR);
-}
-
-/* o = a + b (a's own sum is left-associative: no parentheses needed) */
-static void s_add(char *o, const char *a, const char *b) {
-  char t[EXPR];
-  if (is_zero(b)) checked(t, snprintf(t, sizeof t, "%s", a));
-  else if (is_zero(a)) checked(t, snprintf(t, sizeof t, "%s", b));
-  else checked(t, snprintf(t, sizeof t, "%s + %s%s%s", a, is_atom(b) ? "" : "(", b, is_atom(b) ? "" : ")"));
-  memcpy(o, t, EXPR);
-}
-
-/* o = a - b */
-static void s_sub(char *o, const char *a, const char *b) {
-  char t[EXPR];
-  if (is_zero(b)) checked(t, snprintf(t, sizeof t, "%s", a));
-  else if (is_zero(a)) s_neg(t, b);
-  else checked(t, snprintf(t, sizeof t, "%s - %s%s%s", a, is_atom(b) ? "" : "(", b, is_atom(b) ? "" : ")"));
-  memcpy(o, t, EXPR);
-}
-
 /* a . b, summed left to right as mb_dot3 */
-static void s_dot(char *o, const svec *a, const svec *b) {
-  char t[EXPR], p[EXPR];
-  s_mul(t, a->e[0], b->e[0]);
-  s_mul(p, a->e[1], b->e[1]);
-  s_add(t, t, p);
-  s_mul(p, a->e[2], b->e[2]);
-  s_add(o, t, p);
+static sym_id s_dot(sym_graph *g, const svec *a, const svec *b) {
+  sym_id t = sym_mul(g, a->e[0], b->e[0]);
+  t = sym_add(g, t, sym_mul(g, a->e[1], b->e[1]));
+  return sym_add(g, t, sym_mul(g, a->e[2], b->e[2]));
 }
 
 /* a x b as mb_cross3 */
-static void s_cross(svec *o, const svec *a, const svec *b) {
+static svec s_cross(sym_graph *g, const svec *a, const svec *b) {
   svec t;
-  char p[EXPR], q[EXPR];
   for (int i = 0; i < 3; i++) {
     int j = (i + 1) % 3, k = (i + 2) % 3;
-    s_mul(p, a->e[j], b->e[k]);
-    s_mul(q, a->e[k], b->e[j]);
-    s_sub(t.e[i], p, q);
+    t.e[i] = sym_sub(g, sym_mul(g, a->e[j], b->e[k]), sym_mul(g, a->e[k], b->e[j]));
   }
-  *o = t;
+  return t;
 }
 
-/* A^T x (A row-major, 9 expressions) as mb_mul3t */
-static void s_mul3t(svec *o, char A[9][EXPR], const svec *x) {
+/* A^T x (A row-major, 9 entries) as mb_mul3t */
+static svec s_mul3t(sym_graph *g, const sym_id A[9], const svec *x) {
   svec t;
-  char p[EXPR];
   for (int i = 0; i < 3; i++) {
-    s_mul(t.e[i], A[i], x->e[0]);
-    s_mul(p, A[3 + i], x->e[1]);
-    s_add(t.e[i], t.e[i], p);
-    s_mul(p, A[6 + i], x->e[2]);
-    s_add(t.e[i], t.e[i], p);
+    t.e[i] = sym_mul(g, A[i], x->e[0]);
+    t.e[i] = sym_add(g, t.e[i], sym_mul(g, A[3 + i], x->e[1]));
+    t.e[i] = sym_add(g, t.e[i], sym_mul(g, A[6 + i], x->e[2]));
   }
-  *o = t;
+  return t;
 }
 
-static void s_names(svec *o, const char *fmt, int a) {
-  for (int i = 0; i < 3; i++) {
-    char base[64];
-    snprintf(base, sizeof base, fmt, a);
-    snprintf(o->e[i], EXPR, "%s[%d]", base, i);
-  }
+/* the vector field "<fmt % a>[0..2]" */
+static svec s_names(sym_graph *g, const char *fmt, int a) {
+  char base[64];
+  svec v;
+  int n = snprintf(base, sizeof base, fmt, a);
+  for (int i = 0; i < 3; i++) v.e[i] = n < 0 || (size_t)n >= sizeof base ? -1 : named(g, "%s[%d]", base, i);
+  if (n < 0 || (size_t)n >= sizeof base) g->failed = 1;
+  return v;
 }
 
-static void s_zero(svec *o) {
-  for (int i = 0; i < 3; i++) snprintf(o->e[i], EXPR, "0");
+static svec s_zero(sym_graph *g) {
+  svec v;
+  for (int i = 0; i < 3; i++) v.e[i] = lit(g, 0);
+  return v;
+}
+
+/* body b's rotation matrix A (row-major) */
+static void frame_A(sym_graph *g, int b, sym_id A[9]) {
+  for (int i = 0; i < 9; i++) A[i] = named(g, "f%d.A[%d]", b, i);
 }
 
 /* declare a local 'name' for the entries of v that are not atoms; they become
  * name[i] (an entry that is zero or an atom stays as it is) */
-static void s_local(FILE *f, svec *v, const char *name, const char *indent) {
+static void s_local(FILE *f, sym_graph *g, svec *v, const char *name, const char *indent) {
   int need = 0;
-  for (int i = 0; i < 3; i++) need |= !is_atom(v->e[i]);
+  for (int i = 0; i < 3; i++) need |= !is_atom(g, v->e[i]);
   if (!need) return;
   fprintf(f, "%smb_real %s[3] = ", indent, name);
-  init3(f, v);
+  init3(f, g, v);
   fputs(";\n", f);
   for (int i = 0; i < 3; i++)
-    if (!is_atom(v->e[i])) snprintf(v->e[i], EXPR, "%s[%d]", name, i);
+    if (!is_atom(g, v->e[i])) v->e[i] = named(g, "%s[%d]", name, i);
+}
+
+/* the graph's end: -1 if any of its nodes failed */
+static int rows_graph_done(sym_graph *g) {
+  int st = g->failed ? -1 : 0;
+  sym_free(g);
+  return st;
 }
 
 /* a node whose mode shapes all vanish there (the reference node of the body
@@ -194,45 +185,51 @@ static int marker_rigid(const lmodel *L, int k, const double **s) {
   return 1;
 }
 
+/* 1 if marker k's offset in its body's frame is set at run time
+ * (set_params writes markers[k].s) */
+static int offset_runtime(const lmodel *L, int k) { return L->marker_runtime && L->marker_runtime[k]; }
+
+/* marker k's offset in its body's frame (a rigid marker: s, or a static
+ * node's position): literals, or the symbols markers[k].s[0..2] when the
+ * offset is set at run time.  The one place an offset enters the rows'
+ * expressions. */
+static svec marker_offset(sym_graph *g, const lmodel *L, int k) {
+  const double *s = NULL;
+  svec v;
+  marker_rigid(L, k, &s);
+  for (int j = 0; j < 3; j++) v.e[j] = offset_runtime(L, k) ? named(g, "markers[%d].s[%d]", k, j) : lit(g, s[j]);
+  return v;
+}
+
+static int svec_is_zero(const sym_graph *g, const svec *v) {
+  return is_zero(g, v->e[0]) && is_zero(g, v->e[1]) && is_zero(g, v->e[2]);
+}
+
 int emit_marker_special(FILE *f, const lmodel *L, int k) {
-  const double *s;
-  if (!marker_rigid(L, k, &s)) return 0;
+  if (!marker_rigid(L, k, NULL)) return 0;
   const mb_markerdef *d = &L->marker[k];
-  const int runtime_s = L->marker_runtime && L->marker_runtime[k]; /* s read from markers[k] (set_params) */
   int b = d->body;
+  sym_graph g;
+  rows_graph(&g);
   /* mb_marker_rigid: u = A s, R = A C, P = r + u, V = rd + w x u, W = w,
      aP = w x (w x u), aW = 0 */
-  char A[9][EXPR], p[EXPR], c[EXPR];
-  for (int i = 0; i < 9; i++) snprintf(A[i], EXPR, "f%d.A[%d]", b, i);
+  sym_id A[9];
+  frame_A(&g, b, A);
+  svec Ai[3];
+  for (int i = 0; i < 3; i++)
+    for (int l = 0; l < 3; l++) Ai[i].e[l] = A[3 * i + l];
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++) {
-      char e[EXPR];
-      lit(c, d->C[j]);
-      s_mul(e, A[3 * i], c);
-      lit(c, d->C[3 + j]);
-      s_mul(p, A[3 * i + 1], c);
-      s_add(e, e, p);
-      lit(c, d->C[6 + j]);
-      s_mul(p, A[3 * i + 2], c);
-      s_add(e, e, p);
-      fprintf(f, "  k%d.R[%d] = %s;\n", k, 3 * i + j, e);
+      svec Cj = {{lit(&g, d->C[j]), lit(&g, d->C[3 + j]), lit(&g, d->C[6 + j])}};
+      fprintf(f, "  k%d.R[%d] = ", k, 3 * i + j);
+      put(f, &g, s_dot(&g, &Ai[i], &Cj));
+      fputs(";\n", f);
     }
-  svec u;
-  char sj[3][EXPR];
-  for (int j = 0; j < 3; j++)
-    if (runtime_s) snprintf(sj[j], EXPR, "markers[%d].s[%d]", k, j);
-    else lit(sj[j], s[j]);
-  for (int i = 0; i < 3; i++) {
-    s_mul(u.e[i], A[3 * i], sj[0]);
-    s_mul(p, A[3 * i + 1], sj[1]);
-    s_add(u.e[i], u.e[i], p);
-    s_mul(p, A[3 * i + 2], sj[2]);
-    s_add(u.e[i], u.e[i], p);
-  }
-  int moving = !(is_zero(u.e[0]) && is_zero(u.e[1]) && is_zero(u.e[2]));
-  if (moving) {
+  svec s = marker_offset(&g, L, k), u;
+  for (int i = 0; i < 3; i++) u.e[i] = s_dot(&g, &Ai[i], &s);
+  if (!svec_is_zero(&g, &u)) {
     fputs("  {\n    mb_real u[3] = ", f);
-    init3(f, &u);
+    init3(f, &g, &u);
     fputs(", wu[3];\n", f);
     fprintf(f, "    mb_cross3(f%d.w, u, wu);\n    mb_cross3(f%d.w, wu, k%d.aP);\n", b, b, k);
     for (int i = 0; i < 3; i++)
@@ -245,18 +242,20 @@ int emit_marker_special(FILE *f, const lmodel *L, int k) {
               i, k, i, b, i, k, i);
   }
   for (int i = 0; i < 3; i++) fprintf(f, "  k%d.W[%d] = f%d.w[%d];\n  k%d.aW[%d] = 0;\n", k, i, b, i, k, i);
-  return 1;
+  return rows_graph_done(&g) ? -1 : 1;
 }
 
 /* marker k on a flexible node (mb_marker_node): the node's modal sums with
  * its shapes as constants (zeros dropped, the kernel's order kept), then
  * mb_marker_node_sums */
-void emit_marker_node(FILE *f, const lmodel *L, int k) {
+int emit_marker_node(FILE *f, const lmodel *L, int k) {
   const mb_markerdef *d = &L->marker[k];
   const mb_body *B = &L->body[d->body];
   const mb_flex *fx = B->flex;
   int nm = fx->nm, node = d->node;
   const double *X = fx->node_X + 3 * node * nm, *Psi = fx->node_Psi + 3 * node * nm;
+  sym_graph g;
+  rows_graph(&g);
   fputs("  {\n    mb_real b[3], th[3], thd[3], Xwd[3];\n", f);
   const char *nmv[4] = {"b", "th", "thd", "Xwd"};
   for (int s = 0; s < 4; s++) {
@@ -264,69 +263,63 @@ void emit_marker_node(FILE *f, const lmodel *L, int k) {
     int qa = (s == 0 || s == 1) ? B->qadr + 7 : B->vadr + 6;
     const char *arr = (s == 0 || s == 1) ? "q" : "v";
     for (int i = 0; i < 3; i++) {
-      /* written term by term (as s_add would join them): a sum over
-         hundreds of modes does not fit an expression buffer */
-      fprintf(f, "    %s[%d] = ", nmv[s], i);
-      int any = 0;
+      sym_id sum = lit(&g, 0);
       for (int j = 0; j <= nm; j++) {
-        char c[EXPR], x[EXPR];
-        if (j < nm) {
-          lit(c, T[3 * j + i]);
-          snprintf(x, sizeof x, "%s[%d]", arr, qa + j);
-          s_mul(c, c, x);
-        } else if (s == 0) lit(c, fx->node_x[3 * node + i]);
+        sym_id c;
+        if (j < nm) c = sym_mul(&g, lit(&g, T[3 * j + i]), named(&g, "%s[%d]", arr, qa + j));
+        else if (s == 0) c = lit(&g, fx->node_x[3 * node + i]);
         else break;
-        if (is_zero(c)) continue;
-        if (!any) fputs(c, f);
-        else fprintf(f, " + %s%s%s", is_atom(c) ? "" : "(", c, is_atom(c) ? "" : ")");
-        any = 1;
+        sum = sym_add(&g, sum, c); /* a zero term drops */
       }
-      fprintf(f, "%s;\n", any ? "" : "0");
+      fprintf(f, "    %s[%d] = ", nmv[s], i);
+      put(f, &g, sum);
+      fputs(";\n", f);
     }
   }
   fprintf(f, "    mb_marker_node_sums(&f%d, b, th, thd, Xwd, (const mb_real[9]){", d->body);
   for (int i = 0; i < 9; i++) {
-    char c[EXPR];
-    lit(c, d->C[i]);
-    fprintf(f, "%s%s", i ? ", " : "", c);
+    if (i) fputs(", ", f);
+    put(f, &g, lit(&g, d->C[i]));
   }
   fprintf(f, "}, &k%d);\n  }\n", k);
+  return rows_graph_done(&g);
 }
 
-void emit_node_cols(FILE *f, const lmodel *L, int k, const char *dV, const char *dW, const char *indent) {
+int emit_node_cols(FILE *f, const lmodel *L, int k, const char *dV, const char *dW, const char *indent) {
   const mb_markerdef *d = &L->marker[k];
   const mb_flex *fx = L->body[d->body].flex;
   int nm = fx->nm;
   const double *X = fx->node_X + 3 * d->node * nm, *Psi = fx->node_Psi + 3 * d->node * nm;
+  sym_graph g;
+  rows_graph(&g);
   fprintf(f, "%s{ /* mb_node_cols_mk, node %d's shapes as constants */\n", indent, d->node);
   fprintf(f, "%s  mb_real lV[3], JtW[3];\n", indent);
   fprintf(f, "%s  mb_node_cols_local(&f%d, &k%d, %s, %s, c, lV, JtW);\n", indent, d->body, k, dV, dW);
   svec lv, jw;
   for (int i = 0; i < 3; i++) {
-    snprintf(lv.e[i], EXPR, "lV[%d]", i);
-    snprintf(jw.e[i], EXPR, "JtW[%d]", i);
+    lv.e[i] = named(&g, "lV[%d]", i);
+    jw.e[i] = named(&g, "JtW[%d]", i);
   }
   for (int j = 0; j < nm; j++) {
     svec xj, pj;
-    char a[EXPR], b[EXPR];
     for (int i = 0; i < 3; i++) {
-      lit(xj.e[i], X[3 * j + i]);
-      lit(pj.e[i], Psi[3 * j + i]);
+      xj.e[i] = lit(&g, X[3 * j + i]);
+      pj.e[i] = lit(&g, Psi[3 * j + i]);
     }
-    s_dot(a, &xj, &lv);
-    s_dot(b, &pj, &jw);
-    s_add(a, a, b);
-    fprintf(f, "%s  c[%d] = %s;\n", indent, 6 + j, a);
+    fprintf(f, "%s  c[%d] = ", indent, 6 + j);
+    put(f, &g, sym_add(&g, s_dot(&g, &xj, &lv), s_dot(&g, &pj, &jw)));
+    fputs(";\n", f);
   }
   fprintf(f, "%s}\n", indent);
+  return rows_graph_done(&g);
 }
 
 /* what the rows know of marker k: its fields as expressions, zeros folded */
 typedef struct {
   svec P, V, W, aP, aW;
-  char R[9][EXPR];
+  sym_id R[9];
   int rigid;   /* rigid body (or static node): columns by mb_rigid_cols */
-  int at_origin; /* rigid and s = 0: P = r exactly */
+  int at_origin; /* rigid with a zero offset: P = r exactly */
 } smark;
 
 /* marker k is its body's frame: on a rigid body (or a static node) at the
@@ -337,59 +330,54 @@ static int frame_axes(const lmodel *L, int k);
 int emit_marker_is_frame(const lmodel *L, int k) {
   const double *s;
   if (frame_axes(L, k) < 0 || !marker_rigid(L, k, &s)) return 0;
-  if (L->marker_runtime && L->marker_runtime[k]) return 0; /* its offset is set at run time */
+  if (offset_runtime(L, k)) return 0;
   return s[0] == 0 && s[1] == 0 && s[2] == 0;
 }
 
-static void mark_view(const lmodel *L, int k, smark *m) {
+static void mark_view(sym_graph *g, const lmodel *L, int k, smark *m) {
   const mb_markerdef *d = &L->marker[k];
-  const double *s = NULL;
   memset(m, 0, sizeof *m);
   if (d->body < 0) {
-    for (int i = 0; i < 3; i++) lit(m->P.e[i], d->s[i]);
-    for (int i = 0; i < 9; i++) lit(m->R[i], d->C[i]);
-    s_zero(&m->V); s_zero(&m->W); s_zero(&m->aP); s_zero(&m->aW);
+    for (int i = 0; i < 3; i++) m->P.e[i] = lit(g, d->s[i]);
+    for (int i = 0; i < 9; i++) m->R[i] = lit(g, d->C[i]);
+    m->V = m->W = m->aP = m->aW = s_zero(g);
     return;
   }
   if (emit_marker_is_frame(L, k)) {
     int b = d->body;
-    s_names(&m->P, "f%d.r", b);
-    s_names(&m->V, "f%d.rd", b);
-    s_names(&m->W, "f%d.w", b);
-    s_zero(&m->aP);
-    s_zero(&m->aW);
-    for (int i = 0; i < 9; i++) snprintf(m->R[i], EXPR, "f%d.A[%d]", b, i);
+    m->P = s_names(g, "f%d.r", b);
+    m->V = s_names(g, "f%d.rd", b);
+    m->W = s_names(g, "f%d.w", b);
+    m->aP = m->aW = s_zero(g);
+    frame_A(g, b, m->R);
     m->rigid = m->at_origin = 1;
     return;
   }
-  s_names(&m->P, "k%d.P", k);
-  s_names(&m->V, "k%d.V", k);
-  s_names(&m->W, "k%d.W", k);
-  s_names(&m->aP, "k%d.aP", k);
-  s_names(&m->aW, "k%d.aW", k);
-  for (int i = 0; i < 9; i++) snprintf(m->R[i], EXPR, "k%d.R[%d]", k, i);
-  if (marker_rigid(L, k, &s)) {
+  m->P = s_names(g, "k%d.P", k);
+  m->V = s_names(g, "k%d.V", k);
+  m->W = s_names(g, "k%d.W", k);
+  m->aP = s_names(g, "k%d.aP", k);
+  m->aW = s_names(g, "k%d.aW", k);
+  for (int i = 0; i < 9; i++) m->R[i] = named(g, "k%d.R[%d]", k, i);
+  if (marker_rigid(L, k, NULL)) {
     m->rigid = 1;
-    s_zero(&m->aW);
-    if (s[0] == 0 && s[1] == 0 && s[2] == 0 && !(L->marker_runtime && L->marker_runtime[k])) {
+    m->aW = s_zero(g);
+    svec s = marker_offset(g, L, k);
+    if (svec_is_zero(g, &s)) {
       m->at_origin = 1;
-      s_zero(&m->aP);
+      m->aP = s_zero(g);
     }
   }
 }
 
 /* dV0.a0 + dW0.b0 + dV1.a1 + dW1.b1, summed left to right as mb_row_phidot and
  * mb_row_gamma do (a, b: the markers' V, W or aP, aW) */
-static void s_row_sum(char *o, const svec dV[2], const svec dW[2], const svec *a0, const svec *b0,
-                      const svec *a1, const svec *b1) {
-  char p[EXPR];
-  s_dot(o, &dV[0], a0);
-  s_dot(p, &dW[0], b0);
-  s_add(o, o, p);
-  s_dot(p, &dV[1], a1);
-  s_add(o, o, p);
-  s_dot(p, &dW[1], b1);
-  s_add(o, o, p);
+static sym_id s_row_sum(sym_graph *g, const svec dV[2], const svec dW[2], const svec *a0, const svec *b0,
+                        const svec *a1, const svec *b1) {
+  sym_id o = s_dot(g, &dV[0], a0);
+  o = sym_add(g, o, s_dot(g, &dW[0], b0));
+  o = sym_add(g, o, s_dot(g, &dV[1], a1));
+  return sym_add(g, o, s_dot(g, &dW[1], b1));
 }
 
 int emit_row_side_varies(const lmodel *L, int r, int s) {
@@ -401,13 +389,18 @@ int emit_row_side_varies(const lmodel *L, int r, int s) {
   return 0;
 }
 
-void emit_row_stores(FILE *f, const lmodel *L, int r, int s, const char *const c[6], const char *indent) {
+/* row r's stores through marker s, the body columns c[0..5] nodes of g */
+static void row_stores(FILE *f, const sym_graph *g, const lmodel *L, int r, int s, const sym_id c[6],
+                       const char *indent) {
   const mb_rowdef *R = &L->row[r];
   int k = s ? R->m1 : R->m0;
   const mb_body *B = &L->body[L->marker[k].body];
   for (int j = 0; j < 6; j++)
-    if (R->slot[s][j] >= 0 && !R->constant[s][j])
-      fprintf(f, "%sKx[%d] = Kx[%d] = %s;\n", indent, R->slot[s][j], R->slotT[s][j], c[j]);
+    if (R->slot[s][j] >= 0 && !R->constant[s][j]) {
+      fprintf(f, "%sKx[%d] = Kx[%d] = ", indent, R->slot[s][j], R->slotT[s][j]);
+      put(f, g, c[j]);
+      fputs(";\n", f);
+    }
   if (R->mslot[s] < 0) return;
   int stat = marker_rigid(L, k, NULL);
   const int *ms = L->modal_slot + R->mslot[s];
@@ -416,62 +409,64 @@ void emit_row_stores(FILE *f, const lmodel *L, int r, int s, const char *const c
     else if (ms[j] >= 0) fprintf(f, "%sKx[%d] = Kx[%d] = c[%d];\n", indent, ms[j], ms[B->nm + j], 6 + j);
 }
 
+int emit_row_stores(FILE *f, const lmodel *L, int r, int s, const char *const c[6], const char *indent) {
+  sym_graph g;
+  rows_graph(&g);
+  sym_id cs[6];
+  for (int j = 0; j < 6; j++) cs[j] = sym_symbol(&g, c[j]);
+  row_stores(f, &g, L, r, s, cs, indent);
+  return rows_graph_done(&g);
+}
+
 /* a row's phi, phid, gamma and its entries of D (both triangles of K), from
  * the row's d(phidot)/dV, d(phidot)/dW of each marker, its quadratic term and
  * nu, as mb_row_phidot, mb_row_gamma and mb_rigid_cols / mb_node_cols_mk */
-static void emit_row_common(FILE *f, const lmodel *L, int r, const smark mk[2], svec dV[2], svec dW[2],
-                            const char *quad) {
+static void emit_row_common(FILE *f, sym_graph *g, const lmodel *L, int r, const smark mk[2], const svec dV[2],
+                            const svec dW[2], sym_id quad) {
   const mb_model *m = &L->m;
   const mb_rowdef *R = &L->row[r];
-  char t[EXPR], p[EXPR];
   /* phid = dV0.V0 + dW0.W0 + dV1.V1 + dW1.W1 - nu (nu = 0: no driver) */
-  s_row_sum(t, dV, dW, &mk[0].V, &mk[0].W, &mk[1].V, &mk[1].W);
-  fprintf(f, "    phid[%d] = %s;\n", r, t);
+  fprintf(f, "    phid[%d] = ", r);
+  put(f, g, s_row_sum(g, dV, dW, &mk[0].V, &mk[0].W, &mk[1].V, &mk[1].W));
+  fputs(";\n", f);
   /* gamma = -(dV0.aP0 + dW0.aW0 + dV1.aP1 + dW1.aW1 + quad) */
-  s_row_sum(t, dV, dW, &mk[0].aP, &mk[0].aW, &mk[1].aP, &mk[1].aW);
-  s_add(t, t, quad);
-  s_neg(t, t);
-  fprintf(f, "    rhs[%d] = %s;\n", m->nv + r, t);
+  sym_id t = s_row_sum(g, dV, dW, &mk[0].aP, &mk[0].aW, &mk[1].aP, &mk[1].aW);
+  fprintf(f, "    rhs[%d] = ", m->nv + r);
+  put(f, g, sym_neg(g, sym_add(g, t, quad)));
+  fputs(";\n", f);
   for (int s = 0; s < 2; s++) {
     int k = s ? R->m1 : R->m0, b = L->marker[k].body;
     if (!emit_row_side_varies(L, r, s)) continue;
-    char c[6][EXPR];
+    sym_id c[6];
     if (mk[s].rigid) {
       /* mb_rigid_cols: [dV; A^T ((P - r) x dV + dW)] */
-      svec u, x;
-      char A[9][EXPR];
-      for (int i = 0; i < 9; i++) snprintf(A[i], EXPR, "f%d.A[%d]", b, i);
-      if (mk[s].at_origin) s_zero(&u);
-      else
-        for (int i = 0; i < 3; i++) {
-          snprintf(p, sizeof p, "f%d.r[%d]", b, i);
-          s_sub(u.e[i], mk[s].P.e[i], p);
-        }
-      s_cross(&x, &u, &dV[s]);
-      for (int i = 0; i < 3; i++) s_add(x.e[i], x.e[i], dW[s].e[i]);
-      s_local(f, &x, s ? "t1" : "t0", "    ");
-      svec a;
-      s_mul3t(&a, A, &x);
+      sym_id A[9];
+      frame_A(g, b, A);
+      svec u = s_zero(g);
+      if (!mk[s].at_origin)
+        for (int i = 0; i < 3; i++) u.e[i] = sym_sub(g, mk[s].P.e[i], named(g, "f%d.r[%d]", b, i));
+      svec x = s_cross(g, &u, &dV[s]);
+      for (int i = 0; i < 3; i++) x.e[i] = sym_add(g, x.e[i], dW[s].e[i]);
+      s_local(f, g, &x, s ? "t1" : "t0", "    ");
+      svec a = s_mul3t(g, A, &x);
       for (int i = 0; i < 3; i++) {
-        memcpy(c[i], dV[s].e[i], EXPR);
-        memcpy(c[3 + i], a.e[i], EXPR);
+        c[i] = dV[s].e[i];
+        c[3 + i] = a.e[i];
       }
     } else {
       /* a flexible node: its modal columns too */
-      svec v = dV[s], w = dW[s];
       fprintf(f, "    mb_real dV%d[3] = ", s);
-      init3(f, &v);
+      init3(f, g, &dV[s]);
       fprintf(f, ", dW%d[3] = ", s);
-      init3(f, &w);
+      init3(f, g, &dW[s]);
       fputs(";\n", f);
       char nv[16], nw[16];
       snprintf(nv, sizeof nv, "dV%d", s);
       snprintf(nw, sizeof nw, "dW%d", s);
-      emit_node_cols(f, L, k, nv, nw, "    ");
-      for (int j = 0; j < 6; j++) snprintf(c[j], EXPR, "c[%d]", j);
+      if (emit_node_cols(f, L, k, nv, nw, "    ")) g->failed = 1;
+      for (int j = 0; j < 6; j++) c[j] = named(g, "c[%d]", j);
     }
-    const char *cs[6] = {c[0], c[1], c[2], c[3], c[4], c[5]};
-    emit_row_stores(f, L, r, s, cs, "    ");
+    row_stores(f, g, L, r, s, c, "    ");
   }
 }
 
@@ -512,7 +507,8 @@ static int dot1_frames(const lmodel *L, int r, int *b0, int *b1) {
   return *b0 >= 0 && *b1 >= 0 && *b0 != *b1;
 }
 
-static void rel_name(char *o, int b0, int b1, int k, int l) { snprintf(o, EXPR, "rr%d_%d_%d%d", b0, b1, k, l); }
+/* entry (k, l) of the relative rotation of bodies b0 and b1 (a local of emit_rows_shared) */
+static sym_id rel(sym_graph *g, int b0, int b1, int k, int l) { return named(g, "rr%d_%d_%d%d", b0, b1, k, l); }
 
 /* a dot-1 row of a pair of body frames: the pair first, for the sort */
 typedef struct { int b0, b1, r; } frame_pair_row;
@@ -547,10 +543,8 @@ int emit_rows_shared(FILE *f, const lmodel *L) {
     for (int k = 0; k < 3; k++)
       for (int l = 0; l < 3; l++) {
         if (!need[3 * k + l]) continue;
-        char nmv[EXPR];
-        rel_name(nmv, b0, b1, k, l);
-        fprintf(f, "  const mb_real %s = f%d.A[%d] * f%d.A[%d] + f%d.A[%d] * f%d.A[%d] + f%d.A[%d] * f%d.A[%d];\n",
-                nmv, b0, k, b1, l, b0, 3 + k, b1, 3 + l, b0, 6 + k, b1, 6 + l);
+        fprintf(f, "  const mb_real rr%d_%d_%d%d = f%d.A[%d] * f%d.A[%d] + f%d.A[%d] * f%d.A[%d] + f%d.A[%d] * f%d.A[%d];\n",
+                b0, b1, k, l, b0, k, b1, l, b0, 3 + k, b1, 3 + l, b0, 6 + k, b1, 6 + l);
       }
     fprintf(f, "  mb_real dd%d_%d;\n  {\n    mb_real dw[3] = {f%d.w[0] - f%d.w[0], f%d.w[1] - f%d.w[1], f%d.w[2] - f%d.w[2]};\n"
                "    dd%d_%d = dw[0] * dw[0] + dw[1] * dw[1] + dw[2] * dw[2];\n  }\n",
@@ -560,44 +554,40 @@ int emit_rows_shared(FILE *f, const lmodel *L) {
   return 0;
 }
 
-static void emit_dot1_frames(FILE *f, const lmodel *L, int r, int b0, int b1) {
+static void emit_dot1_frames(FILE *f, sym_graph *g, const lmodel *L, int r, int b0, int b1) {
   const mb_rowdef *R = &L->row[r];
   int i = R->a, j = R->b;
-  svec colj, rowi, ei, ej, c0, c1, wl0, wl1;
-  char t[EXPR], p[EXPR], s01[EXPR], s10[EXPR], quad[EXPR], dd[EXPR];
+  svec colj, rowi, ei = s_zero(g), ej = s_zero(g);
   for (int k = 0; k < 3; k++) {
-    rel_name(colj.e[k], b0, b1, k, j);
-    rel_name(rowi.e[k], b0, b1, i, k);
+    colj.e[k] = rel(g, b0, b1, k, j);
+    rowi.e[k] = rel(g, b0, b1, i, k);
   }
-  s_zero(&ei);
-  s_zero(&ej);
-  snprintf(ei.e[i], EXPR, "1");
-  snprintf(ej.e[j], EXPR, "1");
-  s_cross(&c0, &ei, &colj);
-  s_cross(&c1, &ej, &rowi);
-  s_names(&wl0, "f%d.wl", b0);
-  s_names(&wl1, "f%d.wl", b1);
+  ei.e[i] = ej.e[j] = lit(g, 1);
+  svec c0 = s_cross(g, &ei, &colj), c1 = s_cross(g, &ej, &rowi);
+  svec wl0 = s_names(g, "f%d.wl", b0), wl1 = s_names(g, "f%d.wl", b1);
   fprintf(f, "  { /* from the relative rotation of bodies '%s' and '%s' */\n", L->body[b0].name, L->body[b1].name);
-  fprintf(f, "    phi[%d] = %s;\n", r, rowi.e[j]);
-  s_dot(t, &c0, &wl0);
-  s_dot(p, &c1, &wl1);
-  s_add(t, t, p);
-  fprintf(f, "    phid[%d] = %s;\n", r, t);
-  s_dot(s01, &wl0, &colj);
-  s_dot(s10, &wl1, &rowi);
-  fprintf(f, "    const mb_real s01 = %s, s10 = %s;\n", s01, s10);
+  fprintf(f, "    phi[%d] = ", r);
+  put(f, g, rowi.e[j]);
+  fprintf(f, ";\n    phid[%d] = ", r);
+  put(f, g, sym_add(g, s_dot(g, &c0, &wl0), s_dot(g, &c1, &wl1)));
+  fputs(";\n    const mb_real s01 = ", f);
+  put(f, g, s_dot(g, &wl0, &colj));
+  fputs(", s10 = ", f);
+  put(f, g, s_dot(g, &wl1, &rowi));
+  fputs(";\n", f);
   /* quad = s00 s01 + s11 s10 - 2 s01 s10 - phi |W0 - W1|^2 */
-  snprintf(t, sizeof t, "f%d.wl[%d] * s01 + f%d.wl[%d] * s10 - 2 * (s01 * s10)", b0, i, b1, j);
-  snprintf(dd, sizeof dd, "dd%d_%d", b0, b1);
-  s_mul(p, rowi.e[j], dd);
-  s_sub(quad, t, p);
-  s_neg(t, quad);
-  fprintf(f, "    rhs[%d] = %s;\n", L->m.nv + r, t);
+  sym_id s01 = named(g, "s01"), s10 = named(g, "s10");
+  sym_id quad = sym_add(g, sym_mul(g, wl0.e[i], s01), sym_mul(g, wl1.e[j], s10));
+  quad = sym_sub(g, quad, sym_mul(g, lit(g, 2), sym_mul(g, s01, s10)));
+  quad = sym_sub(g, quad, sym_mul(g, rowi.e[j], named(g, "dd%d_%d", b0, b1)));
+  fprintf(f, "    rhs[%d] = ", L->m.nv + r);
+  put(f, g, sym_neg(g, quad));
+  fputs(";\n", f);
   for (int s = 0; s < 2; s++) {
     if (!emit_row_side_varies(L, r, s)) continue;
     const svec *c = s ? &c1 : &c0;
-    const char *cs[6] = {"0", "0", "0", c->e[0], c->e[1], c->e[2]};
-    emit_row_stores(f, L, r, s, cs, "    ");
+    sym_id zero = lit(g, 0), cs[6] = {zero, zero, zero, c->e[0], c->e[1], c->e[2]};
+    row_stores(f, g, L, r, s, cs, "    ");
   }
   fputs("  }\n", f);
 }
@@ -607,65 +597,63 @@ int emit_row_is_special(const mb_rowdef *R) { return R->kind == MB_PRIM_SPH || R
 int emit_row_special(FILE *f, const lmodel *L, int r) {
   const mb_rowdef *R = &L->row[r];
   if (!emit_row_is_special(R)) return 0;
+  sym_graph g;
+  rows_graph(&g);
   int b0, b1;
   if (dot1_frames(L, r, &b0, &b1)) {
-    emit_dot1_frames(f, L, r, b0, b1);
-    return 1;
+    emit_dot1_frames(f, &g, L, r, b0, b1);
+    return rows_graph_done(&g) ? -1 : 1;
   }
   smark mk[2];
-  mark_view(L, R->m0, &mk[0]);
-  mark_view(L, R->m1, &mk[1]);
+  mark_view(&g, L, R->m0, &mk[0]);
+  mark_view(&g, L, R->m1, &mk[1]);
   svec dV[2], dW[2];
-  char t[EXPR];
   fputs("  {\n", f);
   if (R->kind == MB_PRIM_SPH) {
     /* mb_prim_sph: phi = (P1 - P0)_a, dV0 = -e_a, dV1 = e_a */
     int a = R->a;
-    s_sub(t, mk[1].P.e[a], mk[0].P.e[a]);
-    fprintf(f, "    phi[%d] = %s;\n", r, t);
+    fprintf(f, "    phi[%d] = ", r);
+    put(f, &g, sym_sub(&g, mk[1].P.e[a], mk[0].P.e[a]));
+    fputs(";\n", f);
     for (int s = 0; s < 2; s++) {
-      s_zero(&dV[s]);
-      s_zero(&dW[s]);
-      snprintf(dV[s].e[a], EXPR, s ? "1" : "-1");
+      dV[s] = dW[s] = s_zero(&g);
+      dV[s].e[a] = lit(&g, s ? 1 : -1);
     }
-    emit_row_common(f, L, r, mk, dV, dW, "0");
+    emit_row_common(f, &g, L, r, mk, dV, dW, lit(&g, 0));
   } else {
     /* mb_prim_dot1: phi = ai . aj (ai axis a of marker 0, aj axis b of
        marker 1), dW0 = ai x aj = -dW1, quad = s00 s01 + s11 s10 - 2 s01 s10
        - phi |W0 - W1|^2 (s00 = W0.ai, s01 = W0.aj, s10 = W1.ai, s11 = W1.aj) */
-    svec ai, aj, cr, dw;
-    char p[EXPR], quad[EXPR], ph[EXPR], sc[4][EXPR];
+    svec ai, aj, dw;
+    sym_id sc[4];
     for (int i = 0; i < 3; i++) {
-      memcpy(ai.e[i], mk[0].R[3 * i + R->a], EXPR);
-      memcpy(aj.e[i], mk[1].R[3 * i + R->b], EXPR);
+      ai.e[i] = mk[0].R[3 * i + R->a];
+      aj.e[i] = mk[1].R[3 * i + R->b];
     }
-    s_dot(t, &ai, &aj);
-    fprintf(f, "    const mb_real ph = %s;\n    phi[%d] = ph;\n", t, r);
-    snprintf(ph, sizeof ph, "ph");
-    s_cross(&cr, &ai, &aj);
-    s_local(f, &cr, "cr", "    ");
+    fputs("    const mb_real ph = ", f);
+    put(f, &g, s_dot(&g, &ai, &aj));
+    fprintf(f, ";\n    phi[%d] = ph;\n", r);
+    sym_id ph = named(&g, "ph");
+    svec cr = s_cross(&g, &ai, &aj);
+    s_local(f, &g, &cr, "cr", "    ");
     for (int k = 0; k < 4; k++) {
-      s_dot(sc[k], &mk[k / 2].W, k % 2 ? &aj : &ai);
-      if (is_atom(sc[k])) continue;
-      fprintf(f, "    const mb_real s%d%d = %s;\n", k / 2, k % 2, sc[k]);
-      snprintf(sc[k], EXPR, "s%d%d", k / 2, k % 2);
+      sc[k] = s_dot(&g, &mk[k / 2].W, k % 2 ? &aj : &ai);
+      if (is_atom(&g, sc[k])) continue;
+      fprintf(f, "    const mb_real s%d%d = ", k / 2, k % 2);
+      put(f, &g, sc[k]);
+      fputs(";\n", f);
+      sc[k] = named(&g, "s%d%d", k / 2, k % 2);
     }
-    for (int i = 0; i < 3; i++) s_sub(dw.e[i], mk[0].W.e[i], mk[1].W.e[i]);
-    s_local(f, &dw, "dw", "    ");
-    s_mul(quad, sc[0], sc[1]);
-    s_mul(p, sc[3], sc[2]);
-    s_add(quad, quad, p);
-    s_mul(p, sc[1], sc[2]);
-    s_mul(p, "2", p);
-    s_sub(quad, quad, p);
-    s_dot(t, &dw, &dw);
-    s_mul(p, ph, t);
-    s_sub(quad, quad, p);
-    for (int s = 0; s < 2; s++) s_zero(&dV[s]);
+    for (int i = 0; i < 3; i++) dw.e[i] = sym_sub(&g, mk[0].W.e[i], mk[1].W.e[i]);
+    s_local(f, &g, &dw, "dw", "    ");
+    sym_id quad = sym_add(&g, sym_mul(&g, sc[0], sc[1]), sym_mul(&g, sc[3], sc[2]));
+    quad = sym_sub(&g, quad, sym_mul(&g, lit(&g, 2), sym_mul(&g, sc[1], sc[2])));
+    quad = sym_sub(&g, quad, sym_mul(&g, ph, s_dot(&g, &dw, &dw)));
+    for (int s = 0; s < 2; s++) dV[s] = s_zero(&g);
     dW[0] = cr;
-    for (int i = 0; i < 3; i++) s_neg(dW[1].e[i], cr.e[i]);
-    emit_row_common(f, L, r, mk, dV, dW, quad);
+    for (int i = 0; i < 3; i++) dW[1].e[i] = sym_neg(&g, cr.e[i]);
+    emit_row_common(f, &g, L, r, mk, dV, dW, quad);
   }
   fputs("  }\n", f);
-  return 1;
+  return rows_graph_done(&g) ? -1 : 1;
 }

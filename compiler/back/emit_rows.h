@@ -1,6 +1,7 @@
 /* emit_rows.h: the rigid markers and the spherical and dot-1 rows of the
  * generated evaluation as expressions with the compile-time zeros and ones
- * folded (emit_rows.c) */
+ * folded (emit_rows.c, on the expression graph of sym.h).  The writers
+ * return -1 when memory ran out (the caller discards the output). */
 #ifndef EMIT_ROWS_H
 #define EMIT_ROWS_H
 
@@ -9,7 +10,8 @@
 
 /* 1 if node 'node' of body B is one where all its mode shapes vanish */
 int emit_node_static(const mb_body *B, int node);
-/* write marker k if it sits on a rigid body (or a static node); 0: not handled */
+/* write marker k if it sits on a rigid body (or a static node): 1; 0: not
+ * handled; -1 out of memory */
 int emit_marker_special(FILE *f, const lmodel *L, int k);
 /* 1 if marker k coincides with its body's frame (rigid body or static node,
  * s = 0, C = I): the rows of emit_row_special read the frame, not the marker */
@@ -21,21 +23,22 @@ int emit_rows_shared(FILE *f, const lmodel *L);
 /* 1 if emit_row_special writes row R (spherical and dot-1 rows): it reads
  * its markers' fields (or their frames), never a marker's address */
 int emit_row_is_special(const mb_rowdef *R);
-/* write row r if it is a spherical or dot-1 row; 0: not handled */
+/* write row r if it is a spherical or dot-1 row: 1; 0: not handled; -1 out of memory */
 int emit_row_special(FILE *f, const lmodel *L, int r);
 
-/* write marker k on a flexible node: the modal sums with the node's shapes as constants */
-void emit_marker_node(FILE *f, const lmodel *L, int k);
+/* write marker k on a flexible node: the modal sums with the node's shapes as
+ * constants; 0, or -1 out of memory */
+int emit_marker_node(FILE *f, const lmodel *L, int k);
 /* c = mb_node_cols_mk at marker k (a flexible node) with the node's shapes as
- * constants; dV, dW: names of 3-vectors */
-void emit_node_cols(FILE *f, const lmodel *L, int k, const char *dV, const char *dW, const char *indent);
+ * constants; dV, dW: names of 3-vectors; 0, or -1 out of memory */
+int emit_node_cols(FILE *f, const lmodel *L, int k, const char *dV, const char *dW, const char *indent);
 
 /* 1 when row r writes entries of D through its marker s (0 or 1): on a body,
  * with varying or modal slots */
 int emit_row_side_varies(const lmodel *L, int r, int s);
 /* row r's stores into both triangles of K through marker s: the varying body
- * columns from the expressions c[0..5], the modal columns from c[6 + j]
- * (zero on a node whose shapes vanish) */
-void emit_row_stores(FILE *f, const lmodel *L, int r, int s, const char *const c[6], const char *indent);
+ * columns from the names c[0..5], the modal columns from c[6 + j] (zero on a
+ * node whose shapes vanish); 0, or -1 out of memory */
+int emit_row_stores(FILE *f, const lmodel *L, int r, int s, const char *const c[6], const char *indent);
 
 #endif

@@ -34,8 +34,9 @@ typedef struct element_desc {
   /* lower: markers, record d (kind, markers, pool addresses) and its pools */
   void (*lower)(lmodel *L, const ir_force *F, int index, mb_forcedef *d);
   /* back: the statements of force k inside the emitted eval (its block's
-     braces and comment are the emitter's), adding into rhs */
-  void (*emit_eval)(FILE *f, const lmodel *L, int k);
+     braces and comment are the emitter's), adding into rhs; 0, or -1 when
+     memory ran out (emit_cols < 0; the output is discarded) */
+  int (*emit_eval)(FILE *f, const lmodel *L, int k);
 } element_desc;
 
 /* the force elements, in the order of ir_force_kind; NULL-terminated */

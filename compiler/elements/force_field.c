@@ -254,7 +254,7 @@ static void lower_superelement(lmodel *L, const ir_force *F, int index, mb_force
 }
 
 /* the wrench on marker 1 at its point; the reaction on body 0 at the same point */
-static void emit_field(FILE *f, const lmodel *L, int k) {
+static int emit_field(FILE *f, const lmodel *L, int k) {
   const mb_forcedef *d = &L->force[k];
   int b0 = L->marker[d->m0].body, b1 = L->marker[d->m1].body;
   fprintf(f, "    mb_real F[3], T[3];\n"
@@ -265,12 +265,15 @@ static void emit_field(FILE *f, const lmodel *L, int k) {
   if (b1 >= 0) {
     char P[32];
     snprintf(P, sizeof P, "k%d.P", d->m1);
-    emit_add_cols(f, L->body[b1].vadr, emit_cols(f, L, d->m1, P, "F", "T", "    "));
+    int n = emit_cols(f, L, d->m1, P, "F", "T", "    ");
+    if (n < 0) return -1;
+    emit_add_cols(f, L->body[b1].vadr, n);
   }
   if (b0 >= 0) {
     fprintf(f, "    mb_rigid_cols(&f%d, k%d.P, mF, mT, c); /* reaction at the same point */\n", b0, d->m1);
     emit_add_cols(f, L->body[b0].vadr, 6);
   }
+  return 0;
 }
 
 static const char *const field_keys[] = {"type", "bodies", "point", "stiffness", "damping",

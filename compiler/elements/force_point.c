@@ -42,10 +42,10 @@ static void lower_point_load(lmodel *L, const ir_force *F, int index, mb_forcede
 }
 
 /* the vector as literals (scaled by the profile), turned by the body when local */
-static void emit_point_load(FILE *f, const lmodel *L, int k) {
+static int emit_point_load(FILE *f, const lmodel *L, int k) {
   const mb_forcedef *d = &L->force[k];
   int b0 = L->marker[d->m0].body;
-  if (b0 < 0) { fputs("    /* on the ground: no effect */\n", f); return; }
+  if (b0 < 0) { fputs("    /* on the ground: no effect */\n", f); return 0; }
   fputs("    mb_real s = 1, val[3];\n", f);
   if (d->profile >= 0) fprintf(f, "    mb_profile_eval(&profiles[%d], t, x);\n    s = x[0];\n", d->profile);
   for (int j = 0; j < 3; j++) {
@@ -60,7 +60,9 @@ static void emit_point_load(FILE *f, const lmodel *L, int k) {
   snprintf(P, sizeof P, "k%d.P", d->m0);
   int n = emit_cols(f, L, d->m0, P, d->kind == MB_FORCE_POINT ? "val" : "zero3",
                     d->kind == MB_FORCE_POINT ? "zero3" : "val", "    ");
+  if (n < 0) return -1;
   emit_add_cols(f, L->body[b0].vadr, n);
+  return 0;
 }
 
 static const char *const force_keys[] = {"type",  "body",  "point", "value",

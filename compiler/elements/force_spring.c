@@ -108,7 +108,7 @@ static void lower_spring_damper(lmodel *L, const ir_force *F, int index, mb_forc
   prm[MB_SPRING_PRELOAD] = F->preload;
 }
 
-static void emit_spring_damper(FILE *f, const lmodel *L, int k) {
+static int emit_spring_damper(FILE *f, const lmodel *L, int k) {
   const mb_forcedef *d = &L->force[k];
   int b0 = L->marker[d->m0].body, b1 = L->marker[d->m1].body;
   fprintf(f, "    mb_real F0[3], F1[3];\n"
@@ -117,13 +117,18 @@ static void emit_spring_damper(FILE *f, const lmodel *L, int k) {
   if (b0 >= 0) {
     char P[32];
     snprintf(P, sizeof P, "k%d.P", d->m0);
-    emit_add_cols(f, L->body[b0].vadr, emit_cols(f, L, d->m0, P, "F0", "zero3", "    "));
+    int n = emit_cols(f, L, d->m0, P, "F0", "zero3", "    ");
+    if (n < 0) return -1;
+    emit_add_cols(f, L->body[b0].vadr, n);
   }
   if (b1 >= 0) {
     char P[32];
     snprintf(P, sizeof P, "k%d.P", d->m1);
-    emit_add_cols(f, L->body[b1].vadr, emit_cols(f, L, d->m1, P, "F1", "zero3", "    "));
+    int n = emit_cols(f, L, d->m1, P, "F1", "zero3", "    ");
+    if (n < 0) return -1;
+    emit_add_cols(f, L->body[b1].vadr, n);
   }
+  return 0;
 }
 
 static const char *const spring_keys[] = {"type",    "bodies",      "points",  "stiffness",

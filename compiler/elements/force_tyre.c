@@ -327,7 +327,7 @@ static void lower_tyre(lmodel *L, const ir_force *F, int index, mb_forcedef *d) 
   }
 }
 
-static void emit_tyre(FILE *f, const lmodel *L, int k) {
+static int emit_tyre(FILE *f, const lmodel *L, int k) {
   const mb_forcedef *d = &L->force[k];
   int b0 = L->marker[d->m0].body;
   fprintf(f, "    mb_real Fv[3], Tv[3];\n"
@@ -335,7 +335,10 @@ static void emit_tyre(FILE *f, const lmodel *L, int k) {
           d->m0, d->padr);
   char P[32];
   snprintf(P, sizeof P, "k%d.P", d->m0);
-  emit_add_cols(f, L->body[b0].vadr, emit_cols(f, L, d->m0, P, "Fv", "Tv", "    "));
+  int n = emit_cols(f, L, d->m0, P, "Fv", "Tv", "    ");
+  if (n < 0) return -1;
+  emit_add_cols(f, L->body[b0].vadr, n);
+  return 0;
 }
 
 static const char *const tyre_keys[] = {
