@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "animate.h"
+#include "build.h"
 #include "diag.h"
 #include "emit.h"
 #include "fe.h"
@@ -718,8 +719,17 @@ static int cmd_compile(const options *o, char *dir_out, size_t n, mbc_unit *up) 
   else snprintf(dir, sizeof dir, "generated/%s", name);
   mkdir("generated", 0777);
   int st = emit_model(&u, dir);
-  if (!st && !dir_out)
-    printf("wrote %s/%s.c, %s/%s.h and %s/main.c\n", dir, name, dir, name, dir);
+  if (!st && !dir_out) {
+    char **srcs = generated_sources(dir, name);
+    int n = 0;
+    while (srcs && srcs[n]) n++;
+    if (n > 1) /* a large model in several translation units (emit_files.h) */
+      printf("wrote %s/%s.h, %d C files (listed in %s/%s.sources) and %s/main.c\n", dir, name, n, dir, name, dir);
+    else
+      printf("wrote %s/%s.c, %s/%s.h and %s/main.c\n", dir, name, dir, name, dir);
+    for (int i = 0; srcs && srcs[i]; i++) free(srcs[i]);
+    free(srcs);
+  }
   if (dir_out) snprintf(dir_out, n, "%s", dir);
   if (up) *up = u;
   else mbc_unit_free(&u);
@@ -738,162 +748,6 @@ static void settings_from_ir(const ir_sim *s, mb_settings *set) {
   set->stabilization = (int)s->stabilization;
   set->alpha = s->baumgarte_alpha; set->beta = s->baumgarte_beta;
   set->equilibrium = s->equilibrium;
-}
-
-/* --- the rebuild stamp: a content hash of what goes into an executable --- */
-
-typedef struct { unsigned long long h; } build_hash;
-
-static void hash_bytes(build_hash *b, const void *data, size_t n) {
-  const unsigned char *p = data;
-  for (size_t i = 0; i < n; i++) { b->h ^= p[i]; b->h *= 1099511628211ULL; } /* FNV-1a */
-}
-
-/* the file's name and contents (a missing file hashes as such) */
-static void hash_file(build_hash *b, const char *path) {
-  hash_bytes(b, path, strlen(path) + 1);
-  FILE *f = fopen(path, "rb");
-  if (!f) { hash_bytes(b, "(missing)", 10); return; }
-  char buf[65536];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, f)) > 0) hash_bytes(b, buf, n);
-  fclose(f);
-}
-
-static int name_cmp(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
-
-/* every .c and .h file of a folder, in name order */
-static void hash_sources_in(build_hash *b, const char *dir) {
-  DIR *d = opendir(dir);
-  if (!d) { hash_bytes(b, dir, strlen(dir) + 1); return; }
-  char *names[512];
-  int nn = 0;
-  for (struct dirent *e; (e = readdir(d)) && nn < 512;) {
-    size_t len = strlen(e->d_name);
-    if (len > 2 && e->d_name[len - 2] == '.' && (e->d_name[len - 1] == 'c' || e->d_name[len - 1] == 'h'))
-      names[nn++] = strdup(e->d_name);
-  }
-  closedir(d);
-  qsort(names, (size_t)nn, sizeof names[0], name_cmp);
-  for (int i = 0; i < nn; i++) {
-    char path[8400];
-    if (names[i]) {
-      snprintf(path, sizeof path, "%s/%s", dir, names[i]);
-      hash_file(b, path);
-    }
-    free(names[i]);
-  }
-}
-
-/* exe's stamp: the compiler command, the generated sources, the runtime
- * headers and library -- an executable is reused only if all are unchanged */
-static void build_stamp(char *out, size_t n, char *const ccargs[], const char *dir, const char *main_src,
-                        const char *rtlib) {
-  build_hash b = {14695981039346656037ULL};
-  hash_bytes(&b, "mbcc build stamp 1", 19);
-  for (int i = 0; ccargs[i]; i++) {
-    if (!strcmp(ccargs[i], "-o") && ccargs[i + 1]) { i++; continue; } /* a name of this process's own */
-    hash_bytes(&b, ccargs[i], strlen(ccargs[i]) + 1);
-  }
-  hash_sources_in(&b, dir);
-  hash_file(&b, main_src);
-  /* the runtime headers: both include directories and the element kernels */
-  char rt[8400];
-  for (int k = 0; k < 2; k++) {
-    const char *inc = mbcc_include_dir(k);
-    if (!inc[0]) continue;
-    hash_sources_in(&b, inc);
-    snprintf(rt, sizeof rt, "%s/elements", inc);
-    hash_sources_in(&b, rt);
-  }
-  hash_file(&b, rtlib);
-  snprintf(out, n, "%016llx", b.h);
-}
-
-/* cc the generated model DIR/NAME.c and the main program 'main_src' against the
- * runtime library into 'exe'; 'extra' are more libraries (NULL-terminated).
- * Not recompiled when EXE.stamp holds the stamp of the same inputs. */
-/* ... built as 'exe' and then renamed to 'final_exe' (a name of this process's
- * own, so that two runs of one model never build over each other); the stamp
- * belongs to final_exe, so an unchanged model reuses it.  *reused: 1 when the
- * compile was skipped (exe is then left alone). */
-static int compile_generated_into(const char *dir, const char *name, const char *main_src, const char *exe,
-                                  const char *final_exe, char *const extra[], int quiet, int real_float,
-                                  int *reused) {
-  *reused = 0;
-  char src_c[8400], inc[8400], inc_hosted[8400], lib[8400];
-  snprintf(src_c, sizeof src_c, "%s/%s.c", dir, name);
-  snprintf(inc, sizeof inc, "-I%s", mbcc_include_dir(0));
-  snprintf(inc_hosted, sizeof inc_hosted, "-I%s", mbcc_include_dir(1)[0] ? mbcc_include_dir(1) : mbcc_include_dir(0));
-  snprintf(lib, sizeof lib, "%s", mbcc_runtime_lib());
-  if (real_float) {
-    /* the single-precision runtime sits beside the double one: libmbrt_float.a */
-    char *dot = strstr(lib, ".a");
-    if (dot && !dot[2]) snprintf(dot, sizeof lib - (size_t)(dot - lib), "_float.a");
-  }
-  const char *cc = getenv("CC");
-  /* the C flags mbcc itself was built with (e.g. sanitizers), split on spaces */
-  static char flags[1024];
-  snprintf(flags, sizeof flags, "%s", MBCC_GEN_CFLAGS);
-  char *ccargs[80];
-  int nc = 0;
-  ccargs[nc++] = (char *)(cc && *cc ? cc : "cc");
-  ccargs[nc++] = "-std=c99";
-  if (real_float) ccargs[nc++] = "-DMB_REAL_FLOAT";
-  for (char *tok = strtok(flags, " "); tok && nc < 40; tok = strtok(NULL, " ")) ccargs[nc++] = tok;
-  char *rest[] = {inc, inc_hosted, "-o", (char *)exe, src_c, (char *)main_src, lib, NULL};
-  for (int i = 0; rest[i]; i++) ccargs[nc++] = rest[i];
-  for (int i = 0; extra && extra[i] && nc < 60; i++) ccargs[nc++] = extra[i];
-  char *libs[] = {"-lklu", "-lamd", "-lcolamd", "-lbtf", "-lsuitesparseconfig", "-llapack",
-                  "-lblas", "-lm", NULL};
-  for (int i = 0; libs[i]; i++) ccargs[nc++] = libs[i];
-  ccargs[nc] = NULL;
-  char stamp[32], stamp_path[8500], old[32] = "";
-  build_stamp(stamp, sizeof stamp, ccargs, dir, main_src, lib);
-  snprintf(stamp_path, sizeof stamp_path, "%s.stamp", final_exe);
-  FILE *sf = fopen(stamp_path, "r");
-  if (sf) {
-    if (!fgets(old, sizeof old, sf)) old[0] = 0;
-    fclose(sf);
-    old[strcspn(old, "\n")] = 0;
-  }
-  if (!strcmp(old, stamp) && access(final_exe, X_OK) == 0) {
-    if (!quiet)
-      fprintf(stderr, "mbcc: %s is up to date (same generated code, compiler, flags and runtime)\n", final_exe);
-    *reused = 1;
-    return 0;
-  }
-  if (!quiet) fprintf(stderr, "mbcc: compiling %s\n", src_c);
-  if (run_command(ccargs)) {
-    fprintf(stderr, "mbcc: error: the C compiler failed on %s\n", src_c);
-    return 2;
-  }
-  /* the old stamp goes first: for a moment there is an executable without
-     one (rebuilt next time), never one with another's stamp */
-  remove(stamp_path);
-  if (strcmp(exe, final_exe) && rename(exe, final_exe)) {
-    fprintf(stderr, "mbcc: error: cannot write '%s': %s\n", final_exe, strerror(errno));
-    return 2;
-  }
-  char stamp_part[8520];
-  snprintf(stamp_part, sizeof stamp_part, "%s.XXXXXX", stamp_path);
-  int sfd = mkstemp(stamp_part);
-  sf = sfd >= 0 ? fdopen(sfd, "w") : NULL;
-  if (sf) {
-    fprintf(sf, "%s\n", stamp);
-    int bad = ferror(sf);
-    if (fclose(sf) || bad || rename(stamp_part, stamp_path)) remove(stamp_part);
-  } else if (sfd >= 0) {
-    close(sfd);
-    remove(stamp_part);
-  }
-  return 0;
-}
-
-int compile_generated(const char *dir, const char *name, const char *main_src, const char *exe,
-                      char *const extra[], int quiet, int real_float) {
-  int reused;
-  return compile_generated_into(dir, name, main_src, exe, exe, extra, quiet, real_float, &reused);
 }
 
 /* the simulator's options checked before anything is compiled: the values

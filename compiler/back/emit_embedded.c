@@ -245,9 +245,50 @@ static int join(char *out, size_t n, const char *a, const char *b) {
   return k < 0 || (size_t)k >= n;
 }
 
+/* the files emit_model writes beside <m>.c and <m>.h for a model in
+ * several translation units (emit_files.h): what <m>.sources lists but
+ * <m>.c, the list itself and <m>_parts.h; NULL-terminated, or NULL */
+static char **split_files(const char *dir, const char *nm) {
+  char path[4400], line[400];
+  snprintf(path, sizeof path, "%s/%s.sources", dir, nm);
+  FILE *f = fopen(path, "r");
+  if (!f) return NULL;
+  char **v = calloc(1027, sizeof *v);
+  int n = 0;
+  if (v) {
+    snprintf(line, sizeof line, "%s.sources", nm);
+    v[n++] = strdup(line);
+    snprintf(line, sizeof line, "%s_parts.h", nm);
+    v[n++] = strdup(line);
+  }
+  char self[300];
+  snprintf(self, sizeof self, "%s.c", nm);
+  while (v && n < 1026 && fgets(line, sizeof line, f)) {
+    line[strcspn(line, "\n")] = 0;
+    if (line[0] && !strchr(line, '/') && strcmp(line, self)) v[n++] = strdup(line);
+  }
+  fclose(f);
+  for (int i = 0; v && i < n; i++)
+    if (!v[i]) { /* out of memory: the package cannot be complete */
+      for (int k = 0; k < n; k++) free(v[k]);
+      free(v);
+      return NULL;
+    }
+  return v;
+}
+
+static void free_split(char **v) {
+  for (int i = 0; v && v[i]; i++) free(v[i]);
+  free(v);
+}
+
 /* remove what a failed write_package left in tmp (only names it writes) */
 static void remove_partial(const char *tmp, const char *nm) {
   char path[4400], fn[300];
+  char **split = split_files(tmp, nm);
+  for (int i = 0; split && split[i]; i++)
+    if (!join(path, sizeof path, tmp, split[i])) remove(path);
+  free_split(split);
   static const char *const suffixes[] = {".c", ".h", "_api.c", "_api.h"};
   for (size_t i = 0; i < 4; i++) {
     snprintf(fn, sizeof fn, "%s%s", nm, suffixes[i]);
@@ -318,6 +359,9 @@ static int write_package(const mbc_unit *u, const char *dir, const char *tmp, in
     if (join(sub, sizeof sub, dir, subdirs[i])) return 2;
     mkdir(sub, 0777);
   }
+  /* the model's files: a large model's other translation units too (the
+     package Makefile compiles what <m>.sources lists) */
+  char **split = split_files(tmp, nm);
   const char *model_files[4];
   char f0[300], f1[300], f2[300], f3[300];
   snprintf(f0, sizeof f0, "%s.c", nm);
@@ -326,15 +370,20 @@ static int write_package(const mbc_unit *u, const char *dir, const char *tmp, in
   snprintf(f3, sizeof f3, "%s_api.h", nm);
   model_files[0] = f0; model_files[1] = f1; model_files[2] = f2; model_files[3] = f3;
   size_t ncore = sizeof core_files / sizeof core_files[0], ntpl = sizeof template_files / sizeof template_files[0];
-  for (size_t i = 0; i < 4 + ncore + ntpl; i++) {
-    const char *fn = i < 4 ? model_files[i] : i < 4 + ncore ? core_files[i - 4] : template_files[i - 4 - ncore];
+  size_t nsplit = 0;
+  while (split && split[nsplit]) nsplit++;
+  for (size_t i = 0; i < 4 + ncore + ntpl + nsplit; i++) {
+    const char *fn = i < 4 ? model_files[i] : i < 4 + ncore ? core_files[i - 4]
+                   : i < 4 + ncore + ntpl ? template_files[i - 4 - ncore] : split[i - 4 - ncore - ntpl];
     char to[4400];
     if (join(path, sizeof path, tmp, fn) || join(to, sizeof to, dir, fn)) return 2;
     if (rename(path, to)) {
       diag_error(NULL, (ir_loc){0, 0}, "cannot move '%s' to '%s': %s", path, to, strerror(errno));
+      free_split(split);
       return 2;
     }
   }
+  free_split(split);
   for (size_t i = 0; i < sizeof subdirs / sizeof subdirs[0]; i++)
     if (!join(path, sizeof path, tmp, subdirs[i])) rmdir(path);
   rmdir(tmp);

@@ -11,10 +11,7 @@ int cmd_trade(int argc, char **argv);
 /* main.c: run argv[0] (PATH search), wait; its exit status, 128 if killed, -1
  * if it could not be started */
 int run_command(char *const argv[]);
-/* main.c: cc the generated model DIR/NAME.c and main_src against the runtime
- * library (real_float: the single-precision one, libmbrt_float.a) into exe;
- * 'extra' more arguments (NULL-terminated) */
-int compile_generated(const char *dir, const char *name, const char *main_src, const char *exe,
-                      char *const extra[], int quiet, int real_float);
+/* compile_generated: build.h */
+#include "build.h"
 
 #endif
