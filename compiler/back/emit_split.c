@@ -303,7 +303,7 @@ static const char *const part_args =
     "const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,\n"
     "    mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *phid";
 
-int eval_split_finish(eval_split *s, FILE *out, const char *nm, const char *head) {
+int eval_split_finish(eval_split *s, FILE *out, const char *nm, const char *head, const eval_files *files) {
   if (!out) { free_split(s); return -1; }
   if (s->failed || fflush(s->body) || ferror(s->body)) { free_split(s); return -1; }
   fclose(s->body);
@@ -345,31 +345,42 @@ int eval_split_finish(eval_split *s, FILE *out, const char *nm, const char *head
     free_split(s);
     return 1;
   }
-  fprintf(out, "\n/* The evaluation in %d parts, each a function of bounded size (so that the C\n"
-               " * compiler's cost per function stays bounded).  A value one part declares and\n"
-               " * later parts read (a body frame f<b>, a marker k<m>, ...) passes through\n"
-               " * %s_eval_shared: stored by its part, read into a const local of the same name. */\n",
+  /* with files: the struct and the parts' prototypes go into the private
+     header, each part into the file files->part_file gives it, and the
+     parts have external linkage (one translation unit each group) */
+  FILE *decl = files ? files->header : out;
+  fprintf(decl, "\n/* The evaluation in %d parts, each a function of bounded size (so that the C\n"
+                " * compiler's cost per function stays bounded).  A value one part declares and\n"
+                " * later parts read (a body frame f<b>, a marker k<m>, ...) passes through\n"
+                " * %s_eval_shared: stored by its part, read into a const local of the same name. */\n",
           nparts, nm);
-  fputs("typedef struct {\n", out);
+  fputs("typedef struct {\n", decl);
   int nshared = 0;
   for (int k = 0; k < t.n; k++)
     if (t.v[k].last_part > t.v[k].decl_part) {
-      fprintf(out, "  %s %s;\n", t.v[k].type, t.v[k].name);
+      fprintf(decl, "  %s %s;\n", t.v[k].type, t.v[k].name);
       nshared++;
     }
-  if (!nshared) fputs("  char unused; /* no value crosses parts */\n", out);
-  fprintf(out, "} %s_eval_shared;\n\n", nm);
+  if (!nshared) fputs("  char unused; /* no value crosses parts */\n", decl);
+  fprintf(decl, "} %s_eval_shared;\n\n", nm);
   fputs("#if defined(__GNUC__)\n#define EVAL_NOINLINE __attribute__((noinline))\n#else\n"
-        "#define EVAL_NOINLINE\n#endif\n", out);
+        "#define EVAL_NOINLINE\n#endif\n", decl);
+  if (files)
+    for (int p = 0; p < nparts; p++)
+      fprintf(decl, "void %s_eval_part%d(%s_eval_shared *W, %s);\n", nm, p, nm, part_args);
+  int ok_files = 1;
   for (int p = 0; p < nparts; p++) {
     long a = s->mark[first[p]], b = first[p + 1] < s->nmark ? s->mark[first[p + 1]] : len;
-    fprintf(out, "\n/* part %d of %d: from %s to %s */\n", p + 1, nparts, s->label[first[p]],
+    FILE *pf = files ? files->part_file(files->ctx, p, nparts) : out;
+    if (!pf) { ok_files = 0; break; }
+    fprintf(pf, "\n/* part %d of %d: from %s to %s */\n", p + 1, nparts, s->label[first[p]],
             s->label[first[p + 1] - 1]);
-    fprintf(out, "static EVAL_NOINLINE void %s_eval_part%d(%s_eval_shared *W, %s) {\n", nm, p, nm, part_args);
+    fprintf(pf, "%sEVAL_NOINLINE void %s_eval_part%d(%s_eval_shared *W, %s) {\n", files ? "" : "static ", nm, p,
+            nm, part_args);
     fputs("  static const mb_real zero3[3] = {0, 0, 0};\n"
           "  mb_row r;\n  mb_real c[6 + MB_MAX_MODES], x[3];\n"
           "  (void)W; (void)m; (void)t; (void)q; (void)v; (void)x; (void)c; (void)r; (void)zero3;\n"
-          "  (void)Kx; (void)rhs; (void)phi; (void)phid;\n", out);
+          "  (void)Kx; (void)rhs; (void)phi; (void)phid;\n", pf);
     /* the values of earlier parts this one names, in declaration order: one
        more walk over its text with last_part cleared finds them */
     for (int k = 0; k < t.n; k++) { t.v[k].seen_part = t.v[k].last_part; t.v[k].last_part = -1; }
@@ -377,20 +388,22 @@ int eval_split_finish(eval_split *s, FILE *out, const char *nm, const char *head
     for (int k = 0; k < t.n; k++) {
       var *x = &t.v[k];
       if (x->decl_part < p && x->last_part == p)
-        fprintf(out, "  const %s %s = W->%s;\n", x->type, x->name, x->name);
+        fprintf(pf, "  const %s %s = W->%s;\n", x->type, x->name, x->name);
       x->last_part = x->seen_part;
     }
-    fwrite(s->text + a, 1, (size_t)(b - a), out);
+    fwrite(s->text + a, 1, (size_t)(b - a), pf);
     for (int k = 0; k < t.n; k++) {
       var *x = &t.v[k];
-      if (x->decl_part == p && x->last_part > p) fprintf(out, "  W->%s = %s;\n", x->name, x->name);
+      if (x->decl_part == p && x->last_part > p) fprintf(pf, "  W->%s = %s;\n", x->name, x->name);
     }
-    fputs("}\n", out);
+    fputs("}\n", pf);
   }
+  if (files) fprintf(out, "\n#include \"%s\"\n", files->header_name);
   fputs(head, out);
   fprintf(out, "  %s_eval_shared W;\n", nm);
   for (int p = 0; p < nparts; p++) fprintf(out, "  %s_eval_part%d(&W, m, t, q, v, Kx, rhs, phi, phid);\n", nm, p);
   fputs("}\n", out);
+  if (!ok_files) nparts = -1;
   free_vars(&t);
   free(first);
   free_split(s);

@@ -30,10 +30,22 @@ void eval_split_mark_lines(eval_split *s, long from, const char *prefix, const c
 /* about this many bytes of body text per part; the body is split when it is
  * larger than two parts (MBCC_EVAL_PART_BYTES overrides it, for measurement) */
 long eval_part_bytes(void);
+/* Where the parts go when they are compiled as translation units of their
+ * own (emit_files.c): the shared struct and the parts' prototypes into
+ * 'header' (the private header 'header_name', which 'out' then includes), part
+ * p of n into the stream part_file returns (NULL: failure). */
+typedef struct {
+  FILE *header;
+  const char *header_name;
+  FILE *(*part_file)(void *ctx, int part, int nparts);
+  void *ctx;
+} eval_files;
+
 /* write the evaluation 'nm'_eval to out: 'head' is the monolithic function's
  * signature and locals (written as they were before the split); the parts get
- * the same scratch locals.  Returns the number of parts (1: one function), or
- * -1 out of memory.  Frees s. */
-int eval_split_finish(eval_split *s, FILE *out, const char *nm, const char *head);
+ * the same scratch locals.  With files (may be NULL) a split evaluation's
+ * parts go there instead of into out.  Returns the number of parts (1: one
+ * function), or -1 out of memory.  Frees s. */
+int eval_split_finish(eval_split *s, FILE *out, const char *nm, const char *head, const eval_files *files);
 
 #endif
