@@ -37,7 +37,8 @@ static const help_command commands[] = {
      "emit the model's C code: DIR/NAME.c, DIR/NAME.h and DIR/main.c",
      "The emitted code is C99 with a fixed sparse pattern and its own LDL^T; main.c is a simulator "
      "with the model's settings, linked against libmbrt (pkg-config --cflags --libs mbcc). "
-     "Without -o the code goes to generated/NAME/ in the current directory.",
+     "Without -o the code goes to generated/NAME/ in the current directory. A large model is written "
+     "as several C files, listed in DIR/NAME.sources (NAME.c first): compile them all.",
      {{"--scene S", "apply scene S of the model file"},
       {"-o DIR", "the output directory (its parent must exist)"},
       {"--real float|double", "the precision of the emitted code (float: the LDL^T solver only)"},

@@ -33,10 +33,16 @@ say() { echo "scaling: $*" >&2; }
 [ -x /usr/bin/time ] || die "/usr/bin/time not found (Debian package 'time': scripts/install-deps.sh)"
 mkdir -p "$W"
 
-# the C compiler mbcc runs, timed: one line "wall user+sys maxrss_kB" per call
+# the C compiler mbcc runs, timed: one line "wall user sys maxrss_kB start end" per
+# call (a large model's files are compiled by several calls at once, then linked)
 cat > "$W/timed-cc" <<EOS
 #!/bin/sh
-exec timeout $TIMEOUT /usr/bin/time -a -o "\$SCALING_CC_LOG" -f "%e %U %S %M" ${CC:-cc} "\$@"
+start=\$(date +%s.%N)
+timeout $TIMEOUT /usr/bin/time -o "\$SCALING_CC_LOG.\$\$" -f "%e %U %S %M" ${CC:-cc} "\$@"
+rc=\$?
+echo "\$(cat "\$SCALING_CC_LOG.\$\$") \$start \$(date +%s.%N)" >> "\$SCALING_CC_LOG"
+rm -f "\$SCALING_CC_LOG.\$\$"
+exit \$rc
 EOS
 chmod +x "$W/timed-cc"
 
@@ -46,7 +52,7 @@ for n in $SIZES; do
   d=$W/chain$n
   mkdir -p "$d"
   if [ -n "$stop" ]; then
-    rows+=("| $n | $((11 * n)) | | | | | | | | skipped: a smaller chain did not build |")
+    rows+=("| $n | $((11 * n)) | | | | | | | | | skipped: a smaller chain did not build |")
     continue
   fi
   bash scripts/chain.sh "$n" > "$d/chain$n.yaml"
@@ -54,29 +60,41 @@ for n in $SIZES; do
   /usr/bin/time -o "$d/mbcc.time" -f "%e %U %S %M" "$MBCC" compile "$d/chain$n.yaml" -o "$d/gen" > "$d/compile.log" 2>&1 ||
     die "mbcc compile of the $n-link chain failed: $(tail -3 "$d/compile.log")"
   read -r _ mu ms mk < "$d/mbcc.time"
-  csize=$(wc -c < "$d/gen/chain$n.c")
+  # the model's C files: chain$n.c, or all that chain$n.sources lists
+  if [ -f "$d/gen/chain$n.sources" ]; then
+    csize=$(cd "$d/gen" && cat $(cat "chain$n.sources") | wc -c)
+    nfiles=$(wc -l < "$d/gen/chain$n.sources")
+  else
+    csize=$(wc -c < "$d/gen/chain$n.c")
+    nfiles=1
+  fi
   ldl=$("$MBCC" check "$d/chain$n.yaml" | sed -n 's/^  LDL^T code *//p' | cut -d' ' -f1)
   say "chain of $n links: mbcc bench (C compile of up to $TIMEOUT s, then $REPS interleaved rounds)"
-  touch "$d/cc.time" # one line a compile: kept, for an executable reused unchanged
-  if ! (cd "$d" && SCALING_CC_LOG="$d/cc.time" CC="$W/timed-cc" "$MBCC" bench "chain$n.yaml" \
+  touch "$d/cc.time" # the last build's compiles: kept, for an executable reused unchanged
+  rm -f "$d/cc.new"
+  if ! (cd "$d" && SCALING_CC_LOG="$d/cc.new" CC="$W/timed-cc" "$MBCC" bench "chain$n.yaml" \
         --paths generated+ldl,generic+klu --reps "$REPS" --end "$END" --csv bench.csv --quiet) \
         > "$d/bench.txt" 2> "$d/bench.log"; then
     if grep -q "the C compiler failed" "$d/bench.log"; then
-      rows+=("| $n | $((11 * n)) | $(awk -v u="$mu" -v s="$ms" 'BEGIN { printf "%.2f", u + s }') | $((mk / 1024)) | $((csize / 1024)) | | | | $ldl | did not build within $TIMEOUT s (or failed) |")
+      rows+=("| $n | $((11 * n)) | $(awk -v u="$mu" -v s="$ms" 'BEGIN { printf "%.2f", u + s }') | $((mk / 1024)) | $((csize / 1024)) ($nfiles) | | | | | $ldl | did not build within $TIMEOUT s (or failed) |")
       stop=1
       continue
     fi
     die "mbcc bench of the $n-link chain failed: $(tail -3 "$d/bench.log")"
   fi
+  [ -s "$d/cc.new" ] && mv "$d/cc.new" "$d/cc.time"
   [ -s "$d/cc.time" ] || die "no C compile recorded for the $n-link chain (remove $d and run again)"
-  read -r _ cu cs ck < <(tail -n 1 "$d/cc.time")
+  # the build: wall from the first compiler's start to the last one's end, CPU
+  # summed over the calls, memory of the largest
+  read -r cw cu ck < <(awk '{ u += $2 + $3; if ($4 > k) k = $4; if (s == "" || $5 < s) s = $5; if ($6 > e) e = $6 }
+    END { printf "%.1f %.2f %d\n", e - s, u, k }' "$d/cc.time")
   read -r gen gnc < <(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
     $c["path"] == "generated+ldl" { g = $c["step_median_s"] } $c["path"] == "generic+klu" { k = $c["step_median_s"] }
     END { print g, k }' "$d/bench.csv")
-  rows+=("$(awk -v n="$n" -v mu="$mu" -v ms="$ms" -v mk="$mk" -v cs="$csize" -v cu="$cu" -v css="$cs" -v ck="$ck" \
+  rows+=("$(awk -v n="$n" -v mu="$mu" -v ms="$ms" -v mk="$mk" -v cs="$csize" -v nf="$nfiles" -v cw="$cw" -v cu="$cu" -v ck="$ck" \
       -v g="$gen" -v k="$gnc" -v ldl="$ldl" 'BEGIN {
-    printf "| %d | %d | %.2f | %d | %d | %.1f | %d | %.3g / %.3g | %s | %.1f |", n, 11 * n, mu + ms, mk / 1024,
-      cs / 1024, cu + css, ck / 1024, g, k, ldl, k / g }')")
+    printf "| %d | %d | %.2f | %d | %d (%d) | %.1f | %.1f | %d | %.3g / %.3g | %s | %.1f |", n, 11 * n, mu + ms, mk / 1024,
+      cs / 1024, nf, cw, cu, ck / 1024, g, k, ldl, k / g }')")
   say "${rows[-1]}"
 done
 
@@ -86,20 +104,23 @@ done
   echo "Written by \`make scaling\` (scripts/scaling.sh) on $(date -u +%Y-%m-%d), $(uname -m), $(nproc) cores,"
   echo "$(${CC:-cc} --version | head -n 1)."
   [ -n "${NOTE:-}" ] && echo "$NOTE"
+  echo "Load average when the table was written: $(cut -d' ' -f1-3 /proc/loadavg) (the machine is shared)."
   echo
   echo "Pendulum chains of N uniform rods hinged about z (scripts/chain.sh N; n = 11 N: 6 velocities"
   echo "and 5 constraint rows a link). mbcc compile: the whole of \`mbcc compile\` (read, lower,"
   echo "assembly analysis, ordering, emission), user+system CPU and peak resident memory. C compile:"
   echo "the C compiler building the benchmark executable (the generated model, its main program,"
-  echo "linked against the runtime), CPU and peak memory of the compiler's largest process. C file:"
-  echo "the generated model. Per step: \`mbcc bench"
+  echo "linked against the runtime): wall time from the first compiler's start to the link's end"
+  echo "(a large model's files are compiled $(nproc) at a time), CPU summed over the compiler"
+  echo "processes, peak memory of the largest. C files: the generated model's size and, in"
+  echo "parentheses, its number of C files (docs/pipeline.md, \"A large model in several files\"). Per step: \`mbcc bench"
   echo "--paths generated+ldl,generic+klu --reps $REPS --end $END\`, medians of the repetitions"
   echo "(interleaved round after round, set-up left out) of the time per Dormand–Prince step; the"
   echo "ratio is generic+klu / generated+ldl. LDLᵀ: the emitted factorization's form (straight-line"
   echo "code, or loops over the factor's pattern when above the flop budget)."
   echo
-  echo "| links | n | mbcc compile [s] | mbcc memory [MB] | C file [kB] | C compile [s] | C memory [MB] | per step generated+ldl / generic+klu [s] | LDLᵀ | ratio |"
-  echo "|--:|--:|--:|--:|--:|--:|--:|--:|---|--:|"
+  echo "| links | n | mbcc compile [s] | mbcc memory [MB] | C files [kB] | C compile wall [s] | C compile CPU [s] | C memory [MB] | per step generated+ldl / generic+klu [s] | LDLᵀ | ratio |"
+  echo "|--:|--:|--:|--:|--:|--:|--:|--:|--:|---|--:|"
   printf '%s\n' "${rows[@]}"
 } > "$OUT.part"
 mv "$OUT.part" "$OUT"
