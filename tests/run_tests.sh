@@ -2,7 +2,8 @@
 # run_tests.sh: builds and runs every test; ends with "N passed, N failed".
 #   tests/test_*.c   cmocka programs.  A line "// models: a b" names the models
 #                    (models/a.yaml or tests/models/a.yaml) whose generated code
-#                    the test links; each is compiled by mbcc into $B/gen/<model>/.
+#                    the test links (all its C files); each is compiled by mbcc
+#                    into $B/gen/<model>/.
 #   tests/test_*.sh  shell tests: exit 0 passes (counted as one test).
 # Environment: B (build dir, default build), CFLAGS (e.g. sanitizers).
 set -u
@@ -46,7 +47,13 @@ for t in tests/test_*.c; do
   for m in $models; do
     if ! compile_model "$m"; then echo "FAIL $name: mbcc could not compile model $m"; ok=0; fi
     g=$(gen_name "$m"); d=$(gen_dir "$m")
-    srcs+=("$d/$g.c"); incs+=("-I$d")
+    # a large model is several C files, listed in <name>.sources (docs/pipeline.md)
+    if [ -f "$d/$g.sources" ]; then
+      while read -r f; do srcs+=("$d/$f"); done < "$d/$g.sources"
+    else
+      srcs+=("$d/$g.c")
+    fi
+    incs+=("-I$d")
   done
   if [ $ok = 1 ] && ! $CC -std=c11 -Wall -Wextra -Werror $CFLAGS -Iruntime/core -Iruntime/hosted -Icompiler/front -Icompiler/flex -Icompiler/lower -Icompiler/back -Itests "${incs[@]}" \
         "$t" "${srcs[@]}" tests/support.c "$B/libmbrt.a" $LIBS -o "$B/tests/$name" 2> "$B/tests/$name.build.log"; then
