@@ -5,10 +5,11 @@
 #   - mbcc compile of tests/models/hinged_chain10_rigid.yaml writes
 #     NAME.sources listing NAME.c, the evaluation's part files and NAME_ldl.c,
 #     and NAME_parts.h; every listed file exists and compiles alone;
-#   - mbcc run builds it ("N files, 2 at a time" with MBCC_JOBS=2); the
-#     results equal, to all 17 digits, those of the same model written as one
-#     file (MBCC_EVAL_FILE_BYTES=0); the chain conserves its total energy
-#     (no damping, no driver) to 1e-6 J as it falls;
+#   - mbcc run --set k=5 (a run-time spring stiffness) builds it ("N files,
+#     2 at a time" with MBCC_JOBS=2); the results equal, to all 17 digits,
+#     those of the same model written as one file (MBCC_EVAL_FILE_BYTES=0);
+#     the chain conserves its total energy (no damping, no driver) to 1e-6 J
+#     as it falls;
 #   - a second run reuses the simulator (the stamp covers every file);
 #   - written again as one file into the same directory, the split's files
 #     are gone (nothing stale is built or hashed).
@@ -18,7 +19,15 @@ cd "$(dirname "$0")/.."
 # shellcheck source=tests/shell_setup.sh
 . tests/shell_setup.sh
 m=hinged_chain10_rigid
+# with a spring whose stiffness is a run-time parameter: set_params changes
+# the force pools, which the part files then read through <m>_ref_ pointers
 cp "$root/tests/models/$m.yaml" chain.yaml
+cat >> chain.yaml <<'EOY'
+parameters:
+  k: {value: 2, runtime: true, min: 0, max: 100, unit: N/m}
+forces:
+  tip_spring: {type: spring_damper, bodies: [ground, s9], points: [[1.0, 0.5, 0], [1.0, 0, 0]], stiffness: k, free_length: 0.3}
+EOY
 g=generated/$m
 
 "$MBCC" compile chain.yaml -o "$g" > c.log 2>&1 || err "mbcc compile: $(cat c.log)"
@@ -27,6 +36,7 @@ g=generated/$m
 nfiles=$(wc -l < "$g/$m.sources")
 [ "$nfiles" -ge 3 ] || err "only $nfiles files listed: $(cat "$g/$m.sources")"
 [ "$(head -1 "$g/$m.sources")" = "$m.c" ] || err "$m.c is not listed first"
+grep -q "^#define force_prm ${m}_ref_force_prm" "$g/${m}"_eval*.c || err "the parts do not read the run-time force pool through its pointer"
 grep -q "^${m}_ldl.c$" "$g/$m.sources" || err "the LDL^T is not in a file of its own"
 grep -q "^${m}_eval0.c$" "$g/$m.sources" || err "no evaluation part file"
 grep -q "C files (listed in" c.log || err "mbcc compile does not name the list: $(cat c.log)"
@@ -36,14 +46,14 @@ while read -r f; do
     "$g/$f" > cc.log 2>&1 || err "$f does not compile alone: $(head -5 cc.log)"
 done < "$g/$m.sources"
 
-MBCC_JOBS=2 "$MBCC" run chain.yaml --precision 17 --plot none -o split.csv > r1.log 2>&1 || err "run (split): $(cat r1.log)"
+MBCC_JOBS=2 "$MBCC" run chain.yaml --set k=5 --precision 17 --plot none -o split.csv > r1.log 2>&1 || err "run (split): $(cat r1.log)"
 grep -q "files, 2 at a time" r1.log || err "the split model was not compiled file by file: $(cat r1.log)"
 ls "$g"/*.objs > /dev/null 2>&1 && err "object directory left behind: $(ls "$g")"
-"$MBCC" run chain.yaml --precision 17 --plot none -o split2.csv > r2.log 2>&1 || err "second run: $(cat r2.log)"
+"$MBCC" run chain.yaml --set k=5 --precision 17 --plot none -o split2.csv > r2.log 2>&1 || err "second run: $(cat r2.log)"
 grep -q "up to date" r2.log || err "the second run recompiled: $(cat r2.log)"
 
 mkdir one && cp chain.yaml one/
-(cd one && MBCC_EVAL_FILE_BYTES=0 "$MBCC" run chain.yaml --precision 17 --plot none -o one.csv > r.log 2>&1) ||
+(cd one && MBCC_EVAL_FILE_BYTES=0 "$MBCC" run chain.yaml --set k=5 --precision 17 --plot none -o one.csv > r.log 2>&1) ||
   err "run (one file): $(cat one/r.log)"
 [ -e "one/$g/$m.sources" ] && err "MBCC_EVAL_FILE_BYTES=0 still split the model"
 cmp -s split.csv one/one.csv || err "the split build's results differ from the one-file build's: $(diff split.csv one/one.csv | head -4)"
