@@ -22,7 +22,7 @@ CC_SRC  := $(wildcard compiler/*.c) $(foreach d,$(CC_DIRS),$(wildcard $(d)/*.c))
 B       ?= build
 DEPFLAGS = -MMD -MP
 
-.PHONY: all test demo clean sanitize docs bench peers trade extremes web test-browser embedded man release-check  install scaling chassis vehicle sweeps slurm-check
+.PHONY: all test demo clean sanitize docs bench peers ldl-profile trade extremes web test-browser embedded man release-check  install scaling chassis vehicle sweeps slurm-check
 all: $(B)/mbcc $(B)/libmbrt.a $(B)/libmbrt_float.a
 
 # objects keep the source's folders: $(B)/rt/core/x.o, $(B)/cc/front/x.o
@@ -77,6 +77,11 @@ bench: all
 # only the MuJoCo peer of make bench (scripts/peers.sh): writes docs/peers.md
 peers: all
 	MBCC=$(B)/mbcc PEER_DOC=docs/peers.md sh scripts/peers.sh
+
+# the emitted LDL^T's factor and solve alone, straight-line against looped
+# (scripts/ldl-profile.sh; docs/architecture.md): prints a Markdown table
+ldl-profile: all
+	MBCC=$(B)/mbcc sh scripts/ldl-profile.sh
 
 # build and run time against model size on pendulum chains (scripts/scaling.sh):
 # writes docs/scaling.md; SIZES="5 10 20" for a quick one
