@@ -22,7 +22,7 @@ static void parse_distance(mapping *m, ir_joint *j, bool on_nodes) {
       d[i] = j->point[1][i] - j->point[0][i];
     double length = norm3(d);
     if (!(length > ZERO_LENGTH)) {
-      error_at(r, loc_of(n), "distance joint points coincide (they must be apart)");
+      error_at(r, n ? loc_of(n) : j->loc, "distance joint points coincide (they must be apart)");
     } else { /* the axis of a distance joint is its initial direction */
       scale3(d, 1 / length);
       memcpy(j->axis[0], d, sizeof d);
