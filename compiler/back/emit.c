@@ -112,33 +112,6 @@ static const char *profile_kind_name(mb_profile_kind kind) {
   return "0";
 }
 
-static const char *output_kind_name(mb_output_kind kind) {
-  switch (kind) {
-  case MB_OUT_POSITION: return "MB_OUT_POSITION";
-  case MB_OUT_ORIENTATION: return "MB_OUT_ORIENTATION";
-  case MB_OUT_ANGLE: return "MB_OUT_ANGLE";
-  case MB_OUT_VELOCITY: return "MB_OUT_VELOCITY";
-  case MB_OUT_ANGULAR_VELOCITY: return "MB_OUT_ANGULAR_VELOCITY";
-  case MB_OUT_ACCELERATION: return "MB_OUT_ACCELERATION";
-  case MB_OUT_ANGULAR_ACCELERATION: return "MB_OUT_ANGULAR_ACCELERATION";
-  case MB_OUT_REACTION: return "MB_OUT_REACTION";
-  case MB_OUT_EFFORT: return "MB_OUT_EFFORT";
-  case MB_OUT_KINETIC_ENERGY: return "MB_OUT_KINETIC_ENERGY";
-  case MB_OUT_POTENTIAL_ENERGY: return "MB_OUT_POTENTIAL_ENERGY";
-  case MB_OUT_TOTAL_ENERGY: return "MB_OUT_TOTAL_ENERGY";
-  case MB_OUT_DEFLECTION: return "MB_OUT_DEFLECTION";
-  case MB_OUT_MODAL: return "MB_OUT_MODAL";
-  case MB_OUT_MOMENTUM: return "MB_OUT_MOMENTUM";
-  case MB_OUT_SECTION: return "MB_OUT_SECTION";
-  case MB_OUT_FORCE: return "MB_OUT_FORCE";
-  case MB_OUT_RELATIVE: return "MB_OUT_RELATIVE";
-  case MB_OUT_JOINT: return "MB_OUT_JOINT";
-  case MB_OUT_CENTER_OF_MASS: return "MB_OUT_CENTER_OF_MASS";
-  case MB_OUT_TYRE: return "MB_OUT_TYRE";
-  }
-  return "0";
-}
-
 static const char *law_kind_name(mb_law_kind kind) {
   switch (kind) {
   case MB_LAW_NONE: return "MB_LAW_NONE";
@@ -457,7 +430,8 @@ static void emit_tables(emit_ctx *cx) {
       const mb_outputdef *o = &L->output[k];
       fprintf(f, "  /* output '%s' (", L->ir->outputs[k].name);
       loc_comment(f, L, L->ir->outputs[k].loc);
-      fprintf(f, ") */\n  {.kind = %s, .body = %d", output_kind_name(o->kind), o->body);
+      fprintf(f, ") */\n  {.kind = %s, .body = %d", output_element(L->ir->outputs[k].kind)->runtime_kind_name,
+              o->body);
       const char *vnames[5] = {".s", ".axis", ".u", ".axis_g", ".u_g"};
       const double *vals[5] = {o->s, o->axis, o->u, o->axis_g, o->u_g};
       for (int v = 0; v < 5; v++)

@@ -61,7 +61,7 @@ static int named_node(reader *r, const yaml_node_t *n, const ir_flex *fx, const 
   return -1;
 }
 
-static int to_fe_node(reader *r, yaml_node_t *n, const ir_body *b) {
+int to_fe_node(reader *r, yaml_node_t *n, const ir_body *b) {
   double v;
   char label[SHOWN_SIZE];
   snprintf(label, sizeof label, "FE node of body '%s'", b->name);
@@ -1345,47 +1345,8 @@ static void parse_bodies(reader *r, yaml_node_t *n) {
  * joints
  * ------------------------------------------------------------------------- */
 
-static const char *const joint_type_names[] = {"spherical", "revolute", "cylindrical", "prismatic",
-                                               "universal", "fixed",    "distance",    NULL};
-
-/* The global axis least aligned with 'axis', made perpendicular to it:
- * deterministic, and never nearly parallel. */
-static void default_reference(const double axis[3], double ref[3]) {
-  int k = 0;
-  for (int i = 1; i < 3; i++)
-    if (fabs(axis[i]) < fabs(axis[k]))
-      k = i;
-  double e[3] = {0, 0, 0};
-  e[k] = 1;
-  double along = dot3(e, axis);
-  for (int i = 0; i < 3; i++)
-    ref[i] = e[i] - along * axis[i];
-  scale3(ref, 1 / norm3(ref));
-}
-
-static void parse_reference(mapping *m, ir_joint *j) {
-  double ref[3];
-  default_reference(j->axis[0], j->ref);
-  if (!get_vector(m, "reference", 3, false, ref))
-    return;
-  double length = norm3(ref);
-  if (!(length >= ZERO_LENGTH)) {
-    error_at(m->r, m->last_loc, "zero-length reference ('reference' must be a nonzero direction)");
-    return;
-  }
-  double along = dot3(ref, j->axis[0]);
-  for (int i = 0; i < 3; i++)
-    ref[i] -= along * j->axis[0][i];
-  double across = norm3(ref);
-  if (!(across >= ANGLE_TOLERANCE * length)) {
-    error_at(m->r, m->last_loc,
-             "'reference' is parallel to the joint axis (expected a direction across it)");
-    return;
-  }
-  scale3(ref, 1 / across);
-  memcpy(j->ref, ref, sizeof ref);
-}
-
+/* each kind's keys, points and axes are its element descriptor's
+   (compiler/elements/joint_*.c) */
 static void parse_joint(reader *r, yaml_node_t *key, yaml_node_t *value) {
   ir_model *model = r->model;
   int index = model->njoints++;
@@ -1402,95 +1363,18 @@ static void parse_joint(reader *r, yaml_node_t *key, yaml_node_t *value) {
   if (!map_open(&m, r, value, j->loc, "joint '%s'", j->name))
     return;
   int type;
-  if (!get_choice(&m, "type", "joint type", joint_type_names, true, &type)) {
+  if (!get_choice(&m, "type", "joint type", joint_type_names(), true, &type)) {
     map_close(&m);
     return;
   }
-  j->kind = (ir_joint_kind)type;
-  map_describe(&m, "%s joint '%s'", joint_type_names[type], j->name);
-
-  static const char *const distance_keys[] = {"type", "bodies", "points", "node", "nodes", NULL};
-  static const char *const universal_keys[] = {"type", "bodies", "point", "axes", "reference",
-                                               "node", "nodes", NULL};
-  static const char *const axis_keys[] = {"type", "bodies", "point", "axis", "reference", "node",
-                                          "nodes", NULL};
-  map_check_keys(&m, j->kind == JOINT_DISTANCE    ? distance_keys
-                     : j->kind == JOINT_UNIVERSAL ? universal_keys
-                                                  : axis_keys);
+  const joint_desc *e = joint_elements[type];
+  j->kind = e->ir_kind;
+  map_describe(&m, "%s joint '%s'", e->type, j->name);
+  map_check_keys(&m, e->keys);
   bool on_nodes = false;
   if (get_body_pair(&m, j->body, j->body_loc))
     on_nodes = fe_nodes_given(&m, j->body, j->node);
-
-  if (j->kind == JOINT_DISTANCE) {
-    yaml_node_t *n = map_require(&m, "points", !on_nodes, "a list of 2 points [x, y, z]");
-    bool given = n != NULL && to_vector_list(r, n, "'points'", 2, 3, &j->point[0][0]);
-    if (on_nodes) {
-      /* a side on a node without 'points': the node; the other side needs the points */
-      if (!given && (j->node[0] < 0 || j->node[1] < 0))
-        error_at(r, j->loc, "distance joint '%s' needs 'points' for its side that is not on a node", j->name);
-      check_node_point(r, model, n ? loc_of(n) : j->loc, j->body, j->node, given, &j->point[0][0]);
-    }
-    if (given || on_nodes) {
-      double d[3];
-      for (int i = 0; i < 3; i++)
-        d[i] = j->point[1][i] - j->point[0][i];
-      double length = norm3(d);
-      if (!(length > ZERO_LENGTH)) {
-        error_at(r, loc_of(n), "distance joint points coincide (they must be apart)");
-      } else { /* the axis of a distance joint is its initial direction */
-        scale3(d, 1 / length);
-        memcpy(j->axis[0], d, sizeof d);
-        memcpy(j->axis[1], d, sizeof d);
-      }
-    }
-    default_reference(j->axis[0], j->ref);
-    map_close(&m);
-    return;
-  }
-
-  bool point_given = get_vector(&m, "point", 3, !on_nodes, j->point[0]);
-  if (point_given)
-    memcpy(j->point[1], j->point[0], sizeof j->point[0]);
-  if (on_nodes) {
-    check_node_point(r, model, point_given ? m.loc : j->loc, j->body, j->node, point_given, &j->point[0][0]);
-    if (!point_given) /* both sides at the node that was given */
-      memcpy(j->point[j->node[0] >= 0 ? 1 : 0], j->point[j->node[0] >= 0 ? 0 : 1], sizeof j->point[0]);
-  }
-
-  if (j->kind == JOINT_UNIVERSAL) {
-    yaml_node_t *n = map_require(&m, "axes", true, "a list of 2 perpendicular axes");
-    double axes[6];
-    if (n != NULL && to_vector_list(r, n, "'axes'", 2, 3, axes)) {
-      bool ok = true;
-      for (int i = 0; i < 2; i++) {
-        double length = norm3(axes + 3 * i);
-        if (!(length >= ZERO_LENGTH)) {
-          error_at(r, loc_of(seq_item(r, n, i)),
-                   "zero-length axis (item %d of 'axes' must be a nonzero direction)", i + 1);
-          ok = false;
-        } else {
-          scale3(axes + 3 * i, 1 / length);
-        }
-      }
-      double cosine = dot3(axes, axes + 3);
-      if (ok && fabs(cosine) > ANGLE_TOLERANCE) {
-        error_at(r, loc_of(n),
-                 "universal joint axes must be perpendicular (they are %.6g degrees apart)",
-                 acos(fmax(-1, fmin(1, cosine))) * 180 / PI);
-        ok = false;
-      }
-      if (ok) {
-        memcpy(j->axis[0], axes, 3 * sizeof *axes);
-        memcpy(j->axis[1], axes + 3, 3 * sizeof *axes);
-      }
-    }
-  } else {
-    bool required = j->kind == JOINT_REVOLUTE || j->kind == JOINT_CYLINDRICAL ||
-                    j->kind == JOINT_PRISMATIC;
-    if (get_axis(&m, "axis", required, j->axis[0]))
-      memcpy(j->axis[1], j->axis[0], sizeof j->axis[0]);
-  }
-  parse_reference(&m, j);
+  e->parse(&m, j, on_nodes);
   map_close(&m);
 }
 
@@ -1596,8 +1480,7 @@ void parse_profile(reader *r, yaml_node_t *n, const char *label, ir_profile *p) 
  * drivers
  * ------------------------------------------------------------------------- */
 
-static const char *const dof_names[] = {"rotation", "translation", NULL};
-
+/* its keys and fields are the driver descriptor's (compiler/elements/driver.c) */
 static void parse_driver(reader *r, yaml_node_t *key, yaml_node_t *value) {
   ir_model *model = r->model;
   int index = model->ndrivers++;
@@ -1610,64 +1493,9 @@ static void parse_driver(reader *r, yaml_node_t *key, yaml_node_t *value) {
   mapping m;
   if (!map_open(&m, r, value, d->loc, "driver '%s'", d->name))
     return;
-  static const char *const keys[] = {"joint", "dof", "motion", NULL};
-  map_check_keys(&m, keys);
-
-  ir_loc joint_loc = d->loc;
-  get_ref(&m, "joint", NAME_JOINT, true, &d->joint, &joint_loc);
-  int dof = -1;
-  bool dof_given = map_has(&m, "dof");
-  bool dof_valid = get_choice(&m, "dof", "dof", dof_names, false, &dof);
-  ir_loc dof_loc = m.last_loc;
-  if (d->joint >= 0) {
-    const ir_joint *j = &model->joints[d->joint];
-    bool rotates = j->kind == JOINT_REVOLUTE || j->kind == JOINT_CYLINDRICAL;
-    bool slides = j->kind == JOINT_PRISMATIC || j->kind == JOINT_CYLINDRICAL;
-    if (!rotates && !slides) {
-      error_at(r, joint_loc,
-               "%s joint '%s' cannot be driven (a driver needs a revolute, prismatic or "
-               "cylindrical joint)",
-               joint_type_names[j->kind], j->name);
-    } else if (dof_valid) {
-      if ((dof == DRIVER_ROTATION && !rotates) || (dof == DRIVER_TRANSLATION && !slides))
-        error_at(r, dof_loc, "%s joint '%s' has no %s dof (expected 'dof: %s')",
-                 joint_type_names[j->kind], j->name, dof_names[dof], dof_names[1 - dof]);
-      d->dof = (ir_driver_dof)dof;
-    } else if (!dof_given) {
-      if (rotates && slides)
-        error_at(r, d->loc,
-                 "missing 'dof' in driver '%s' (expected rotation or translation: joint '%s' "
-                 "is cylindrical)",
-                 d->name, j->name);
-      d->dof = rotates ? DRIVER_ROTATION : DRIVER_TRANSLATION;
-    }
-  }
-  yaml_node_t *motion = map_require(&m, "motion", true, "a profile such as {type: constant, value: 0}");
-  if (motion != NULL) {
-    char label[SHOWN_SIZE];
-    snprintf(label, sizeof label, "'motion' of driver '%s'", d->name);
-    parse_profile(r, motion, label, &d->motion);
-  }
+  map_check_keys(&m, element_driver.keys);
+  element_driver.parse(&m, d);
   map_close(&m);
-}
-
-/* Two active drivers on one joint dof would over-constrain it. */
-static void check_drivers(reader *r) {
-  const ir_model *model = r->model;
-  for (int i = 0; i < model->ndrivers; i++) {
-    const ir_driver *d = &model->drivers[i];
-    if (!d->active || d->joint < 0)
-      continue;
-    for (int k = 0; k < i; k++) {
-      const ir_driver *first = &model->drivers[k];
-      if (first->active && first->joint == d->joint && first->dof == d->dof) {
-        error_at(r, d->loc, "joint '%s' is already driven in %s by driver '%s'",
-                 model->joints[d->joint].name, dof_names[d->dof], first->name);
-        note_at(r, first->loc, "driver '%s' is defined here", first->name);
-        break;
-      }
-    }
-  }
 }
 
 /* ---------------------------------------------------------------------------
@@ -1706,115 +1534,6 @@ static void parse_force(reader *r, yaml_node_t *key, yaml_node_t *value) {
  * outputs
  * ------------------------------------------------------------------------- */
 
-static const char *const output_type_names[] = {
-    "position",     "orientation",          "angle",    "velocity",       "angular_velocity",
-    "acceleration", "angular_acceleration", "reaction", "effort",         "kinetic_energy",
-    "potential_energy", "total_energy",     "deflection", "modal", "momentum", "section",
-    "force", "relative", "joint", "center_of_mass", "tyre", NULL};
-static const char *const component_names[] = {"x", "y", "z", NULL};
-static const char *const force_component_names[] = {"fx", "fy", "fz", "tx", "ty", "tz", "tension", NULL};
-
-/* A marker of a relative output: 'body' with an optional 'point' (global at
- * t = 0) or FE 'node' (flexible bodies), in mapping m. */
-static void get_output_marker(reader *r, mapping *m, bool required, int *body, bool *has_point,
-                              double point[3], int *node) {
-  if (!get_ref(m, "body", NAME_BODY, required, body, NULL)) return;
-  *has_point = get_vector(m, "point", 3, false, point);
-  yaml_node_t *nd = map_get(m, "node");
-  if (nd == NULL) return;
-  const ir_body *b = &r->model->bodies[*body];
-  if (b->kind != BODY_FLEXIBLE)
-    error_at(r, loc_of(nd), "'node' needs a flexible body ('%s' is not)", b->name);
-  else if (*has_point)
-    error_at(r, loc_of(nd), "give either 'point' or 'node', not both");
-  else
-    *node = to_fe_node(r, nd, b);
-}
-
-/* the keys and values of the output types that measure elements and markers
- * (force, relative, joint, center_of_mass) */
-static void parse_output_measure(reader *r, mapping *m, ir_output *o) {
-  static const char *const displacement_names[] = {"displacement", "velocity", "acceleration", NULL};
-  static const char *const cm_quantity_names[] = {"position", "velocity", "acceleration", NULL};
-  static const char *const force_keys[] = {"name", "type", "element", "component", "scale", NULL};
-  static const char *const relative_keys[] = {"name", "type", "quantity", "body", "point", "node",
-                                              "relative_to", "frame", "component", "scale", NULL};
-  static const char *const joint_keys[] = {"name", "type", "joint", "scale", NULL};
-  static const char *const cm_keys[] = {"name", "type", "quantity", "bodies", "component", "scale", NULL};
-  int choice = 0;
-  switch (o->kind) {
-  case OUT_FORCE:
-    map_check_keys(m, force_keys);
-    get_ref(m, "element", NAME_FORCE, true, &o->force, NULL);
-    get_choice(m, "component", "component", force_component_names, false, &o->component);
-    if (o->component == 6 && o->force >= 0 && r->model->forces[o->force].kind != FORCE_SPRING_DAMPER)
-      error_at(r, m->last_loc, "component 'tension' needs a spring_damper ('%s' is not)",
-               r->model->forces[o->force].name);
-    break;
-  case OUT_RELATIVE: {
-    map_check_keys(m, relative_keys);
-    if (get_choice(m, "quantity", "quantity", displacement_names, false, &choice))
-      o->quantity = (ir_quantity)choice;
-    get_output_marker(r, m, true, &o->body, &o->has_point, o->point, &o->node);
-    yaml_node_t *rel = map_get(m, "relative_to");
-    if (rel != NULL) {
-      static const char *const marker_keys[] = {"body", "point", "node", NULL};
-      mapping sub;
-      if (map_open(&sub, r, rel, loc_of(rel), "'relative_to' of output '%s'", o->name ? o->name : "?")) {
-        map_check_keys(&sub, marker_keys);
-        get_output_marker(r, &sub, true, &o->rel_body, &o->rel_has_point, o->rel_point, &o->rel_node);
-      }
-      map_close(&sub);
-    }
-    yaml_node_t *fr = map_get(m, "frame");
-    if (fr != NULL && !(fr->type == YAML_SCALAR_NODE && scalar_equals(fr, "global"))) {
-      int b = resolve_name(r, fr, NAME_BODY, "frame");
-      if (b >= 0) o->frame_body = b;
-    }
-    get_choice(m, "component", "component", component_names, false, &o->component);
-    break;
-  }
-  case OUT_JOINT:
-    map_check_keys(m, joint_keys);
-    if (get_ref(m, "joint", NAME_JOINT, true, &o->joint, NULL)) {
-      ir_joint_kind jk = r->model->joints[o->joint].kind;
-      if (jk != JOINT_REVOLUTE && jk != JOINT_PRISMATIC && jk != JOINT_CYLINDRICAL)
-        error_at(r, m->last_loc, "joint output '%s' needs a revolute, prismatic or cylindrical joint ('%s' is not)",
-                 o->name ? o->name : "?", r->model->joints[o->joint].name);
-    }
-    break;
-  case OUT_CENTER_OF_MASS: {
-    map_check_keys(m, cm_keys);
-    if (get_choice(m, "quantity", "quantity", cm_quantity_names, false, &choice))
-      o->quantity = (ir_quantity)choice;
-    get_choice(m, "component", "component", component_names, false, &o->component);
-    yaml_node_t *list = map_get(m, "bodies");
-    if (list == NULL) break;
-    int n = list->type == YAML_SEQUENCE_NODE ? seq_length(list) : 0;
-    if (n == 0) {
-      error_at(r, loc_of(list), "'bodies' must be a list of body names (got %s)", show_node(r, list));
-      break;
-    }
-    o->cm_bodies = xcalloc((size_t)n, sizeof *o->cm_bodies);
-    for (int i = 0; i < n; i++) {
-      yaml_node_t *item = seq_item(r, list, i);
-      int b = resolve_name(r, item, NAME_BODY, "bodies");
-      if (b == 0) error_at(r, loc_of(item), "'bodies': the ground has no centre of mass");
-      for (int j = 0; j < o->ncm_bodies && b > 0; j++)
-        if (o->cm_bodies[j] == b) error_at(r, loc_of(item), "'bodies': '%s' is listed twice", r->model->bodies[b].name);
-      if (b > 0) o->cm_bodies[o->ncm_bodies++] = b;
-    }
-    break;
-  }
-  default:
-    break;
-  }
-  get_number(m, "scale", false, &o->scale);
-}
-/* the columns of a tyre output, in the order of mb_model_outputs */
-const char *const tyre_component_names[] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz", "slip",
-                                            "slip_angle", "camber", "deflection", NULL};
-
 static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_outputs,
                          ir_output *o) {
   o->loc = loc_of(n);
@@ -1837,137 +1556,17 @@ static void parse_output(reader *r, yaml_node_t *n, int item, name_table *scene_
   if (o->name != NULL)
     map_describe(&m, "output '%s'", o->name);
 
+  /* each type's keys and fields are its element descriptor's (compiler/elements/output_*.c) */
   int type;
-  if (!get_choice(&m, "type", "output type", output_type_names, true, &type)) {
+  if (!get_choice(&m, "type", "output type", output_type_names(), true, &type)) {
     map_close(&m);
     return;
   }
-  o->kind = (ir_output_kind)type;
-  map_describe(&m, "%s output '%s'", output_type_names[type], o->name ? o->name : "?");
-
-  ir_output_kind k = o->kind;
-  if (k >= OUT_FORCE && k != OUT_TYRE) {
-    parse_output_measure(r, &m, o);
-    map_close(&m);
-    return;
-  }
-  bool of_body = k <= OUT_ANGULAR_ACCELERATION || k == OUT_DEFLECTION || k == OUT_MODAL || k == OUT_SECTION;
-  bool has_point = k == OUT_POSITION || k == OUT_VELOCITY || k == OUT_ACCELERATION;
-  bool has_component = of_body && k != OUT_ORIENTATION && k != OUT_ANGLE && k != OUT_MODAL;
-  const char *keys[12];
-  int nkeys = 0;
-  keys[nkeys++] = "name";
-  keys[nkeys++] = "type";
-  if (of_body)
-    keys[nkeys++] = "body";
-  if (has_point)
-    keys[nkeys++] = "point";
-  if (k == OUT_POSITION || k == OUT_VELOCITY || k == OUT_ACCELERATION)
-    keys[nkeys++] = "node";
-  if (k == OUT_ANGLE)
-    keys[nkeys++] = "axis";
-  if (has_component)
-    keys[nkeys++] = "component";
-  if (k == OUT_REACTION)
-    keys[nkeys++] = "joint";
-  if (k == OUT_EFFORT)
-    keys[nkeys++] = "driver";
-  if (k == OUT_DEFLECTION) {
-    keys[nkeys++] = "node";
-    keys[nkeys++] = "chord";
-  }
-  if (k == OUT_MODAL)
-    keys[nkeys++] = "mode";
-  if (k == OUT_SECTION) {
-    keys[nkeys++] = "element";
-    keys[nkeys++] = "end";
-    keys[nkeys++] = "fiber";
-  }
-  if (k == OUT_TYRE) {
-    keys[nkeys++] = "element";
-    keys[nkeys++] = "component";
-  }
-  keys[nkeys++] = "scale";
-  keys[nkeys] = NULL;
-  map_check_keys(&m, keys);
-
-  if (of_body)
-    get_ref(&m, "body", NAME_BODY, true, &o->body, NULL);
-  if (has_point)
-    o->has_point = get_vector(&m, "point", 3, false, o->point);
-  if (has_point && map_has(&m, "node") && o->body >= 0) {
-    const ir_body *b = &r->model->bodies[o->body];
-    yaml_node_t *nd = map_get(&m, "node");
-    if (b->kind != BODY_FLEXIBLE)
-      error_at(r, loc_of(nd), "'node' needs a flexible body ('%s' is not)", b->name);
-    else if (o->has_point)
-      error_at(r, loc_of(nd), "give either 'point' or 'node', not both");
-    else
-      o->node = to_fe_node(r, nd, b);
-  }
-  if (k == OUT_ANGLE)
-    get_axis(&m, "axis", true, o->axis);
-  static const char *const section_names[] = {"N", "Vy", "Vz", "T", "My", "Mz", NULL};
-  if (has_component)
-    get_choice(&m, "component", "component", k == OUT_SECTION ? section_names : component_names, false,
-               &o->component);
-  if (k == OUT_REACTION)
-    get_ref(&m, "joint", NAME_JOINT, true, &o->joint, NULL);
-  if (k == OUT_EFFORT)
-    get_ref(&m, "driver", NAME_DRIVER, true, &o->driver, NULL);
-  if ((k == OUT_DEFLECTION || k == OUT_MODAL || k == OUT_SECTION) && o->body >= 0 &&
-      r->model->bodies[o->body].kind != BODY_FLEXIBLE) {
-    error_at(r, m.loc, "%s output '%s' needs a flexible body ('%s' is not)", output_type_names[k],
-             o->name ? o->name : "?", r->model->bodies[o->body].name);
-  } else if (k == OUT_DEFLECTION && o->body >= 0) {
-    const ir_body *b = &r->model->bodies[o->body];
-    yaml_node_t *nd = map_require(&m, "node", true, "a node number");
-    if (nd != NULL) o->node = to_fe_node(r, nd, b);
-    yaml_node_t *ch = map_get(&m, "chord");
-    if (ch != NULL) {
-      if (ch->type != YAML_SEQUENCE_NODE || seq_length(ch) != 2)
-        error_at(r, loc_of(ch), "'chord': expected [K0, K1], two node numbers");
-      else
-        for (int i = 0; i < 2; i++) o->chord[i] = to_fe_node(r, seq_item(r, ch, i), b);
-    }
-  } else if (k == OUT_SECTION && o->body >= 0) {
-    const ir_flex *fx = r->model->bodies[o->body].flex;
-    double e = -1;
-    if (get_number(&m, "element", true, &e)) {
-      o->element = -1;
-      if (fx && fx->nodes && e == floor(e))
-        for (int i = 0; i < fx->nbeams; i++)
-          if ((fx->beam_ids ? fx->beam_ids[i] : i) == (long)e) o->element = i;
-      if (o->element < 0)
-        error_at(r, m.last_loc, "body '%s' has no beam %g (%s)", r->model->bodies[o->body].name, e,
-                 fx && fx->beam_ids ? "elements by their ids in the FE file" : "beams are numbered from 0");
-    }
-    static const char *const end_names[] = {"A", "B", NULL};
-    get_choice(&m, "end", "element end", end_names, false, &o->end);
-    yaml_node_t *fb = map_get(&m, "fiber");
-    if (fb != NULL) {
-      o->has_fiber = to_vector(r, fb, "'fiber'", 2, o->fiber);
-      if (map_has(&m, "component")) error_at(r, loc_of(fb), "give either 'fiber' (a stress) or 'component'");
-    }
-  } else if (k == OUT_MODAL) {
-    double mode;
-    if (get_positive(&m, "mode", true, &mode)) {
-      if (mode != floor(mode) || mode > LIMIT_COUNT)
-        error_at(r, m.last_loc, "'mode' must be a mode number (1, 2, ... up to %g)", LIMIT_COUNT);
-      else
-        o->mode = (int)mode - 1;
-    }
-  }
-  if (k == OUT_TYRE) {
-    o->force = -1;
-    if (get_ref(&m, "element", NAME_FORCE, true, &o->force, NULL) &&
-        r->model->forces[o->force].kind != FORCE_TYRE) {
-      error_at(r, m.last_loc, "tyre output '%s': force '%s' is not a tyre", o->name ? o->name : "?",
-               r->model->forces[o->force].name);
-      o->force = -1;
-    }
-    get_choice(&m, "component", "tyre component", tyre_component_names, false, &o->component);
-  }
+  const output_desc *e = output_elements[type];
+  o->kind = e->ir_kind;
+  map_describe(&m, "%s output '%s'", e->type, o->name ? o->name : "?");
+  map_check_keys(&m, e->keys);
+  if (e->parse) e->parse(&m, o);
   get_number(&m, "scale", false, &o->scale);
   map_close(&m);
 }
@@ -2113,7 +1712,7 @@ static void parse_model(reader *r, yaml_node_t *root, const char *chosen_scene_n
   if (r->scene.found)
     apply_scene(model, &r->scene);
   scene_mark_pruned_uses(r, root);
-  check_drivers(r);
+  element_driver.check(r);
   mark_virtual_joints(r, jof_list);
 }
 

@@ -25,8 +25,11 @@ char *model_relative_path(reader *r, const yaml_node_t *n);
 bool read_superelement_fe(mapping *m, const char *owner, ir_flex *fx, int nodes[2]);
 /* one entry of the top-level 'roads' (compiler/elements/force_tyre.c) */
 void parse_road(reader *r, yaml_node_t *key, yaml_node_t *value);
-/* the components of a tyre output, NULL-terminated */
+/* the components of a tyre output, NULL-terminated (output_element.c) */
 extern const char *const tyre_component_names[];
+/* FE node n of flexible body b (a number, a GRID id or a name of
+   'node_names'), or -1 after an error at n */
+int to_fe_node(reader *r, yaml_node_t *n, const ir_body *b);
 
 /* what the scenes (scene.c) reuse: a flexible body's modal settings, the
    outputs list (a scene replaces it), freeing outputs */

@@ -44,19 +44,6 @@ static void frame_from_axes(const double z[3], const double xref[3], double C[9]
   }
 }
 
-/* any unit vector perpendicular to a */
-static void perpendicular(const double a[3], double u[3]) {
-  int k = 0;
-  for (int j = 1; j < 3; j++)
-    if (fabs(a[j]) < fabs(a[k])) k = j;
-  double e[3] = {0, 0, 0};
-  e[k] = 1;
-  double d = mb_dot3(e, a);
-  for (int j = 0; j < 3; j++) u[j] = e[j] - d * a[j];
-  double n = sqrt(mb_dot3(u, u));
-  for (int j = 0; j < 3; j++) u[j] /= n;
-}
-
 /* natural cubic spline second derivatives through ntable (t, x) pairs */
 static void natural_spline(const double *d, int n, double *m2) {
   double *u = calloc((size_t)n, sizeof(double));
@@ -173,14 +160,8 @@ int lower_force_marker(lmodel *L, const ir_force *F, int side, const double C[9]
                                    L->ir->bodies[F->body[side]].name, ""), F->body_loc[side]);
 }
 
-static const char *joint_kind_name(ir_joint_kind k) {
-  static const char *n[] = {"spherical", "revolute", "cylindrical", "prismatic",
-                            "universal", "fixed", "distance"};
-  return n[k];
-}
-
-static void add_row(lmodel *L, mb_prim_kind kind, int m0, int m1, int a, int b, const char *what,
-                    int joint, int driver, ir_loc loc, const char *elem, const char *ekind) {
+void lower_add_row(lmodel *L, mb_prim_kind kind, int m0, int m1, int a, int b, const char *what,
+                   int joint, int driver, ir_loc loc, const char *elem, const char *ekind) {
   int r = L->m.nrow++;
   mb_rowdef *R = &L->row[r];
   memset(R, 0, sizeof *R);
@@ -198,189 +179,6 @@ static void add_row(lmodel *L, mb_prim_kind kind, int m0, int m1, int a, int b, 
 }
 
 static const char *axis_name[3] = {"x", "y", "z"};
-
-/* the rows of a joint between markers m0 and m1 (joint frames z = axis) */
-static void joint_rows(lmodel *L, int j, int m0, int m1) {
-  const ir_joint *J = &L->ir->joints[j];
-  char what[64];
-  ir_loc loc = J->loc;
-  const char *nm = J->name, *kn = joint_kind_name(J->kind);
-  int sph = 0, perp_z = 0, dot2 = 0, noroll = 0;
-  switch (J->kind) {
-  case JOINT_SPHERICAL: sph = 1; break;
-  case JOINT_REVOLUTE: sph = 1; perp_z = 1; break;
-  case JOINT_CYLINDRICAL: perp_z = 1; dot2 = 1; break;
-  case JOINT_PRISMATIC: perp_z = 1; dot2 = 1; noroll = 1; break;
-  case JOINT_UNIVERSAL: sph = 1; break;
-  case JOINT_FIXED: sph = 1; break;
-  case JOINT_DISTANCE: {
-    double d[3];
-    for (int k = 0; k < 3; k++) d[k] = J->point[1][k] - J->point[0][k];
-    add_row(L, MB_PRIM_DIST, m0, m1, 0, 0, "distance", j, -1, loc, nm, kn);
-    L->row[L->m.nrow - 1].L = sqrt(mb_dot3(d, d));
-    return;
-  }
-  }
-  if (sph)
-    for (int k = 0; k < 3; k++) {
-      snprintf(what, sizeof what, "coincident points, %s", axis_name[k]);
-      add_row(L, MB_PRIM_SPH, m0, m1, k, 0, what, j, -1, loc, nm, kn);
-    }
-  if (perp_z) {
-    add_row(L, MB_PRIM_DOT1, m0, m1, 0, 2, "axis z1 perpendicular to x0", j, -1, loc, nm, kn);
-    add_row(L, MB_PRIM_DOT1, m0, m1, 1, 2, "axis z1 perpendicular to y0", j, -1, loc, nm, kn);
-  }
-  if (dot2) {
-    add_row(L, MB_PRIM_DOT2, m0, m1, 0, 0, "point 1 on axis, x0 offset", j, -1, loc, nm, kn);
-    add_row(L, MB_PRIM_DOT2, m0, m1, 1, 0, "point 1 on axis, y0 offset", j, -1, loc, nm, kn);
-  }
-  if (noroll)
-    add_row(L, MB_PRIM_DOT1, m0, m1, 0, 1, "no rotation about axis (x0 . y1)", j, -1, loc, nm, kn);
-  if (J->kind == JOINT_UNIVERSAL)
-    add_row(L, MB_PRIM_DOT1, m0, m1, 2, 2, "cross axes perpendicular (z0 . z1)", j, -1, loc, nm,
-            kn);
-  if (J->kind == JOINT_FIXED) {
-    add_row(L, MB_PRIM_DOT1, m0, m1, 0, 1, "no rotation about z (x0 . y1)", j, -1, loc, nm, kn);
-    add_row(L, MB_PRIM_DOT1, m0, m1, 1, 2, "no rotation about x (y0 . z1)", j, -1, loc, nm, kn);
-    add_row(L, MB_PRIM_DOT1, m0, m1, 2, 0, "no rotation about y (z0 . x1)", j, -1, loc, nm, kn);
-  }
-}
-
-static int output_columns(const ir_model *ir, const ir_output *o) {
-  switch (o->kind) {
-  case OUT_POSITION: case OUT_VELOCITY: case OUT_ANGULAR_VELOCITY: case OUT_ACCELERATION:
-  case OUT_ANGULAR_ACCELERATION: case OUT_DEFLECTION: case OUT_RELATIVE: case OUT_CENTER_OF_MASS:
-    return o->component >= 0 ? 1 : 3;
-  case OUT_FORCE: return o->component >= 0 ? 1 : 6;
-  case OUT_JOINT: return o->joint >= 0 && ir->joints[o->joint].kind == JOINT_CYLINDRICAL ? 2 : 1;
-  case OUT_ORIENTATION: return 4;
-  case OUT_REACTION: case OUT_MOMENTUM: return 6;
-  case OUT_SECTION: return o->component >= 0 || o->has_fiber ? 1 : 6;
-  case OUT_TYRE: return o->component >= 0 ? 1 : 10;
-  default: return 1;
-  }
-}
-
-static const mb_output_kind out_kind_map[] = {
-    [OUT_POSITION] = MB_OUT_POSITION, [OUT_ORIENTATION] = MB_OUT_ORIENTATION,
-    [OUT_ANGLE] = MB_OUT_ANGLE, [OUT_VELOCITY] = MB_OUT_VELOCITY,
-    [OUT_ANGULAR_VELOCITY] = MB_OUT_ANGULAR_VELOCITY, [OUT_ACCELERATION] = MB_OUT_ACCELERATION,
-    [OUT_ANGULAR_ACCELERATION] = MB_OUT_ANGULAR_ACCELERATION, [OUT_REACTION] = MB_OUT_REACTION,
-    [OUT_EFFORT] = MB_OUT_EFFORT, [OUT_KINETIC_ENERGY] = MB_OUT_KINETIC_ENERGY,
-    [OUT_POTENTIAL_ENERGY] = MB_OUT_POTENTIAL_ENERGY, [OUT_TOTAL_ENERGY] = MB_OUT_TOTAL_ENERGY,
-    [OUT_DEFLECTION] = MB_OUT_DEFLECTION, [OUT_MODAL] = MB_OUT_MODAL,
-    [OUT_MOMENTUM] = MB_OUT_MOMENTUM, [OUT_SECTION] = MB_OUT_SECTION, [OUT_FORCE] = MB_OUT_FORCE,
-    [OUT_RELATIVE] = MB_OUT_RELATIVE, [OUT_JOINT] = MB_OUT_JOINT,
-    [OUT_CENTER_OF_MASS] = MB_OUT_CENTER_OF_MASS, [OUT_TYRE] = MB_OUT_TYRE};
-
-/* the fields of the output kinds that measure elements and markers (force,
- * relative, joint, center_of_mass); 0, or -1 after reporting an error */
-static int lower_measure_output(lmodel *L, const ir_output *o, const int *jm0, const int *jm1,
-                                mb_outputdef *d) {
-  const ir_model *ir = L->ir;
-  mb_model *m = &L->m;
-  d->frame = d->body2 = d->node2 = d->element = -1;
-  d->jmarker[0] = d->jmarker[1] = -1;
-  d->quantity = (int)o->quantity;
-  switch (o->kind) {
-  case OUT_FORCE:
-    for (int k = 0; k < m->nforce; k++)
-      if (L->force_ir[k] == o->force) d->element = k;
-    if (d->element < 0) {
-      diag_error(ir->path, o->loc, "output '%s': force '%s' is not active", o->name, ir->forces[o->force].name);
-      return -1;
-    }
-    return 0;
-  case OUT_RELATIVE: {
-    if (d->body < 0 && o->has_point) memcpy(d->s, o->point, sizeof d->s);
-    d->node = o->node;
-    d->body2 = o->rel_body - 1;
-    d->node2 = o->rel_node;
-    if (o->rel_has_point && d->body2 < 0) {
-      memcpy(d->s2, o->rel_point, sizeof d->s2);
-    } else if (o->rel_has_point) {
-      const ir_body *B = &ir->bodies[o->rel_body];
-      double A[9], rel[3];
-      mb_euler_to_A(B->orientation, A);
-      for (int j = 0; j < 3; j++) rel[j] = o->rel_point[j] - B->position[j];
-      mb_mul3t(A, rel, d->s2);
-    }
-    d->frame = o->frame_body - 1;
-    return 0;
-  }
-  case OUT_JOINT: {
-    const ir_joint *J = &ir->joints[o->joint];
-    if (jm0[o->joint] < 0) {
-      diag_error(ir->path, o->loc, "output '%s': joint '%s' is not active", o->name, J->name);
-      return -1;
-    }
-    d->jmarker[0] = jm0[o->joint];
-    d->jmarker[1] = jm1[o->joint];
-    d->joint_dofs = J->kind == JOINT_REVOLUTE ? 1 : J->kind == JOINT_PRISMATIC ? 2 : 3;
-    return 0;
-  }
-  case OUT_CENTER_OF_MASS: {
-    double total = 0;
-    d->node = -1;
-    if (o->cm_bodies) { /* the subset's weights in output_coef */
-      double *c = realloc(L->output_coef, sizeof(double) * (size_t)(L->noutput_coef + m->nbody + 1));
-      if (!c) return -1;
-      L->output_coef = c;
-      d->node = L->noutput_coef;
-      for (int b = 0; b < m->nbody; b++) c[d->node + b] = 0;
-      for (int i = 0; i < o->ncm_bodies; i++) c[d->node + o->cm_bodies[i] - 1] = 1;
-      L->noutput_coef += m->nbody;
-    }
-    for (int b = 0; b < m->nbody; b++)
-      if (d->node < 0 || L->output_coef[d->node + b] != 0)
-        total += L->body[b].kind == MB_BODY_FLEXIBLE ? L->body[b].flex->mass : L->body[b].mass;
-    if (!(total > 0)) {
-      diag_error(ir->path, o->loc, "output '%s': the bodies have no mass", o->name);
-      return -1;
-    }
-    return 0;
-  }
-  default:
-    return 0;
-  }
-}
-
-/* a SECTION output's rows of coefficients on w, appended to L->output_coef */
-static int section_coefficients(lmodel *L, const ir_output *o, mb_outputdef *d) {
-  const ir_body *B = &L->ir->bodies[o->body];
-  const fe_modes *fm = &L->modes[d->body];
-  int nm = L->body[d->body].nm;
-  double rows[6 * MB_MAX_MODES + 1], sec[3];
-  char err[256];
-  if (!B->flex->nodes || !B->flex->beams) {
-    diag_error(L->ir->path, o->loc, "output '%s': body '%s' has no beam elements (a modal data file)", o->name,
-               B->name);
-    return -1;
-  }
-  if (fe_section_rows(B->flex, o->element, o->end, fm, rows, sec, err, sizeof err)) {
-    diag_error(L->ir->path, o->loc, "output '%s': %s", o->name, err);
-    return -1;
-  }
-  double *c = realloc(L->output_coef, sizeof(double) * (size_t)(L->noutput_coef + 6 * nm + 1));
-  if (!c) return -1;
-  L->output_coef = c;
-  d->node = L->noutput_coef;
-  double *dst = c + L->noutput_coef;
-  if (o->has_fiber) { /* sigma = N / A - Mz y / Iz + My z / Iy */
-    for (int j = 0; j < nm; j++)
-      dst[j] = rows[j] / sec[0] - (sec[2] > 0 ? rows[5 * nm + j] * o->fiber[0] / sec[2] : 0) +
-               (sec[1] > 0 ? rows[4 * nm + j] * o->fiber[1] / sec[1] : 0);
-    L->noutput_coef += nm;
-  } else if (o->component >= 0) {
-    memcpy(dst, rows + (size_t)o->component * nm, sizeof(double) * (size_t)nm);
-    L->noutput_coef += nm;
-  } else {
-    memcpy(dst, rows, sizeof(double) * 6 * (size_t)nm);
-    L->noutput_coef += 6 * nm;
-  }
-  d->component = -1; /* the rows are the columns */
-  return 0;
-}
 
 lmodel *lower_model(const ir_model *ir, const flex_product *flex) {
   lmodel *L = calloc(1, sizeof *L);
@@ -511,7 +309,8 @@ lmodel *lower_model(const ir_model *ir, const flex_product *flex) {
     if (!J->active) { jm0[j] = jm1[j] = -1; continue; }
     double C[2][9];
     frame_from_axes(J->axis[0], J->ref, C[0]);
-    if (J->kind == JOINT_UNIVERSAL)
+    const joint_desc *desc = joint_element(J->kind);
+    if (desc->cross_axes)
       frame_from_axes(J->axis[1], J->axis[0], C[1]); /* x1 along the other cross axis */
     else
       memcpy(C[1], C[0], sizeof C[1]);
@@ -559,11 +358,11 @@ lmodel *lower_model(const ir_model *ir, const flex_product *flex) {
         char what[64];
         for (int k = 0; k < 3; k++) {
           snprintf(what, sizeof what, "node and virtual body coincide, %s", axis_name[k]);
-          add_row(L, MB_PRIM_SPH, mn, mv, k, 0, what, -1, -1, J->loc, name, "rigid joint of virtual body");
+          lower_add_row(L, MB_PRIM_SPH, mn, mv, k, 0, what, -1, -1, J->loc, name, "rigid joint of virtual body");
         }
-        add_row(L, MB_PRIM_DOT1, mn, mv, 0, 1, "no relative rotation about z", -1, -1, J->loc, name, "rigid joint of virtual body");
-        add_row(L, MB_PRIM_DOT1, mn, mv, 1, 2, "no relative rotation about x", -1, -1, J->loc, name, "rigid joint of virtual body");
-        add_row(L, MB_PRIM_DOT1, mn, mv, 2, 0, "no relative rotation about y", -1, -1, J->loc, name, "rigid joint of virtual body");
+        lower_add_row(L, MB_PRIM_DOT1, mn, mv, 0, 1, "no relative rotation about z", -1, -1, J->loc, name, "rigid joint of virtual body");
+        lower_add_row(L, MB_PRIM_DOT1, mn, mv, 1, 2, "no relative rotation about x", -1, -1, J->loc, name, "rigid joint of virtual body");
+        lower_add_row(L, MB_PRIM_DOT1, mn, mv, 2, 0, "no relative rotation about y", -1, -1, J->loc, name, "rigid joint of virtual body");
         L->nvirtual++;
         b = v;
         node = -1;
@@ -574,7 +373,7 @@ lmodel *lower_model(const ir_model *ir, const flex_product *flex) {
     }
     jm0[j] = mk[0];
     jm1[j] = mk[1];
-    joint_rows(L, j, jm0[j], jm1[j]);
+    desc->lower_rows(L, j, jm0[j], jm1[j]); /* compiler/elements/joint_*.c */
   }
   m->nq = nq;
   m->nv = nv;
@@ -582,14 +381,7 @@ lmodel *lower_model(const ir_model *ir, const flex_product *flex) {
   for (int d = 0; d < ir->ndrivers; d++) {
     const ir_driver *D = &ir->drivers[d];
     if (!D->active || !ir->joints[D->joint].active) continue;
-    int p = lower_add_profile(L, &D->motion, d, -1);
-    if (p < 0) { free(jm0); free(jm1); lower_free(L); return NULL; }
-    int rot = D->dof == DRIVER_ROTATION;
-    add_row(L, rot ? MB_PRIM_ROT : MB_PRIM_TRANS, jm0[D->joint], jm1[D->joint], 2, 0,
-            rot ? "rotation about the joint axis follows the motion"
-                : "translation along the joint axis follows the motion",
-            -1, d, D->loc, D->name, "driver");
-    L->row[m->nrow - 1].profile = p;
+    if (element_driver.lower(L, d, jm0, jm1)) { free(jm0); free(jm1); lower_free(L); return NULL; }
   }
 
   /* forces: each kind lowered by its element descriptor (compiler/elements/) */
@@ -611,7 +403,8 @@ lmodel *lower_model(const ir_model *ir, const flex_product *flex) {
   for (int k = 0; k < ir->noutputs; k++) {
     const ir_output *o = &ir->outputs[k];
     mb_outputdef *d = &L->output[k];
-    d->kind = out_kind_map[o->kind];
+    const output_desc *desc = output_element(o->kind);
+    d->kind = desc->runtime_kind;
     d->body = o->body >= 0 ? o->body - 1 : -1;
     d->component = o->component;
     d->scale = o->scale;
@@ -623,88 +416,23 @@ lmodel *lower_model(const ir_model *ir, const flex_product *flex) {
     d->chord[0] = d->chord[1] = -1;
     d->ncols = output_columns(ir, o);
     d->col = col;
-    if (d->body >= 0) {
+    if (d->body >= 0 && o->has_point) {
       const ir_body *B = &ir->bodies[o->body];
       double A[9], rel[3];
       mb_euler_to_A(B->orientation, A);
-      if (o->has_point) {
-        for (int j = 0; j < 3; j++) rel[j] = o->point[j] - B->position[j];
-        mb_mul3t(A, rel, d->s);
-      }
-      if (o->kind == OUT_ANGLE) {
-        memcpy(d->axis_g, o->axis, sizeof d->axis_g);
-        perpendicular(o->axis, d->u_g);
-        mb_mul3t(A, d->axis_g, d->axis);
-        mb_mul3t(A, d->u_g, d->u);
-      }
+      for (int j = 0; j < 3; j++) rel[j] = o->point[j] - B->position[j];
+      mb_mul3t(A, rel, d->s);
     }
-    if (o->kind == OUT_DEFLECTION) {
-      d->node = o->node;
-      d->chord[0] = o->chord[0];
-      d->chord[1] = o->chord[1];
-    }
-    if (o->kind == OUT_MODAL) d->node = o->mode;
-    if (o->kind == OUT_SECTION && d->body >= 0 && L->body[d->body].kind == MB_BODY_FLEXIBLE &&
-        section_coefficients(L, o, d)) {
+    /* the kind's own fields (compiler/elements/output_*.c) */
+    if (desc->lower && desc->lower(L, o, jm0, jm1, d)) {
       free(jm0);
       free(jm1);
       lower_free(L);
       return NULL;
     }
-    if (o->kind == OUT_POSITION || o->kind == OUT_VELOCITY || o->kind == OUT_ACCELERATION) d->node = o->node;
-    if (o->kind >= OUT_FORCE && o->kind != OUT_TYRE && lower_measure_output(L, o, jm0, jm1, d)) {
-      free(jm0);
-      free(jm1);
-      lower_free(L);
-      return NULL;
-    }
-    if ((o->kind == OUT_DEFLECTION || o->kind == OUT_MODAL || o->kind == OUT_SECTION) &&
-        (d->body < 0 || L->body[d->body].kind != MB_BODY_FLEXIBLE ||
-         (o->kind == OUT_MODAL && o->mode >= L->body[d->body].nm))) {
-      diag_error(ir->path, o->loc, "output '%s' needs a flexible body%s", o->name,
-                 o->kind == OUT_MODAL ? " with that many modes" : "");
-      free(jm0);
-      free(jm1);
-      lower_free(L);
-      return NULL;
-    }
-    if (o->kind == OUT_REACTION) d->reaction_marker = jm1[o->joint];
-    if (o->kind == OUT_TYRE) { /* joint: the lowered force record */
-      d->joint = -1;
-      for (int e = 0; e < m->nforce; e++)
-        if (L->force_ir[e] == o->force) d->joint = e;
-      if (d->joint < 0) {
-        diag_error(ir->path, o->loc, "output '%s': tyre '%s' is switched off in this scene", o->name,
-                   ir->forces[o->force].name);
-        free(jm0);
-        free(jm1);
-        lower_free(L);
-        return NULL;
-      }
-    }
-    if (o->kind == OUT_EFFORT) {
-      const ir_driver *D = &ir->drivers[o->driver];
-      d->driver_marker = jm0[D->joint];
-      d->driver_rotation = D->dof == DRIVER_ROTATION;
-      for (int r = 0; r < m->nrow; r++)
-        if (L->row[r].driver == o->driver) d->driver_row = r;
-    }
-    static const char *xyz[3] = {"x", "y", "z"}, *e4[4] = {"e0", "e1", "e2", "e3"},
-                      *rc[6] = {"fx", "fy", "fz", "tx", "ty", "tz"},
-                      *pm[6] = {"px", "py", "pz", "hx", "hy", "hz"},
-                      *sf[6] = {"N", "Vy", "Vz", "T", "My", "Mz"},
-                      *ty[10] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz", "slip", "slip_angle", "camber",
-                                 "deflection"};
-    for (int j = 0; j < d->ncols; j++) {
-      const char *suffix = NULL;
-      if (d->ncols == 3) suffix = xyz[j];
-      else if (d->ncols == 4) suffix = e4[j];
-      else if (d->ncols == 6) suffix = o->kind == OUT_MOMENTUM ? pm[j] : o->kind == OUT_SECTION ? sf[j] : rc[j];
-      else if (d->ncols == 10) suffix = ty[j];
-      else if (d->ncols == 2 && o->kind == OUT_JOINT) suffix = j ? "travel" : "angle";
-      L->col_name[col + j] = suffix ? xstrdup_printf("%s.%s%s", o->name, suffix, "")
-                                    : strdup(o->name);
-    }
+    for (int j = 0; j < d->ncols; j++)
+      L->col_name[col + j] = d->ncols > 1 ? xstrdup_printf("%s.%s%s", o->name, desc->columns[j], "")
+                                          : strdup(o->name);
     col += d->ncols;
   }
   m->noutput = ir->noutputs;

@@ -72,6 +72,11 @@ int lower_force_marker(lmodel *L, const ir_force *F, int side, const double C[9]
 double *lower_force_prm(lmodel *L, mb_forcedef *d, int n);
 mb_law *lower_force_laws(lmodel *L, mb_forcedef *d, int n);
 int lower_add_profile(lmodel *L, const ir_profile *p, int driver, int force);
+/* For the joints and drivers: a constraint row between markers m0 and m1
+ * (mb_rowdef's a, b), described as "<ekind> '<elem>': <what>" at loc; joint
+ * and driver: its source element, or -1. */
+void lower_add_row(lmodel *L, mb_prim_kind kind, int m0, int m1, int a, int b, const char *what,
+                   int joint, int driver, ir_loc loc, const char *elem, const char *ekind);
 
 /* Build the tables and pattern from the IR (positions as given) and the
  * flexible bodies' reduction (flex_reduce of the same IR).  Returns NULL and

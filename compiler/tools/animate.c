@@ -21,6 +21,7 @@
 #include "animate.h"
 #include "plot.h"
 #include "diag.h"
+#include "element.h"
 #include "flex.h"
 #include "lower.h"
 #include "unit.h"
@@ -258,12 +259,6 @@ static int pose_columns(const csv_table *t, const char *name, int nm, int *cols)
   return 7 + nm;
 }
 
-static const char *joint_kind_name(ir_joint_kind k) {
-  static const char *names[] = {"spherical", "revolute", "cylindrical", "prismatic", "universal", "fixed",
-                                "distance"};
-  return names[k];
-}
-
 /* the JSON of one body drawn from the model (L: lowered; b: its IR index) */
 static void body_from_model(sbuf *b, const lmodel *L, int ib, const csv_table *t, const int *cols) {
   const ir_body *B = &L->ir->bodies[ib];
@@ -487,10 +482,10 @@ int animate_write(const char *csv, const char *model, const char *scene, const c
   for (int j = 0; ir && j < ir->njoints; j++) {
     const ir_joint *J = &ir->joints[j];
     if (!J->active || (J->body[0] != 0 && J->body[1] != 0)) continue;
-    if (J->kind != JOINT_REVOLUTE && J->kind != JOINT_PRISMATIC && J->kind != JOINT_CYLINDRICAL) continue;
+    if (!joint_element(J->kind)->free_dofs) continue; /* revolute, prismatic, cylindrical */
     int side = J->body[0] == 0 ? 0 : 1;
     sb_add(&b, "%s{\"joint\":\"%s\",\"kind\":\"%s\",\"point\":", ng++ ? "," : "", J->name,
-           joint_kind_name(J->kind));
+           joint_element(J->kind)->type);
     sb_vec(&b, J->point[side], 3);
     sb_add(&b, ",\"axis\":");
     sb_vec(&b, J->axis[side], 3);
