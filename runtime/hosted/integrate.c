@@ -415,15 +415,18 @@ int mb_integrator_auto(const mb_model *m, const mb_settings *set, char *why, siz
 static const double DP_D[7] = {-12715105075.0 / 11282082432.0, 0, 87487479700.0 / 32700410799.0,
                                -10690763975.0 / 1880347072.0, 701980252875.0 / 199316789632.0,
                                -1453857185.0 / 822651844.0, 69997945.0 / 29380423.0};
-static void dp_dense(int ny, const mb_real *y0, const mb_real *y1, mb_real *const *k, double h,
-                     double theta, mb_real *out) {
+/* written out like dp_stage (DP_D[1] = 0 dropped, the sum in the row's
+ * order): a loop over the stages per state cost three times the instructions */
+static void dp_dense(int ny, const mb_real *restrict y0, const mb_real *restrict y1, mb_real *const *k,
+                     double h, double theta, mb_real *restrict out) {
+  const mb_real *k0 = k[0], *k2 = k[2], *k3 = k[3], *k4 = k[4], *k5 = k[5], *k6 = k[6];
   double theta1 = 1 - theta;
   for (int i = 0; i < ny; i++) {
     double ydiff = y1[i] - y0[i];
-    double bspl = h * k[0][i] - ydiff;
-    double r4 = ydiff - h * k[6][i] - bspl;
-    double r5 = 0;
-    for (int j = 0; j < 7; j++) r5 += DP_D[j] * k[j][i];
+    double bspl = h * k0[i] - ydiff;
+    double r4 = ydiff - h * k6[i] - bspl;
+    double r5 = DP_D[0] * k0[i] + DP_D[2] * k2[i] + DP_D[3] * k3[i] + DP_D[4] * k4[i] + DP_D[5] * k5[i] +
+                DP_D[6] * k6[i];
     r5 *= h;
     out[i] = y0[i] + theta * (ydiff + theta1 * (bspl + theta * (r4 + theta1 * r5)));
   }
