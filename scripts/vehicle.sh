@@ -332,6 +332,60 @@ for s in $SCENES; do
   done
   echo "$row |"
 done
+# the step's instruction counts: measured apart (cachegrind), not by this script
+cat <<'EOF'
+
+### Where a step goes (instruction counts)
+
+Cachegrind on `mbcc bench --end 0.5 --reps 1 --paths P` (502, 521 and 517
+Dormand–Prince steps, 500 output rows), instructions per step (whole run over the steps;
+process start and the bench's own comparison are under 3 % of it). Before:
+the tree before the step-cost work (commit 8e82981); after: with it.
+
+| scene | generated + LDLᵀ before | after | generic + KLU before | after | ratio before | after |
+|---|--:|--:|--:|--:|--:|--:|
+| `rigid` | 907 k | 757 k | 7.36 M | 7.11 M | 8.1 | 9.4 |
+| `flexible` | 3.24 M | 2.90 M | 12.69 M | 12.40 M | 3.9 | 4.3 |
+| `flexible_virtual` | 4.59 M | 4.23 M | 17.18 M | 16.87 M | 3.7 | 4.0 |
+
+The generated + LDLᵀ step after, by part (callgrind, inclusive):
+
+| scene | evaluation | LDLᵀ factor | LDLᵀ solve | output rows | integrator and the rest |
+|---|--:|--:|--:|--:|--:|
+| `rigid` | 297 k (39 %) | 220 k (29 %) | 120 k (16 %) | 40 k (5 %) | 79 k (10 %) |
+| `flexible` | 707 k (24 %) | 1612 k (56 %) | 438 k (15 %) | 56 k (2 %) | 84 k (3 %) |
+| `flexible_virtual` | 788 k (19 %) | 2492 k (59 %) | 785 k (19 %) | 55 k (1 %) | 107 k (3 %) |
+
+A step is six stages (an evaluation, a factorization and a solve each), the
+projection at the new positions (an evaluation and a factorization, then the
+velocity correction's solve) and the accelerations at the stabilized state
+(an evaluation and a solve: the next step's first stage and, when a row falls
+there, the row's).  A row that falls inside a step (nearly every row here:
+once a step is shortened, the steps of at most 1 ms no longer meet the 1 ms
+output grid) adds the projection and the accelerations of the interpolated
+state: two evaluations, one factorization, two solves, so about 10
+evaluations, 8 factorizations and 10 solves per step.  What was removed: the
+second projection and evaluation of a row at a step's end; the node
+markers' 3×3 products and sines (the flexible chassis's 16 node markers per
+evaluation: 187 M to 91 M instructions over the run); the spring table
+law's energy integral and linear segment search in every evaluation; every
+marker of the model formed for each output row and after each step (the
+angle outputs' step bound) where a few are read; the dense output's loop
+over the stages; the tyre's repeated road evaluation on a flat road.
+Results are equal to round-off (17-digit CSVs: the largest difference is
+2.9e-15 absolute, on the rigid car's numerically-zero roll).  The generic
+path shares the kernels and the integrator and got faster too; beside
+them it spends 56 % of its step in KLU's refactorization and 14 % turning
+the triplets into a compressed matrix at every factorization (its design:
+no compile-time pattern).  On the flexible car the LDLᵀ factor is over half
+of the generated step: the ratio to generic + KLU is set there.
+
+Reproduce: `valgrind --tool=cachegrind --cache-sim=no DIR/sports_car_SCENE_bench
+--end 0.5 --reps 1 --paths generated+ldl --quiet` (DIR: the `generated/`
+directory `mbcc bench models/sports_car.yaml --scene SCENE` leaves), then
+`cg_annotate`; `valgrind --tool=callgrind` and `callgrind_annotate
+--inclusive=yes` for the parts.
+EOF
 cat <<EOF
 
 ## Compile time

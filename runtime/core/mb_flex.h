@@ -39,44 +39,46 @@ typedef struct {
   const mb_real *node_Psi;  /* per node 3 x nm, likewise */
 } mb_flex;
 
-/* left Jacobian of SO(3) at theta and its time derivative along thetad:
- * d/dt exp(theta~) = (Jl thetad)~ exp(theta~) */
-static inline void mb_so3_jl(const mb_real th[3], const mb_real thd[3], mb_real Jl[9],
-                             mb_real Jld[9]) {
-  mb_real p2 = mb_dot3(th, th), p = MB_SQRT(p2), a, b, a1, b1;
-  if (p < MB_R(1e-2)) { /* series: no cancellation near zero */
-    a = MB_R(0.5) - p2 / 24 + p2 * p2 / 720;
-    b = MB_R(1.0) / 6 - p2 / 120 + p2 * p2 / 5040;
-    a1 = -MB_R(1.0) / 12 + p2 / 180;
-    b1 = -MB_R(1.0) / 60 + p2 / 1260;
+/* The coefficients of a node rotation exp(T), T = theta~, p = |theta|:
+ *   exp(T) = I + s1 T + c1 T^2               (Rodrigues: s1 = sin p / p, c1 = (1 - cos p) / p^2)
+ *   Jl = I + a T + b T^2                     (left Jacobian: a = c1, b = (p - sin p) / p^3,
+ *                                             s1 = 1 - b p^2)
+ * and a1 = a' / p, b1 = b' / p for its time derivative.  Below p = 1e-2 (node
+ * rotations are small) their series, exact to round-off there and without
+ * the cancellation of the closed forms: no sine or cosine per marker. */
+typedef struct { mb_real s1, c1, a, b, a1, b1; } mb_so3_coef;
+
+static inline void mb_so3_coefs(mb_real p2, mb_so3_coef *k) {
+  mb_real p = MB_SQRT(p2);
+  if (p < MB_R(1e-2)) {
+    k->a = MB_R(0.5) - p2 / 24 + p2 * p2 / 720;
+    k->b = MB_R(1.0) / 6 - p2 / 120 + p2 * p2 / 5040;
+    k->a1 = -MB_R(1.0) / 12 + p2 / 180;
+    k->b1 = -MB_R(1.0) / 60 + p2 / 1260;
+    k->s1 = 1 - k->b * p2;
   } else {
     mb_real s = MB_SIN(p), c = MB_COS(p);
-    a = (1 - c) / p2;
-    b = (p - s) / (p2 * p);
-    a1 = (p * s - 2 + 2 * c) / (p2 * p2);
-    b1 = ((1 - c) * p - 3 * (p - s)) / (p2 * p2 * p);
+    k->a = (1 - c) / p2;
+    k->b = (p - s) / (p2 * p);
+    k->a1 = (p * s - 2 + 2 * c) / (p2 * p2);
+    k->b1 = ((1 - c) * p - 3 * (p - s)) / (p2 * p2 * p);
+    k->s1 = s / p;
   }
-  mb_real T[9] = {0, -th[2], th[1], th[2], 0, -th[0], -th[1], th[0], 0};
-  mb_real Td[9] = {0, -thd[2], thd[1], thd[2], 0, -thd[0], -thd[1], thd[0], 0};
-  mb_real T2[9], TdT[9], TTd[9];
-  mb_matmul3(T, T, T2);
-  mb_matmul3(Td, T, TdT);
-  mb_matmul3(T, Td, TTd);
-  mb_real tt = mb_dot3(th, thd); /* phi phid */
-  for (int i = 0; i < 9; i++) {
-    Jl[i] = (i % 4 == 0) + a * T[i] + b * T2[i];
-    Jld[i] = a1 * tt * T[i] + a * Td[i] + b1 * tt * T2[i] + b * (TdT[i] + TTd[i]);
-  }
+  k->c1 = k->a;
 }
 
-/* exp(theta~) by Rodrigues' formula */
-static inline void mb_so3_exp(const mb_real th[3], mb_real E[9]) {
-  mb_real p2 = mb_dot3(th, th), p = MB_SQRT(p2), s1, c1;
-  if (p < MB_R(1e-4)) { s1 = 1 - p2 / 6; c1 = MB_R(0.5) - p2 / 24; }
-  else { s1 = MB_SIN(p) / p; c1 = (1 - MB_COS(p)) / p2; }
-  mb_real T[9] = {0, -th[2], th[1], th[2], 0, -th[0], -th[1], th[0], 0}, T2[9];
-  mb_matmul3(T, T, T2);
-  for (int i = 0; i < 9; i++) E[i] = (i % 4 == 0) + s1 * T[i] + c1 * T2[i];
+/* I + x T + y T^2 for T = th~, with T^2 = th th^T - |th|^2 I (no 3x3 product) */
+static inline void mb_so3_poly(const mb_real th[3], mb_real p2, mb_real x, mb_real y, mb_real M[9]) {
+  mb_real d = 1 - y * p2;
+  M[0] = d + y * th[0] * th[0];
+  M[4] = d + y * th[1] * th[1];
+  M[8] = d + y * th[2] * th[2];
+  M[1] = y * th[0] * th[1] - x * th[2];
+  M[3] = y * th[0] * th[1] + x * th[2];
+  M[2] = y * th[0] * th[2] + x * th[1];
+  M[6] = y * th[0] * th[2] - x * th[1];
+  M[5] = y * th[1] * th[2] - x * th[0];
+  M[7] = y * th[1] * th[2] + x * th[0];
 }
 
 /* y = X w for a 3 x nm block stored by columns */
@@ -92,10 +94,23 @@ static inline void mb_modal3(const mb_real *X, int nm, const mb_real *w, mb_real
 static inline void mb_marker_node_sums(const mb_frame *f, const mb_real b[3], const mb_real th[3],
                                        const mb_real thd[3], const mb_real Xwd[3], const mb_real C[9],
                                        mb_marker *m) {
-  mb_real Jl[9], Jld[9], Ex[9], AE[9], u[3], t1[3], t2[3], g[3];
-  mb_so3_jl(th, thd, Jl, Jld);
-  for (int i = 0; i < 9; i++) m->Jl[i] = Jl[i];
-  mb_so3_exp(th, Ex);
+  mb_real Ex[9], AE[9], u[3], t1[3], t2[3], g[3], c[3], e[3], jd[3];
+  mb_so3_coef k;
+  mb_real p2 = mb_dot3(th, th);
+  mb_so3_coefs(p2, &k);
+  mb_so3_poly(th, p2, k.a, k.b, m->Jl);
+  mb_so3_poly(th, p2, k.s1, k.c1, Ex);
+  /* g = Jl thd = thd + a c + b th x c and jd = Jl' thd =
+     (th . thd) (a1 c + b1 th x c) + b thd x c, with c = th x thd
+     (the terms of Jl' in thd~ vanish on thd) */
+  mb_cross3(th, thd, c);
+  mb_cross3(th, c, e);
+  mb_cross3(thd, c, t1);
+  mb_real tt = mb_dot3(th, thd);
+  for (int i = 0; i < 3; i++) {
+    g[i] = thd[i] + k.a * c[i] + k.b * e[i];
+    jd[i] = tt * (k.a1 * c[i] + k.b1 * e[i]) + k.b * t1[i];
+  }
   mb_matmul3(f->A, Ex, AE);
   mb_matmul3(AE, C, m->R);
   mb_mul3(f->A, b, u);
@@ -109,13 +124,11 @@ static inline void mb_marker_node_sums(const mb_frame *f, const mb_real b[3], co
   mb_cross3(f->wl, Xwd, t2);
   for (int i = 0; i < 3; i++) t1[i] += 2 * t2[i];
   mb_mul3(f->A, t1, m->aP);
-  /* W = A (w' + Jl thd),  aW = A (w' x Jl thd + Jld thd) */
-  mb_mul3(Jl, thd, g);
+  /* W = A (w' + Jl thd),  aW = A (w' x Jl thd + Jl' thd) */
   for (int i = 0; i < 3; i++) t1[i] = f->wl[i] + g[i];
   mb_mul3(f->A, t1, m->W);
   mb_cross3(f->wl, g, t1);
-  mb_mul3(Jld, thd, t2);
-  for (int i = 0; i < 3; i++) t1[i] += t2[i];
+  for (int i = 0; i < 3; i++) t1[i] += jd[i];
   mb_mul3(f->A, t1, m->aW);
 }
 

@@ -63,22 +63,31 @@ static inline void put(sink *k, int slot, int row, int col, mb_real x) {
   }
 }
 
+/* body frames at (q, v) */
+static void frames_only(const mb_model *m, const mb_real *q, const mb_real *v, mb_frame *F) {
+  for (int b = 0; b < m->nbody; b++)
+    mb_frame_rigid(q + m->body[b].qadr, v + m->body[b].vadr, &F[b]);
+}
+
+/* marker k at (q, v) from its body's frame in F */
+static void marker_from_frame(const mb_model *m, const mb_real *q, const mb_real *v, const mb_frame *F,
+                              int k, mb_marker *mk) {
+  const mb_markerdef *d = &m->marker[k];
+  if (d->body < 0) {
+    mb_marker_ground(d->s, d->C, mk);
+  } else if (d->node >= 0) {
+    const mb_body *B = &m->body[d->body];
+    mb_marker_node(&F[d->body], B->flex, d->node, q + B->qadr + 7, v + B->vadr + 6, d->C, mk);
+  } else {
+    mb_marker_rigid(&F[d->body], d->s, d->C, mk);
+  }
+}
+
 /* body frames and markers at (q, v) */
 static void frames_and_markers(const mb_model *m, const mb_real *q, const mb_real *v,
                                mb_frame *F, mb_marker *MK) {
-  for (int b = 0; b < m->nbody; b++)
-    mb_frame_rigid(q + m->body[b].qadr, v + m->body[b].vadr, &F[b]);
-  for (int k = 0; k < m->nmarker; k++) {
-    const mb_markerdef *d = &m->marker[k];
-    if (d->body < 0) {
-      mb_marker_ground(d->s, d->C, &MK[k]);
-    } else if (d->node >= 0) {
-      const mb_body *B = &m->body[d->body];
-      mb_marker_node(&F[d->body], B->flex, d->node, q + B->qadr + 7, v + B->vadr + 6, d->C, &MK[k]);
-    } else {
-      mb_marker_rigid(&F[d->body], d->s, d->C, &MK[k]);
-    }
-  }
+  frames_only(m, q, v, F);
+  for (int k = 0; k < m->nmarker; k++) marker_from_frame(m, q, v, F, k, &MK[k]);
 }
 
 /* the body columns of a force-like pair (dV, dW) at marker k: 6 or 6 + nm values */
@@ -692,21 +701,26 @@ void mb_model_track_angles(const mb_model *m, const mb_real *q, const mb_real *v
   }
 }
 
+/* called after every step: only the frames and markers the angle outputs
+ * read are formed, not the model's every marker */
 double mb_model_angle_step(const mb_model *m, const mb_real *q, const mb_real *v, void *work) {
   int any = 0;
   for (int k = 0; k < m->noutput; k++) any |= m->output[k].kind == MB_OUT_ANGLE || joint_angle_output(&m->output[k]);
   if (!any) return (double)INFINITY; /* INFINITY is a float: the cast keeps -Wdouble-promotion quiet */
-  mb_frame *F = (mb_frame *)work;
-  mb_marker *MK = (mb_marker *)(F + m->nbody);
-  frames_and_markers(m, q, v, F, MK);
+  (void)work;
   mb_real wmax = 0;
   for (int k = 0; k < m->noutput; k++) {
     const mb_outputdef *o = &m->output[k];
     mb_real w[3];
     if (o->kind == MB_OUT_ANGLE) {
-      for (int j = 0; j < 3; j++) w[j] = F[o->body].w[j];
+      mb_frame f;
+      mb_frame_rigid(q + m->body[o->body].qadr, v + m->body[o->body].vadr, &f);
+      for (int j = 0; j < 3; j++) w[j] = f.w[j];
     } else if (joint_angle_output(o)) { /* the joint's relative angular velocity */
-      for (int j = 0; j < 3; j++) w[j] = MK[o->jmarker[1]].W[j] - MK[o->jmarker[0]].W[j];
+      mb_marker k0, k1;
+      marker_at(m, o->jmarker[0], q, v, &k0);
+      marker_at(m, o->jmarker[1], q, v, &k1);
+      for (int j = 0; j < 3; j++) w[j] = k1.W[j] - k0.W[j];
     } else {
       continue;
     }
@@ -714,6 +728,13 @@ double mb_model_angle_step(const mb_model *m, const mb_real *q, const mb_real *v
   }
   /* a quarter turn at most between two unwrappings (pi would be ambiguous) */
   return wmax > 0 ? (double)(MB_R(0.25) * MB_R(MB_PI) / wmax) : (double)INFINITY;
+}
+
+/* the two markers of constraint row rd, from the frames F */
+static void need_row_markers(const mb_model *m, const mb_rowdef *rd, const mb_real *q, const mb_real *v,
+                             const mb_frame *F, mb_marker *MK) {
+  marker_from_frame(m, q, v, F, rd->m0, &MK[rd->m0]);
+  marker_from_frame(m, q, v, F, rd->m1, &MK[rd->m1]);
 }
 
 void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,
@@ -730,7 +751,10 @@ void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_r
       need_energy = 1;
   }
   if (need_energy) mb_model_energy(m, t, q, v, &kin, &pot, work);
-  frames_and_markers(m, q, v, F, MK);
+  /* every frame, but only the markers an output reads (need_marker): a row
+     comes at every output time, and a flexible body's node markers are
+     costly */
+  frames_only(m, q, v, F);
 
   for (int k = 0; k < m->noutput; k++) {
     const mb_outputdef *o = &m->output[k];
@@ -797,6 +821,7 @@ void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_r
       for (int r = 0; r < m->nrow; r++) {
         if (m->row[r].joint != o->joint) continue;
         mb_row row;
+        need_row_markers(m, &m->row[r], q, v, F, MK);
         row_eval(m, &m->row[r], MK, t, &row);
         for (int j = 0; j < 3; j++) {
           val[j] -= lambda[r] * row.dV[1][j];
@@ -810,6 +835,8 @@ void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_r
       if (o->driver_row >= 0) {
         mb_row row;
         mb_real z[3];
+        need_row_markers(m, &m->row[o->driver_row], q, v, F, MK);
+        marker_from_frame(m, q, v, F, o->driver_marker, &MK[o->driver_marker]);
         row_eval(m, &m->row[o->driver_row], MK, t, &row);
         mb_col3(MK[o->driver_marker].R, 2, z);
         val[0] = -lambda[o->driver_row] * mb_dot3(o->driver_rotation ? row.dW[1] : row.dV[1], z);
@@ -887,6 +914,7 @@ void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_r
       const mb_forcedef *d = &m->force[o->joint];
       mb_tyre_state ts;
       mb_real Fv[3], Tv[3], all[10];
+      marker_from_frame(m, q, v, F, d->m0, &MK[d->m0]);
       mb_tyre(&MK[d->m0], m->force_prm + d->padr, Fv, Tv, &ts, 0);
       all[0] = ts.Fx; all[1] = ts.Fy; all[2] = ts.Fz; all[3] = ts.Mx; all[4] = ts.My;
       all[5] = ts.Mz; all[6] = ts.slip; all[7] = ts.slip_angle; all[8] = ts.camber;
@@ -897,6 +925,8 @@ void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_r
     }
     case MB_OUT_FORCE: {
       const mb_forcedef *d = &m->force[o->element];
+      if (d->m0 >= 0) marker_from_frame(m, q, v, F, d->m0, &MK[d->m0]);
+      if (d->m1 >= 0) marker_from_frame(m, q, v, F, d->m1, &MK[d->m1]);
       force_wrench_markers(m, o->element, t, F, MK, val, val + 3);
       nval = 6;
       if (d->kind == MB_FORCE_SPRING) { /* tension: the pull along P1 - P0 (F1 = -T n) */

@@ -415,21 +415,46 @@ int mb_integrator_auto(const mb_model *m, const mb_settings *set, char *why, siz
 static const double DP_D[7] = {-12715105075.0 / 11282082432.0, 0, 87487479700.0 / 32700410799.0,
                                -10690763975.0 / 1880347072.0, 701980252875.0 / 199316789632.0,
                                -1453857185.0 / 822651844.0, 69997945.0 / 29380423.0};
-static void dp_dense(int ny, const mb_real *y0, const mb_real *y1, mb_real *const *k, double h,
-                     double theta, mb_real *out) {
+/* written out like dp_stage (DP_D[1] = 0 dropped, the sum in the row's
+ * order): a loop over the stages per state cost three times the instructions */
+static void dp_dense(int ny, const mb_real *restrict y0, const mb_real *restrict y1, mb_real *const *k,
+                     double h, double theta, mb_real *restrict out) {
+  const mb_real *k0 = k[0], *k2 = k[2], *k3 = k[3], *k4 = k[4], *k5 = k[5], *k6 = k[6];
   double theta1 = 1 - theta;
   for (int i = 0; i < ny; i++) {
     double ydiff = y1[i] - y0[i];
-    double bspl = h * k[0][i] - ydiff;
-    double r4 = ydiff - h * k[6][i] - bspl;
-    double r5 = 0;
-    for (int j = 0; j < 7; j++) r5 += DP_D[j] * k[j][i];
+    double bspl = h * k0[i] - ydiff;
+    double r4 = ydiff - h * k6[i] - bspl;
+    double r5 = DP_D[0] * k0[i] + DP_D[2] * k2[i] + DP_D[3] * k3[i] + DP_D[4] * k4[i] + DP_D[5] * k5[i] +
+                DP_D[6] * k6[i];
     r5 *= h;
     out[i] = y0[i] + theta * (ydiff + theta1 * (bspl + theta * (r4 + theta1 * r5)));
   }
 }
 
-/* one output row at (t, q, v): a consistent state, then its accelerations */
+/* the accelerations at the step's end (s->q, s->v, already stabilized by
+ * mb_sim_finish_step): the next step's first stage k[0], and the output row
+ * when one falls there */
+static int dp_first_stage(mb_sim *s, mb_real *vd, mb_real *lam) {
+  const mb_model *m = s->m;
+  int st = mb_sim_accel(s, s->t, s->q, s->v, vd, lam);
+  if (st) return st;
+  memcpy(s->k[0] + m->nq, vd, sizeof(mb_real) * (size_t)m->nv);
+  mb_model_qdot(m, s->q, s->v, s->k[0]);
+  return MB_OK;
+}
+
+/* hand one row to the caller: (t, q, v) consistent and vd, lam its
+ * accelerations and multipliers (s->phi from the same evaluation) */
+static void dp_emit(mb_sim *s, double t, const mb_real *q, const mb_real *v, const mb_real *vd,
+                    const mb_real *lam, mb_output_fn out, void *user, int *stop) {
+  double mx = max_abs(s->phi, s->m->nc);
+  if (mx > s->stats.max_phi) s->stats.max_phi = mx;
+  *stop = out && out(user, t, q, v, vd, lam);
+}
+
+/* one output row at an interpolated (t, q, v): a consistent state, then its
+ * accelerations */
 static int dp_output(mb_sim *s, double t, mb_real *q, mb_real *v, mb_real *vd, mb_real *lam,
                      mb_output_fn out, void *user, int *stop) {
   const mb_model *m = s->m;
@@ -445,16 +470,18 @@ static int dp_output(mb_sim *s, double t, mb_real *q, mb_real *v, mb_real *vd, m
     s->t = t;
     return st;
   }
-  double mx = max_abs(s->phi, m->nc);
-  if (mx > s->stats.max_phi) s->stats.max_phi = mx;
-  *stop = out && out(user, t, q, v, vd, lam);
+  dp_emit(s, t, q, v, vd, lam, out, user, stop);
   return MB_OK;
 }
 
 /* Adaptive Dormand-Prince 5(4).  The steps follow the error control alone:
  * output rows inside a step come from the continuous extension, so the output
  * grid neither caps nor changes the steps (only the last one ends on the last
- * output time). */
+ * output time).  Per accepted step: the six stages (an evaluation and a
+ * factorization each), the projection at the new positions (one of each,
+ * then the velocity correction's solve) and the accelerations at the
+ * stabilized state (an evaluation, K already factored), which are both the
+ * output row at the step's end and the next step's first stage. */
 static int dp_run(mb_sim *s, mb_output_fn out, void *user) {
   const mb_model *m = s->m;
   const mb_settings *set = &s->set;
@@ -467,18 +494,21 @@ static int dp_run(mb_sim *s, mb_output_fn out, void *user) {
   long nout = (long)floor(set->end_time / set->output_step + 1e-9), iout = 0;
   double t_end = (double)nout * set->output_step, tiny = 1e-9 * set->output_step;
   double h = fmin(set->step, set->max_step);
-  if (set->stabilization == MB_STAB_PROJECTION && (st = mb_sim_project(s, 0, s->q, s->v))) goto done;
+  if (set->stabilization != MB_STAB_PROJECTION) mb_model_normalize(m, s->q);
+  else if ((st = mb_sim_project(s, 0, s->q, s->v))) goto done;
   s->angle_hmax = mb_model_angle_step(m, s->q, s->v, s->work);
-  if ((st = dp_output(s, 0, s->q, s->v, vd, lam, out, user, &stop)) || stop) goto done;
+  if ((st = dp_first_stage(s, vd, lam))) goto done;
+  dp_emit(s, 0, s->q, s->v, vd, lam, out, user, &stop);
+  if (stop) goto done;
   iout = 1;
+  int first_stage_ready = 1; /* k[0] holds the derivative at (s->t, s->q, s->v) */
   while (iout <= nout) {
     if ((st = mb_sim_step_budget(s, h))) goto done;
     /* the first stage at (t, y) */
     memcpy(s->y, s->q, sizeof(mb_real) * (size_t)nq);
     memcpy(s->y + nq, s->v, sizeof(mb_real) * (size_t)nv);
-    if ((st = mb_sim_accel(s, s->t, s->q, s->v, vd, lam))) goto done;
-    memcpy(s->k[0] + nq, vd, sizeof(mb_real) * (size_t)nv);
-    mb_model_qdot(m, s->q, s->v, s->k[0]);
+    if (!first_stage_ready && (st = dp_first_stage(s, vd, lam))) goto done;
+    first_stage_ready = 0;
     double hrest = t_end - s->t, hh;
     char stage_failure[160] = ""; /* why a stage failed in this step's attempts */
     double stage_failure_t = 0;
@@ -533,10 +563,13 @@ static int dp_run(mb_sim *s, mb_output_fn out, void *user) {
     memcpy(s->v, s->ytmp + nq, sizeof(mb_real) * (size_t)nv);
     s->t = t1;
     if ((st = mb_sim_finish_step(s, s->t))) goto done;
-    /* a row at the step's end: the stabilized state itself */
+    /* a row at the step's end: the stabilized state itself, with the
+       accelerations the next step starts from */
     if (iout <= nout && fabs((double)iout * set->output_step - t1) <= tiny) {
-      if ((st = dp_output(s, (double)iout * set->output_step, s->q, s->v, vd, lam, out, user, &stop)) || stop)
-        goto done;
+      if ((st = dp_first_stage(s, vd, lam))) goto done;
+      first_stage_ready = 1;
+      dp_emit(s, (double)iout * set->output_step, s->q, s->v, vd, lam, out, user, &stop);
+      if (stop) goto done;
       iout++;
     }
   }

@@ -25,12 +25,18 @@ typedef struct {
 enum { MB_SPRING_L0 = 0, MB_SPRING_PRELOAD = 1, MB_SPRING_NPRM = 2 };
 enum { MB_SPRING_STIFFNESS = 0, MB_SPRING_DAMPING = 1, MB_SPRING_NLAW = 2 };
 
-/* the table segment x falls in (the end segments extend linearly) */
+/* the table segment x falls in (the end segments extend linearly): the
+ * last k <= ntable - 2 with x > x_k, or 0, by bisection (the x_k strictly
+ * increase, as the reader requires) */
 static inline int mb_law_segment(const mb_law *l, mb_real x) {
   const mb_real *d = l->table;
-  int n = l->ntable, k = 0;
-  while (k < n - 2 && x > d[2 * (k + 1)]) k++;
-  return k;
+  int lo = 0, hi = l->ntable - 2;
+  while (lo < hi) {
+    int mid = (lo + hi + 1) / 2;
+    if (x > d[2 * mid]) lo = mid;
+    else hi = mid - 1;
+  }
+  return lo;
 }
 
 /* An embedded package of a model without power laws defines MB_NO_POWER_LAW
@@ -43,28 +49,41 @@ static inline int mb_law_segment(const mb_law *l, mb_real x) {
 #define MB_LAW_POW(x, y) MB_POW(x, y)
 #endif
 
-/* F(x) of a force law, and its integral from 0 to x (for potential energy) */
-static inline mb_real mb_law_eval(const mb_law *l, mb_real x, mb_real *energy) {
-  mb_real F = 0, E = 0;
+/* F(x) of a force law */
+static inline mb_real mb_law_force(const mb_law *l, mb_real x) {
+  switch (l->kind) {
+  case MB_LAW_NONE: return 0;
+  case MB_LAW_LINEAR: return l->coef * x;
+  case MB_LAW_POWER: return (x < 0 ? -1 : 1) * l->coef * MB_LAW_POW(MB_FABS(x), l->exponent);
+  case MB_LAW_TABLE: { /* piecewise linear, extrapolated linearly */
+    const mb_real *d = l->table;
+    int k = mb_law_segment(l, x);
+    mb_real s = (d[2 * k + 3] - d[2 * k + 1]) / (d[2 * k + 2] - d[2 * k]);
+    return d[2 * k + 1] + s * (x - d[2 * k]);
+  }
+  }
+  return 0;
+}
+
+/* the integral of F from 0 to x (the potential energy): apart from
+ * mb_law_force, so that a caller that needs no energy (the evaluation's force
+ * loop) does not integrate a table at every call */
+static inline mb_real mb_law_energy(const mb_law *l, mb_real x) {
+  mb_real E = 0;
   switch (l->kind) {
   case MB_LAW_NONE:
     break;
   case MB_LAW_LINEAR:
-    F = l->coef * x;
     E = MB_R(0.5) * l->coef * x * x;
     break;
   case MB_LAW_POWER: {
     mb_real ax = MB_FABS(x), pw = MB_LAW_POW(ax, l->exponent);
-    F = (x < 0 ? -1 : 1) * l->coef * pw;
     E = l->coef * pw * ax / (l->exponent + 1);
     break;
   }
-  case MB_LAW_TABLE: { /* piecewise linear, extrapolated linearly */
+  case MB_LAW_TABLE: { /* the same piecewise-linear curve, segment by segment */
     const mb_real *d = l->table;
-    int n = l->ntable, k = mb_law_segment(l, x);
-    mb_real s = (d[2 * k + 3] - d[2 * k + 1]) / (d[2 * k + 2] - d[2 * k]);
-    F = d[2 * k + 1] + s * (x - d[2 * k]);
-    /* energy: integrate the same piecewise-linear curve from 0 to x by segments */
+    int n = l->ntable;
     mb_real a = 0, b = x, sign = 1;
     if (b < a) { a = x; b = 0; sign = -1; }
     for (int j = 0; j <= n - 2; j++) {
@@ -78,8 +97,13 @@ static inline mb_real mb_law_eval(const mb_law *l, mb_real x, mb_real *energy) {
     break;
   }
   }
-  if (energy) *energy = E;
-  return F;
+  return E;
+}
+
+/* F(x) of a force law, and its integral from 0 to x (energy NULL: not wanted) */
+static inline mb_real mb_law_eval(const mb_law *l, mb_real x, mb_real *energy) {
+  if (energy) *energy = mb_law_energy(l, x);
+  return mb_law_force(l, x);
 }
 
 /* dF/dx of a force law (a power law with exponent < 1 has an infinite slope at 0) */
@@ -105,13 +129,13 @@ static inline mb_real mb_law_slope(const mb_law *l, mb_real x) {
 static inline mb_real mb_spring(const mb_marker *m0, const mb_marker *m1, const mb_real *prm,
                                 const mb_law *law, mb_real F0[3], mb_real F1[3],
                                 mb_real *tangent) {
-  mb_real d[3], dd[3], E = 0;
+  mb_real d[3], dd[3];
   for (int j = 0; j < 3; j++) { d[j] = m1->P[j] - m0->P[j]; dd[j] = m1->V[j] - m0->V[j]; }
   mb_real L = MB_SQRT(mb_dot3(d, d));
   mb_real n[3] = {d[0] / L, d[1] / L, d[2] / L};
   mb_real x = L - prm[MB_SPRING_L0], Ld = mb_dot3(n, dd);
-  mb_real T = mb_law_eval(&law[MB_SPRING_STIFFNESS], x, &E) +
-              mb_law_eval(&law[MB_SPRING_DAMPING], Ld, 0) + prm[MB_SPRING_PRELOAD];
+  mb_real T = mb_law_force(&law[MB_SPRING_STIFFNESS], x) + mb_law_force(&law[MB_SPRING_DAMPING], Ld) +
+              prm[MB_SPRING_PRELOAD];
   for (int j = 0; j < 3; j++) { F0[j] = T * n[j]; F1[j] = -T * n[j]; }
   if (tangent) {
     /* F1 = -T n, n = d / L, dn/dd = (I - n n^T) / L, dLd/dd = dd^T (I - n n^T) / L:
@@ -128,7 +152,9 @@ static inline mb_real mb_spring(const mb_marker *m0, const mb_marker *m1, const 
         tangent[9 + 3 * i + j] = -cs * n[i] * n[j];
       }
   }
-  return E + prm[MB_SPRING_PRELOAD] * x;
+  /* the energy last: a caller that drops it (the emitted evaluation) lets the
+     C compiler drop the table's integral with it */
+  return mb_law_energy(&law[MB_SPRING_STIFFNESS], x) + prm[MB_SPRING_PRELOAD] * x;
 }
 
 #endif

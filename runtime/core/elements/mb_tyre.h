@@ -113,7 +113,7 @@ static inline int mb_tyre_contact(const mb_real *road, const mb_real C[3], const
   f[0] /= fl; f[1] /= fl;
   mb_real u[3], g[2], Hs[3];
   mb_cross3(f, a, u);
-  mb_real s = 0, w = 0, h = 0;
+  mb_real s = 0, w = 0, h = 0, ds = 1;
   /* converged: a step below the precision's resolution of a metre-sized s */
   const mb_real tol = sizeof(mb_real) < sizeof(double) ? MB_R(1e-6) : MB_R(1e-13);
   for (int it = 0; it < 30; it++) {
@@ -128,14 +128,16 @@ static inline int mb_tyre_contact(const mb_real *road, const mb_real C[3], const
     mb_real w2 = (Hs[0] * f[0] * f[0] + 2 * Hs[1] * f[0] * f[1] + Hs[2] * f[1] * f[1]) / den;
     mb_real curv = 1 + w1 * w1 + w * w2;
     if (curv < MB_R(0.1)) curv = MB_R(0.1);
-    mb_real ds = -(s + w * w1) / curv;
+    ds = -(s + w * w1) / curv;
     s += ds;
     if (MB_FABS(ds) < tol) break;
   }
-  w = mb_road_height(road, C[0] + s * f[0], C[1] + s * f[1], g, Hs) - C[2];
-  for (int k = 0; k < 3; k++) {
-    h = mb_road_height(road, C[0] + s * f[0] + w * u[0], C[1] + s * f[1] + w * u[1], g, Hs);
-    w = (h - C[2]) / u[2];
+  if (ds != 0) { /* w, g and Hs at the final s (a zero step, as on a flat road, left them there) */
+    w = mb_road_height(road, C[0] + s * f[0], C[1] + s * f[1], g, Hs) - C[2];
+    for (int k = 0; k < 3; k++) {
+      h = mb_road_height(road, C[0] + s * f[0] + w * u[0], C[1] + s * f[1] + w * u[1], g, Hs);
+      w = (h - C[2]) / u[2];
+    }
   }
   for (int k = 0; k < 3; k++) X[k] = C[k] + s * f[k] + w * u[k];
   mb_real nl = MB_SQRT(1 + g[0] * g[0] + g[1] * g[1]);
@@ -176,6 +178,7 @@ static inline mb_real mb_tyre(const mb_marker *mk, const mb_real *prm, mb_real F
   int fiala = prm[MB_TYRE_MODEL] != 0;
   mb_real a[3] = {mk->R[2], mk->R[5], mk->R[8]}, X[3], n[3], E = 0;
   mb_tyre_state s0;
+  int want_state = st != 0; /* the outputs' camber angle costs an arcsine */
   if (!st) st = &s0;
   for (int k = 0; k < 3; k++) {
     F[k] = T[k] = 0;
@@ -196,7 +199,7 @@ static inline mb_real mb_tyre(const mb_marker *mk, const mb_real *prm, mb_real F
   mb_cross3(n, ex, ey);
   mb_real sg = mb_dot3(a, n); /* sin(camber): the spin axis out of the road plane */
   for (int k = 0; k < 3; k++) { st->X[k] = X[k]; st->ex[k] = ex[k]; st->ey[k] = ey[k]; st->n[k] = n[k]; }
-  st->camber = MB_ASIN(sg > 1 ? 1 : sg < -1 ? -1 : sg);
+  if (want_state) st->camber = MB_ASIN(sg > 1 ? 1 : sg < -1 ? -1 : sg);
   st->deflection = delta;
   if (delta <= 0) return 0; /* off the road: no force at all */
   E = MB_R(0.5) * Kz * delta * delta;
