@@ -27,7 +27,9 @@
 #   6. a run-time point that makes a compile-time redundant row independent
 #      (a door on two coaxial hinges, one moved off the axis): the generated
 #      simulator stops with the cause (the generic path, reading the model
-#      again, shows the door then locked).
+#      again, shows the door then locked);
+#   7. a --set or sweep value beyond the reader's bound on a number (1e30):
+#      an error, exit 2, on mbcc run, the simulator and mbcc sweep.
 set -u
 cd "$(dirname "$0")/.."
 # shellcheck source=tests/shell_setup.sh
@@ -265,4 +267,10 @@ awk -F, 'NR > 1 && ($2 < 0.4 - 1e-9 || $2 > 0.4 + 1e-9) { bad = 1 } END { exit b
   err "door: the generic path does not show the door locked"
 run door.yaml -o dzero.csv --set hinge_y=0 > /dev/null 2>&1 || err "door: --set hinge_y=0 (on the axis) failed"
 awk -F, 'END { exit !($2 < 0.4 - 1e-4) }' dzero.csv || err "door: on the axis, the door does not swing"
+
+# 7. values beyond the bound on numbers in the file (no ranges given: rt.yaml, door.yaml)
+expect_error "error: --set anchor_x=1e200: 1e+200 is beyond the limit 1e+30" run rt.yaml -o e.csv --set anchor_x=1e200
+expect_error "error: --set hinge_y=-2e30: -2e+30 is beyond the limit 1e+30" generated/door_rt/door_rt_sim -o e.csv --set hinge_y=-2e30
+expect_error "error: '--vary anchor_x=1,1e40': 1e+40 is beyond the limit 1e+30" "$MBCC" sweep rt.yaml --vary anchor_x=1,1e40 --dir big
+[ -e e.csv ] || [ -e big/jobs.txt ] && err "a value beyond the bound wrote results or jobs"
 exit $fail

@@ -309,6 +309,11 @@ static int apply_sets(const mb_model **model, const char *prog, int nsets, const
       free(p);
       return 2;
     }
+    if (fabs(v) > 1e30) { /* the compiler's bound on a number in the model file (LIMIT_MAGNITUDE) */
+      fprintf(stderr, "%s: error: --set %s: %g is beyond the limit 1e+30 on the size of a number\n", prog, sets[i], v);
+      free(p);
+      return 2;
+    }
     if (!(v >= (double)m->param_min[k] && v <= (double)m->param_max[k])) {
       fprintf(stderr, "%s: error: --set %s: outside the parameter's range [%g, %g]\n", prog, sets[i],
               (double)m->param_min[k], (double)m->param_max[k]);
