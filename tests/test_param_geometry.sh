@@ -156,6 +156,8 @@ expect_error "turn.yaml:4:3: error: body 'arm': run-time parameter 'turn' turns 
 model 1.2 1.2 "  tilt: {value: 1, runtime: true}" | sed 's/axis: \[0, 1, 0\]/axis: [0, tilt, 0]/' > axis.yaml
 expect_error "axis.yaml:15:15: error: this value depends on run-time parameter 'tilt'" run axis.yaml -o e.csv
 expect_error "not orientations, axes, masses" run axis.yaml -o e.csv
+model 1.2 1.2 "  hinge_x: {value: 0, input: true}" | sed 's/point: \[0, 0, 0\]/point: [hinge_x, 0, 0]/' > input.yaml
+expect_error "error: input parameter 'hinge_x' moves joint points or body positions" run input.yaml -o e.csv
 [ -e e.csv ] && err "a refused model wrote e.csv"
 
 # 4. a run-time joint point: the four-bar of models/four_bar.yaml with its

@@ -107,11 +107,21 @@ static void orthogonalize(const reassembly *a, int n, double *w, double *coef) {
     }
 }
 
+/* what the model's reals resolve: the compiler's rank tolerance (1e-9) in
+ * double, a coarser one in single precision, where D carries errors of 1e-7 */
+#ifdef MB_REAL_FLOAT
+#define RANK_TOL 1e-5
+#define ACCEPT_PHI 1e-5
+#else
+#define RANK_TOL 1e-9
+#define ACCEPT_PHI 1e-9
+#endif
+
 /* Gram-Schmidt over D's rows in 'order': a row whose part independent of
- * the rows before it is at most 1e-9 of the largest row norm (the compiler's
- * tolerance) is not live; returns the basis size */
+ * the rows before it is at most RANK_TOL of the largest row norm (the
+ * compiler's tolerance) is not live; returns the basis size */
 static int factor(reassembly *a) {
-  double tol = 1e-9 * row_scale(a);
+  double tol = RANK_TOL * row_scale(a);
   int n = 0;
   for (int k = 0; k < a->nc; k++) {
     double *w = a->Q + (size_t)n * (size_t)a->nv, *coef = a->T + (size_t)k * (size_t)a->nc;
@@ -233,11 +243,7 @@ int mb_reassemble(const mb_model *m, mb_real *q, mb_real *v, char *why, size_t n
     mb_model_qincrement(m, q, dq);
     mb_model_normalize(m, q);
   }
-#ifdef MB_REAL_FLOAT
-  const double accept = 1e-5;
-#else
-  const double accept = 1e-9;
-#endif
+  const double accept = ACCEPT_PHI;
   char row[200];
   if (!(res <= accept)) {
     row_name(m, &m->row[worst >= 0 ? worst : 0], row, sizeof row);
@@ -264,7 +270,7 @@ int mb_reassemble(const mb_model *m, mb_real *q, mb_real *v, char *why, size_t n
     double norm = sqrt(dot(b, b, m->nv));
     orthogonalize(&a, rank, b, NULL);
     double off = sqrt(dot(b, b, m->nv));
-    if (fabs(phi) > 1e3 * accept || off > 1e-7 * fmax(scale, norm)) {
+    if (fabs(phi) > 1e3 * accept || off > 1e2 * RANK_TOL * fmax(scale, norm)) {
       snprintf(why, nwhy, "at the new geometry the constraint '%s', removed as redundant at compile time, is no "
                "longer redundant (%s %.3g): the compiled model would ignore it; recompile with the values in "
                "the file", m->redundant_name ? m->redundant_name[r] : "?",
