@@ -12,7 +12,7 @@ LIBS    := -lyaml -lcholmod -larpack -lklu -lamd -lcolamd -lbtf -lsuitesparsecon
 RT_INC  := -Iruntime/core -Iruntime/hosted
 RT_SRC  := runtime/core/model_generic.c runtime/core/mb_step.c \
            $(addprefix runtime/hosted/,solver_select.c genalpha.c solver_klu.c solver_dense.c \
-             solver_generic.c solver_ldl.c integrate.c equilibrium.c driver.c ida.c bench.c)
+             solver_generic.c solver_ldl.c integrate.c equilibrium.c reassemble.c driver.c ida.c bench.c)
 # the compiler, one folder a stage: front (YAML -> IR), flex (FE models and
 # modal reduction), lower (IR -> coordinates, rows, pattern, assembly),
 # back (ordering, LDL^T plan, C emission), tools (trade)
@@ -39,7 +39,7 @@ $(B)/libmbrt.a: $(patsubst runtime/%.c,$(B)/rt/%.o,$(RT_SRC))
 # the single-precision runtime (mbcc compile --real float): the emitted LDL^T
 # only, since KLU, LAPACK and SUNDIALS work in double
 RT_FLOAT_SRC := runtime/core/model_generic.c runtime/core/mb_step.c \
-                $(addprefix runtime/hosted/,solver_select.c solver_ldl.c integrate.c equilibrium.c genalpha.c driver.c)
+                $(addprefix runtime/hosted/,solver_select.c solver_ldl.c integrate.c equilibrium.c reassemble.c genalpha.c driver.c)
 $(B)/rt-float/%.o: runtime/%.c
 	@mkdir -p $(@D)
 	$(CC) $(STD) $(WARN) $(CFLAGS) $(DEPFLAGS) -DMB_REAL_FLOAT $(RT_INC) -c $< -o $@

@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "animate.h"
+#include "bounds.h"
 #include "build.h"
 #include "diag.h"
 #include "emit.h"
@@ -82,6 +83,11 @@ static int parse_options(int argc, char **argv, options *o) {
       double value = eq ? strtod(eq + 1, &end) : 0;
       if (!eq || eq == v || end == eq + 1 || *end || !isfinite(value)) {
         fprintf(stderr, "mbcc: error: --set needs NAME=VALUE with a finite number, got '%s'\n", v);
+        return 2;
+      }
+      if (fabs(value) > LIMIT_MAGNITUDE) { /* the reader's bound on a number in the file */
+        fprintf(stderr, "mbcc: error: --set %s: %g is beyond the limit %g on the size of a number\n", v, value,
+                LIMIT_MAGNITUDE);
         return 2;
       }
       if (o->nset == 64) { fprintf(stderr, "mbcc: error: more than 64 --set options\n"); return 2; }

@@ -148,6 +148,205 @@ static int bind_force_points(mbc_unit *u, const ir_model *B, const lmodel *LB, b
   return rc;
 }
 
+/* the field of ir->uses that holds value a in the model as read and b in the
+ * model read with the run-time parameters moved (B), a field of its own first
+ * (equal values written several times); -1: none */
+static int find_use(const ir_model *A, const ir_model *B, const bool *bound, double a, double b) {
+  for (int pass = 0; pass < 2; pass++)
+    for (int i = 0; i < A->nuses; i++)
+      if (A->uses[i].uses_runtime && (pass || !bound[i]) && same(A->uses[i].value, a) && same(B->uses[i].value, b))
+        return i;
+  return -1;
+}
+
+const runtime_body *mbc_runtime_body(const mbc_unit *u, int b) {
+  for (int i = 0; b >= 0 && i < u->nrbody; i++)
+    if (u->rbody[i].body == b) return &u->rbody[i];
+  return NULL;
+}
+
+/* the joint whose rows use marker k, and its side; -1: none */
+static int marker_joint(const lmodel *L, int k, int *side) {
+  for (int r = 0; r < L->m.nrow; r++) {
+    const mb_rowdef *R = &L->row[r];
+    if (R->joint < 0 || (R->m0 != k && R->m1 != k)) continue;
+    *side = R->m1 == k;
+    return R->joint;
+  }
+  return -1;
+}
+
+/* Run-time geometry: body positions and the points of joints (and of forces
+ * on bodies that move) written as expressions over run-time parameters (B:
+ * the model read with the parameters moved).  Each moved coordinate of a
+ * rigid body's initial position must be its 'position' field; each moved
+ * marker offset s = A^T (P - r) is then written by set_params from its point
+ * P (the joint's or force's 'point' fields, literal or run-time) and r, and
+ * the simulator re-assembles at start.  Markers on flexible bodies, tyres,
+ * orientations: located errors. */
+static int bind_geometry(mbc_unit *u, const ir_model *B, const lmodel *LB, bool *bound, const ir_param *first) {
+  const ir_model *A = u->ir;
+  lmodel *LA = u->lowered;
+  int rc = 0;
+  u->rbody = calloc((size_t)LA->m.nbody + 1, sizeof *u->rbody);
+  u->rmark = calloc((size_t)(LA->m.nmarker + LA->m.noutput) + 1, sizeof *u->rmark);
+  if (!u->rbody || !u->rmark) {
+    diag_error(u->path, (ir_loc){0, 0}, "out of memory while binding run-time parameters");
+    return 2;
+  }
+  for (int b = 0; b < LA->m.nbody && b + 1 < A->nbodies; b++) {
+    const double *qa = LA->q0 + LA->body[b].qadr, *qb = LB->q0 + LB->body[b].qadr;
+    const ir_body *IB = &A->bodies[b + 1];
+    if (memcmp(qa + 3, qb + 3, 4 * sizeof *qa)) {
+      diag_error(u->path, IB->loc, "body '%s': run-time parameter '%s' turns its initial orientation, which "
+                 "stays compile-time (run-time geometry: joint points and body positions); make the "
+                 "parameter compile-time (drop 'runtime: true')", IB->name, first->name);
+      rc = 2;
+      continue;
+    }
+    runtime_body rb = {.body = b, .use = {-1, -1, -1}};
+    int moved = 0;
+    for (int j = 0; j < 3; j++) {
+      rb.r[j] = qa[j];
+      if (same(qa[j], qb[j])) continue;
+      int use = find_use(A, B, bound, qa[j], qb[j]);
+      const char *why = use < 0 ? "its position is derived from the parameter rather than written in its field"
+                        : LA->body[b].kind != MB_BODY_RIGID ? "it is not a rigid body" : NULL;
+      if (why) {
+        diag_error(u->path, IB->loc, "body '%s': run-time parameter '%s' moves its initial position, but %s "
+                   "(run-time positions are supported for rigid bodies, written in their 'position' field); "
+                   "make the parameter compile-time (drop 'runtime: true')", IB->name, first->name, why);
+        rc = 2;
+        continue;
+      }
+      bound[use] = true;
+      rb.use[j] = use;
+      moved = 1;
+    }
+    if (moved) u->rbody[u->nrbody++] = rb;
+  }
+  for (int k = 0; k < LA->m.nmarker; k++) {
+    const mb_markerdef *M = &LA->marker[k];
+    if (LA->marker_runtime[k] || !memcmp(M->s, LB->marker[k].s, sizeof M->s)) continue;
+    int side = 0, joint = marker_joint(LA, k, &side), force = -1;
+    for (int e = 0; e < LA->m.nforce && joint < 0 && force < 0; e++)
+      if (LA->force[e].m0 == k || LA->force[e].m1 == k) {
+        force = e;
+        side = LA->force[e].m1 == k;
+      }
+    const double *PA = NULL, *PB = NULL;
+    const char *owner = "?";
+    ir_loc loc = LA->marker_loc[k];
+    if (joint >= 0) {
+      PA = A->joints[joint].point[side];
+      PB = B->joints[joint].point[side];
+      owner = A->joints[joint].name;
+    } else if (force >= 0) {
+      PA = A->forces[LA->force_ir[force]].point[side];
+      PB = B->forces[LB->force_ir[force]].point[side];
+      owner = A->forces[LA->force_ir[force]].name;
+    }
+    runtime_marker rm = {.marker = k, .output = -1, .body = M->body, .use = {-1, -1, -1}};
+    snprintf(rm.what, sizeof rm.what, "%s '%s', point %d", joint >= 0 ? "joint" : "force", owner, side);
+    const char *why = !PA ? "the marker is not a joint's or a force's point"
+                      : M->node >= 0 || (M->body >= 0 && LA->body[M->body].kind != MB_BODY_RIGID)
+                      ? "the point is on a flexible body's node or a virtual body"
+                      : force >= 0 && LA->force[force].kind == MB_FORCE_TYRE ? "a tyre's wheel centre is fixed at compile time"
+                      : NULL;
+    for (int j = 0; j < 3 && !why; j++) {
+      rm.P[j] = PA[j];
+      if (same(PA[j], PB[j])) continue;
+      rm.use[j] = find_use(A, B, bound, PA[j], PB[j]);
+      if (rm.use[j] < 0) why = "the point is derived from the parameter rather than written in its 'point' field";
+      else bound[rm.use[j]] = true;
+    }
+    if (why) {
+      diag_error(u->path, loc, "%s: run-time parameter '%s' moves its point, but %s (run-time geometry is "
+                 "supported for joint and force points on rigid bodies and the ground, written as global "
+                 "coordinates in 'point' fields, and for rigid bodies' positions); make the parameter "
+                 "compile-time (drop 'runtime: true')", rm.what, first->name, why);
+      rc = 2;
+      continue;
+    }
+    static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    if (M->body < 0) {
+      memcpy(rm.frame_A, I3, sizeof I3);
+    } else {
+      const double *q = LA->q0 + LA->body[M->body].qadr;
+      mb_euler_to_A(q + 3, rm.frame_A);
+      memcpy(rm.frame_r, q, sizeof rm.frame_r);
+    }
+    u->rmark[u->nrmark++] = rm;
+    LA->marker_runtime[k] = 1;
+  }
+  /* outputs measure points in body axes, taken at the lowered q0: those on
+     bodies that move follow them (set_params writes outputs[k].s) */
+  for (int k = 0; k < LA->m.noutput; k++) {
+    const mb_outputdef *OA = &LA->output[k], *OB = &LB->output[k];
+    bool moved_s = memcmp(OA->s, OB->s, sizeof OA->s) != 0;
+    if (!moved_s && !memcmp(OA->s2, OB->s2, sizeof OA->s2)) continue;
+    const ir_output *IO = &A->outputs[k];
+    bool point_kind = OA->kind == MB_OUT_POSITION || OA->kind == MB_OUT_VELOCITY || OA->kind == MB_OUT_ACCELERATION;
+    runtime_marker rm = {.marker = -1, .output = k, .body = OA->body, .use = {-1, -1, -1}};
+    snprintf(rm.what, sizeof rm.what, "output '%s', point", IO->name);
+    const char *why = !moved_s || !point_kind ? "it is not a position, velocity or acceleration output's point"
+                      : OA->body < 0 || OA->node >= 0 || LA->body[OA->body].kind != MB_BODY_RIGID
+                      ? "it is not on a rigid body's frame" : NULL;
+    for (int j = 0; j < 3 && !why; j++) {
+      rm.P[j] = IO->point[j];
+      if (same(IO->point[j], B->outputs[k].point[j])) continue;
+      rm.use[j] = find_use(A, B, bound, IO->point[j], B->outputs[k].point[j]);
+      if (rm.use[j] < 0) why = "the point is derived from the parameter rather than written in its 'point' field";
+      else bound[rm.use[j]] = true;
+    }
+    if (why) {
+      diag_error(u->path, IO->loc, "output '%s': run-time parameter '%s' moves the point it measures, but %s; "
+                 "make the parameter compile-time (drop 'runtime: true')", IO->name, first->name, why);
+      rc = 2;
+      continue;
+    }
+    const double *q = LA->q0 + LA->body[OA->body].qadr;
+    mb_euler_to_A(q + 3, rm.frame_A);
+    memcpy(rm.frame_r, q, sizeof rm.frame_r);
+    u->rmark[u->nrmark++] = rm;
+  }
+  /* a marker at its body's origin has no rotational columns in the pattern:
+     one that moves at run time needs them (lower.c, marker_offset) */
+  int rebuild = 0;
+  for (int i = 0; i < u->nrmark; i++) {
+    if (u->rmark[i].marker < 0) continue;
+    const double *s0 = LA->marker[u->rmark[i].marker].s;
+    rebuild |= u->rmark[i].body >= 0 && s0[0] == 0 && s0[1] == 0 && s0[2] == 0;
+  }
+  if (!rc && rebuild && lower_pattern(LA)) {
+    diag_error(u->path, (ir_loc){0, 0}, "out of memory while binding run-time parameters");
+    rc = 2;
+  }
+  return rc;
+}
+
+/* whether expression e depends on parameter k (directly, or through
+ * parameters defined by expressions) */
+static bool expr_depends(const ir_model *ir, const ir_expr *e, int k) {
+  if (expr_names(e, k)) return true;
+  for (int i = 0; i < ir->nparams; i++)
+    if (i != k && ir->params[i].uses_runtime && !ir->params[i].runtime && ir->params[i].expr &&
+        expr_names(e, i) && expr_depends(ir, ir->params[i].expr, k))
+      return true;
+  return false;
+}
+
+bool mbc_param_moves_assembly(const mbc_unit *u, int k) {
+  const ir_model *ir = u->ir;
+  for (int i = 0; i < u->nrbody; i++)
+    for (int j = 0; j < 3; j++)
+      if (u->rbody[i].use[j] >= 0 && expr_depends(ir, ir->uses[u->rbody[i].use[j]].expr, k)) return true;
+  for (int i = 0; i < u->nrmark; i++)
+    for (int j = 0; j < 3; j++)
+      if (u->rmark[i].use[j] >= 0 && expr_depends(ir, ir->uses[u->rmark[i].use[j]].expr, k)) return true;
+  return false;
+}
+
 /* Which pool entries of the lowered model the run-time parameters set.  The
  * model is read and lowered a second time with every run-time parameter
  * moved a little (by a different fraction each); an entry of the force pools
@@ -235,14 +434,22 @@ static int bind_runtime(mbc_unit *u) {
     if (pool == BIND_PRM) u->lowered->prm_runtime[index] = 1;
   }
   if (bind_force_points(u, B, LB, bound, first)) rc = 2;
+  if (bind_geometry(u, B, LB, bound, first)) rc = 2;
+  for (int k = 0; k < A->nparams; k++) /* the embedded step API sets inputs without re-assembling */
+    if (A->params[k].input && mbc_param_moves_assembly(u, k)) {
+      diag_error(u->path, A->params[k].loc, "input parameter '%s' moves joint points or body positions, which "
+                 "are re-assembled only at start: it cannot be an input (drop 'input: true')", A->params[k].name);
+      rc = 2;
+    }
   for (int i = 0; i < A->nuses; i++)
     if (A->uses[i].uses_runtime && !A->uses[i].pruned && !bound[i] && !same(A->uses[i].value, B->uses[i].value)) {
       diag_error(u->path, A->uses[i].loc,
                  "this value depends on run-time parameter '%s', but the generated code fixes it at compile "
                  "time (run-time parameters can set force-element constants: stiffness, damping, preload, free "
-                 "length, force and torque values, and the attachment points of force elements on rigid bodies "
-                 "and the ground; not joint points, body positions, masses, inertia, flexible bodies or "
-                 "gravity); make the parameter compile-time (drop 'runtime: true')",
+                 "length, force and torque values, the attachment points of force elements and the points of "
+                 "joints on rigid bodies and the ground, and rigid bodies' initial positions; not orientations, "
+                 "axes, masses, inertia, flexible bodies or gravity); make the parameter compile-time (drop "
+                 "'runtime: true')",
                  runtime_name(A, A->uses[i].expr));
       rc = 2;
     }
@@ -256,8 +463,9 @@ static int bind_runtime(mbc_unit *u) {
   for (int k = 0; k < LA->m.nrow && !moved; k++) moved = !same(LA->row[k].L, LB->row[k].L);
   if (moved && !rc) {
     diag_error(u->path, first->loc, "run-time parameter '%s' changes the model's masses, geometry or gravity, which "
-               "the generated code fixes at compile time (of the geometry, only force elements' attachment points "
-               "can be run-time): make it compile-time (drop 'runtime: true')", first->name);
+               "the generated code fixes at compile time (of the geometry, joint and force points and rigid "
+               "bodies' positions can be run-time, not a distance joint's length, axes or orientations): make it "
+               "compile-time (drop 'runtime: true')", first->name);
     rc = 2;
   }
 done:
@@ -309,6 +517,8 @@ int mbc_unit_build(mbc_unit *u, const char *path, const char *scene, int verbose
 void mbc_unit_free(mbc_unit *u) {
   if (u->have_plan) ldl_plan_free(&u->plan);
   free(u->bind);
+  free(u->rmark);
+  free(u->rbody);
   if (u->lowered) {
     free(u->lowered->prm_runtime);
     free(u->lowered->marker_runtime);

@@ -5,6 +5,7 @@
 #ifndef MBCC_UNIT_H
 #define MBCC_UNIT_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "flex.h"
@@ -27,6 +28,14 @@ typedef struct mbc_unit {
    * (pipeline.c, bind_runtime); none when the model has no run-time parameter */
   struct runtime_binding *bind;
   int nbind;
+  /* run-time geometry (pipeline.c, bind_geometry): the markers of joints
+   * (and of forces on moved bodies) whose body-frame offsets set_params
+   * writes, and the bodies whose initial positions it writes; the simulator
+   * then re-assembles at start (runtime/hosted/reassemble.c) */
+  struct runtime_marker *rmark;
+  int nrmark;
+  struct runtime_body *rbody;
+  int nrbody;
   int overridden;           /* read with --set values (the generic path), or the IR changed after
                                reading (mbcc trade's variants): run-time parameters are not bound,
                                and the emitted code folds them like compile-time ones */
@@ -48,6 +57,34 @@ typedef struct runtime_binding {
   int use;      /* ir->uses[use]: its expression and location */
   int force;    /* the force element (lowered index) */
 } runtime_binding;
+
+/* a marker whose offset s = A^T (P - r) follows run-time parameters: its
+ * global point P at t = 0 as written (each coordinate a literal or the
+ * expression of ir->uses[use[j]]), its body's frame at the lowered q0 (A, and
+ * r unless the body's position is itself run-time, runtime_body) */
+typedef struct runtime_marker {
+  int marker;
+  int output;            /* >= 0: instead of a marker, the point s of this output */
+  int body;              /* lowered body, -1: the ground */
+  double P[3];
+  int use[3];            /* -1: the literal P[j] */
+  double frame_A[9], frame_r[3];
+  char what[160];        /* "joint 'pin', point 0" (the generated comment) */
+} runtime_marker;
+
+/* a body whose initial position (body frame origin, global) has run-time
+ * coordinates: use[j] >= 0 for those, r the lowered (as written) position */
+typedef struct runtime_body {
+  int body;
+  int use[3];
+  double r[3];
+} runtime_body;
+
+/* body b's run-time position (lowered index), or NULL when it is fixed */
+const runtime_body *mbc_runtime_body(const mbc_unit *u, int b);
+/* whether run-time parameter k (an index of ir->params) moves joint points or
+ * body positions: the simulator then re-assembles at start */
+bool mbc_param_moves_assembly(const mbc_unit *u, int k);
 
 /* The first stage alone: read the model and apply the scene, so that a tool
  * can change the IR before the rest (mbcc trade's variants).  0, or 2 after

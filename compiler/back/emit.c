@@ -137,6 +137,64 @@ static void limit_literal(FILE *f, double x) {
   else num(f, x);
 }
 
+/* a run-time coordinate: the C text of expression ir->uses[use] over p, or
+ * the literal when use < 0 */
+static void geometry_coordinate(FILE *f, const mbc_unit *u, int use, double literal) {
+  if (use < 0) {
+    num(f, literal);
+    return;
+  }
+  fputc('(', f);
+  expr_print_c(f, u->ir, u->ir->uses[use].expr, u->real_float ? "p" : "(double)p");
+  fputc(')', f);
+}
+
+/* coordinate j of body b's lowered position: run-time or the literal r */
+static void body_coordinate(FILE *f, const mbc_unit *u, int b, int j, double r) {
+  const runtime_body *rb = mbc_runtime_body(u, b);
+  geometry_coordinate(f, u, rb ? rb->use[j] : -1, r);
+}
+
+/* set_params's lines for run-time geometry (pipeline.c, bind_geometry): the
+ * initial positions of bodies as given (q_given), and the offsets s = A^T (P - r) of the markers that follow them or
+ * their run-time points; the simulator then re-assembles (mb_reassemble) */
+static void emit_geometry_params(FILE *f, const mbc_unit *u) {
+  const lmodel *L = u->lowered;
+  for (int i = 0; i < u->nrbody; i++) {
+    const runtime_body *rb = &u->rbody[i];
+    for (int j = 0; j < 3; j++) {
+      if (rb->use[j] < 0) continue;
+      fprintf(f, "  q_given[%d] = (mb_real)", L->body[rb->body].qadr + j);
+      geometry_coordinate(f, u, rb->use[j], 0);
+      fprintf(f, "; /* body '%s', position %s */\n", L->body[rb->body].name, j == 0 ? "x" : j == 1 ? "y" : "z");
+    }
+  }
+  for (int i = 0; i < u->nrmark; i++) {
+    const runtime_marker *rm = &u->rmark[i];
+    for (int r = 0; r < 3; r++) {
+      if (rm->output >= 0) fprintf(f, "  outputs[%d].s[%d] = (mb_real)(", rm->output, r);
+      else fprintf(f, "  markers[%d].s[%d] = (mb_real)(", rm->marker, r);
+      if (rm->body < 0) {
+        geometry_coordinate(f, u, rm->use[r], rm->P[r]);
+      } else {
+        int written = 0;
+        for (int j = 0; j < 3; j++) {
+          if (rm->frame_A[3 * j + r] == 0) continue; /* an exact zero: left out */
+          if (written++) fputs(" + ", f);
+          num(f, rm->frame_A[3 * j + r]);
+          fputs(" * (", f);
+          geometry_coordinate(f, u, rm->use[j], rm->P[j]);
+          fputs(" - ", f);
+          body_coordinate(f, u, rm->body, j, rm->frame_r[j]);
+          fputc(')', f);
+        }
+        if (!written) fputc('0', f);
+      }
+      fprintf(f, "); /* %s, %s */\n", rm->what, r == 0 ? "x" : r == 1 ? "y" : "z");
+    }
+  }
+}
+
 /* set_params's lines for a force marker whose global point at t = 0 has
  * run-time coordinates (binding i, the marker's first): its offset in the
  * body's frame, s = A^T (P - r), the arithmetic of lower.c's add_marker with
@@ -173,7 +231,7 @@ static void emit_marker_point(FILE *f, const mbc_unit *u, int i) {
       }
       if (!on_ground) {
         fputs(" - ", f);
-        num(f, b->frame_r[j]);
+        body_coordinate(f, u, u->lowered->marker[b->index].body, j, b->frame_r[j]);
         fputc(')', f);
       }
     }
@@ -244,7 +302,32 @@ static void emit_runtime_params(emit_ctx *cx) {
     expr_print_c(f, ir, use->expr, u->real_float ? "p" : "(double)p");
     fputs(";\n", f);
   }
+  emit_geometry_params(f, u);
   fputs("  return NULL;\n}\n", f);
+  if (!u->nrmark && !u->nrbody) return;
+  /* which parameters move the assembly, and the rows that must stay redundant */
+  fprintf(f, "static const unsigned char param_geometry[%d] = {", n);
+  for (int k = 0, j = 0; k < ir->nparams; k++)
+    if (ir->params[k].runtime) fprintf(f, "%s%d", j++ ? ", " : "", mbc_param_moves_assembly(u, k));
+  fputs("};\n", f);
+  if (!L->nremoved) return;
+  fprintf(f, "static const mb_rowdef redundant_rows[%d] = {\n", L->nremoved);
+  for (int r = 0; r < L->nremoved; r++) {
+    const mb_rowdef *R = &L->removed_row[r];
+    fprintf(f, "  {.kind = %s, .m0 = %d, .m1 = %d, .a = %d, .b = %d", prim_kind_name(R->kind), R->m0, R->m1, R->a, R->b);
+    if (R->L != 0) { fputs(", .L = ", f); num(f, R->L); }
+    fprintf(f, ", .profile = %d, .joint = %d, .driver = %d},\n", R->profile, R->joint, R->driver);
+  }
+  fputs("};\n", f);
+  fprintf(f, "static const char *const redundant_names[%d] = {\n", L->nremoved);
+  for (int r = 0; r < L->nremoved; r++) {
+    fputs("  \"", f);
+    for (const char *c = L->removed_desc[r]; *c; c++)
+      if (*c == '"' || *c == '\\') fprintf(f, "\\%c", *c);
+      else fputc((unsigned char)*c < 0x20 ? '?' : *c, f);
+    fputs("\",\n", f);
+  }
+  fputs("};\n", f);
 }
 
 /* the force records (kind and addresses) and their pools: force_prm, force_laws */
@@ -305,7 +388,7 @@ static void emit_force_tables(emit_ctx *cx) {
     }
     fputs("};\n", f);
   }
-  emit_runtime_params(cx);
+  if (!cx->u->nrmark && !cx->u->nrbody) emit_runtime_params(cx);
 }
 
 /* the tables: bodies, markers, rows, forces, profiles, outputs */
@@ -425,7 +508,9 @@ static void emit_tables(emit_ctx *cx) {
     fputs("};\n", f);
   }
   if (m->noutput) {
-    fprintf(f, "static const mb_outputdef outputs[%d] = {\n", m->noutput);
+    bool runtime_points = false; /* set_params writes points of outputs (run-time geometry): then not const */
+    for (int i = 0; i < cx->u->nrmark && runtime_count(cx->u); i++) runtime_points |= cx->u->rmark[i].output >= 0;
+    fprintf(f, "static %smb_outputdef outputs[%d] = {\n", runtime_points ? "" : "const ", m->noutput);
     for (int k = 0; k < m->noutput; k++) {
       const mb_outputdef *o = &L->output[k];
       fprintf(f, "  /* output '%s' (", L->ir->outputs[k].name);
@@ -473,6 +558,8 @@ static void emit_tables(emit_ctx *cx) {
     for (int j = 0; j < m->ncols; j++) fprintf(f, "%s\"%s\"", j ? ", " : "", L->col_name[j]);
     fputs("};\n", f);
   }
+  /* run-time geometry: set_params writes markers and outputs too, so after them */
+  if (cx->u->nrmark || cx->u->nrbody) emit_runtime_params(cx);
 }
 
 
@@ -949,6 +1036,19 @@ static int emit_source(emit_ctx *cx, emit_files *EF, char **text, size_t *len) {
   fprintf(f, "\n/* --- assembled, consistent initial state --- */\n");
   if (m->nq) real_array(f, "q0", L->q0, m->nq);
   if (m->nv) real_array(f, "v0", L->v0, m->nv);
+  if (runtime_count(cx->u) && (cx->u->nrmark || cx->u->nrbody)) {
+    /* run-time geometry: the state as the file gives it, where the start-up
+       re-assembly starts (as the compiler's did); set_params writes the
+       run-time bodies' positions */
+    fputs("/* as given, before assembly (the start of the re-assembly after --set) */\n", f);
+    fprintf(f, "static mb_real q_given[%d] = {", m->nq + 1);
+    for (int i = 0; i < m->nq; i++) {
+      fputs(i % 4 ? ", " : (i ? ",\n  " : "\n  "), f);
+      num(f, L->q_given[i]);
+    }
+    fputs(m->nq ? "\n};\n" : "0};\n", f);
+    real_array(f, "v_given", L->v_given, m->nv);
+  }
   fputc('\n', f);
   emit_tables(cx);
   emit_init(cx);
@@ -1000,6 +1100,10 @@ static int emit_source(emit_ctx *cx, emit_files *EF, char **text, size_t *len) {
   }
   if (L->force_tslot)
     fputs("  .force_tslot = force_tslot, .tangent_slot = tangent_slot,\n", f);
+  if (runtime_count(cx->u) && (cx->u->nrmark || cx->u->nrbody))
+    fprintf(f, "  .param_geometry = param_geometry, .q_given = q_given, .v_given = v_given,\n"
+               "  .nredundant = %d, .redundant_row = %s, .redundant_name = %s,\n",
+            L->nremoved, L->nremoved ? "redundant_rows" : "0", L->nremoved ? "redundant_names" : "0");
   fputs("};\n", f);
   if (EF->active && (fflush(f) || emit_files_keep(EF, f, *text, *len))) return 1;
   return 0;

@@ -338,7 +338,8 @@ static void mark_view(sym_graph *g, const lmodel *L, int k, smark *m) {
   const mb_markerdef *d = &L->marker[k];
   memset(m, 0, sizeof *m);
   if (d->body < 0) {
-    for (int i = 0; i < 3; i++) m->P.e[i] = lit(g, d->s[i]);
+    for (int i = 0; i < 3; i++) /* a ground marker's point: set at run time, or literal */
+      m->P.e[i] = offset_runtime(L, k) ? named(g, "markers[%d].s[%d]", k, i) : lit(g, d->s[i]);
     for (int i = 0; i < 9; i++) m->R[i] = lit(g, d->C[i]);
     m->V = m->W = m->aP = m->aW = s_zero(g);
     return;

@@ -300,6 +300,29 @@ static int K_singular(const mb_model *m, const double *Kx, int *failed) {
   return singular;
 }
 
+/* the rows about to be removed (keep[r] 0), appended to L->removed_row:
+ * the generated code checks at start that run-time geometry leaves them
+ * redundant (runtime/hosted/reassemble.c); 0, or -1 when out of memory */
+static int keep_removed_rows(lmodel *L, const int *keep) {
+  int nremove = 0;
+  for (int r = 0; r < L->m.nrow; r++) nremove += !keep[r];
+  mb_rowdef *rows = realloc(L->removed_row, sizeof *rows * (size_t)(L->nremoved + nremove + 1));
+  if (rows) L->removed_row = rows;
+  char **desc = realloc(L->removed_desc, sizeof *desc * (size_t)(L->nremoved + nremove + 1));
+  if (desc) L->removed_desc = desc;
+  if (!rows || !desc) return -1;
+  for (int r = 0; r < L->m.nrow; r++) {
+    if (keep[r]) continue;
+    size_t n = strlen(L->row_desc[r]) + 1;
+    char *d = malloc(n);
+    if (!d) return -1;
+    memcpy(d, L->row_desc[r], n);
+    L->removed_row[L->nremoved] = L->row[r];
+    L->removed_desc[L->nremoved++] = d;
+  }
+  return 0;
+}
+
 int assemble_model(lmodel *L, int verbose) {
   mb_model *m = &L->m;
   const char *file = L->ir->path;
@@ -319,6 +342,13 @@ int assemble_model(lmodel *L, int verbose) {
   order = row_order(L);
   frozen = frozen_modes(m);
   if (!b || !dx || !keep || !order || !frozen) goto out;
+  free(L->q_given);
+  free(L->v_given);
+  L->q_given = malloc(sizeof(double) * (size_t)(m->nq + 1));
+  L->v_given = malloc(sizeof(double) * (size_t)(m->nv + 1));
+  if (!L->q_given || !L->v_given) goto out;
+  memcpy(L->q_given, L->q0, sizeof(double) * (size_t)m->nq);
+  memcpy(L->v_given, L->v0, sizeof(double) * (size_t)m->nv);
 
   /* 1. positions: Newton with minimum-norm steps over a basis of the rows */
   int worst = -1, it;
@@ -360,6 +390,7 @@ int assemble_model(lmodel *L, int verbose) {
         explain_dependency(L, &D, &B, r);
       }
       L->nredundant += m->nc - rank;
+      if (keep_removed_rows(L, keep)) goto out;
       if (lower_remove_rows(L, keep)) goto out;
       evalbuf_free(&e);
       if (evalbuf_init(&e, m)) goto out;

@@ -486,6 +486,7 @@ int lower_node_rotates(const mb_body *B, int node) { return node_shapes_nonzero(
  * the node sits at the origin (the reference node of a body frame): then
  * P = r exactly and a point row has no rotational columns there */
 static int marker_offset(const lmodel *L, const mb_markerdef *md) {
+  if (L->marker_runtime && L->marker_runtime[md - L->marker]) return 1; /* set at run time (pipeline.c) */
   if (md->node < 0) return fabs(md->s[0]) + fabs(md->s[1]) + fabs(md->s[2]) > 0;
   const mb_body *B = &L->body[md->body];
   const double *x = B->flex->node_x + 3 * (size_t)md->node;
@@ -802,5 +803,8 @@ void lower_free(lmodel *L) {
   free(L->name);
   free(L->mslotf); free(L->body_name); free(L->modal_slot);
   free(L->force_tslot); free(L->tangent_slot);
+  for (int r = 0; r < L->nremoved; r++) free(L->removed_desc[r]);
+  free(L->removed_row); free(L->removed_desc);
+  free(L->q_given); free(L->v_given);
   free(L);
 }

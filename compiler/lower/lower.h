@@ -62,6 +62,15 @@ typedef struct {
   /* per marker: 1 when its offset s is set by run-time parameters (a force
      element's attachment point): the emitted code reads markers[k].s */
   unsigned char *marker_runtime;
+  /* the rows the assembly removed as redundant (assemble.c), kept for the
+   * generated code's re-assembly check when run-time geometry may change
+   * their redundancy: their records (slots unset) and descriptions */
+  mb_rowdef *removed_row;
+  char **removed_desc;
+  int nremoved;
+  /* q0 and v0 as lowered, before the assembly moved them (assemble.c): where
+   * the generated code's re-assembly starts */
+  double *q_given, *v_given;
 } lmodel;
 
 /* For the lowering hooks of the elements (compiler/elements/): the marker

@@ -15,6 +15,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "bounds.h"
 #include "outfile.h"
 #include "proc.h"
 
@@ -29,7 +30,7 @@ static int parse_number(const char *s, size_t len, double *x) {
   return (*end || errno || !isfinite(*x)) ? -1 : 0;
 }
 
-int sweep_parse_vary(const char *arg, sweep_var *v) {
+static int parse_vary_values(const char *arg, sweep_var *v) {
   memset(v, 0, sizeof *v);
   const char *eq = strchr(arg, '=');
   if (!eq || eq == arg || (size_t)(eq - arg) >= sizeof v->name) {
@@ -95,6 +96,22 @@ int sweep_parse_vary(const char *arg, sweep_var *v) {
     p = c + 1;
   }
   return 0;
+}
+
+/* the reader's bound on the size of a number in the file (bounds.h), for
+ * the values a sweep sets too: beyond it a run would stop at t = 0 */
+static int beyond_limit(const char *arg, double x) {
+  if (!(fabs(x) > LIMIT_MAGNITUDE)) return 0;
+  fprintf(stderr, "mbcc: error: '--vary %s': %g is beyond the limit %g on the size of a number\n", arg, x,
+          LIMIT_MAGNITUDE);
+  return 1;
+}
+
+int sweep_parse_vary(const char *arg, sweep_var *v) {
+  if (parse_vary_values(arg, v)) return 2;
+  int bad = !v->nvalue && (beyond_limit(arg, v->lo) || beyond_limit(arg, v->hi));
+  for (int i = 0; i < v->nvalue && !bad; i++) bad = beyond_limit(arg, v->values[i]);
+  return bad ? 2 : 0;
 }
 
 /* splitmix64: a small reproducible generator for the Latin hypercube */

@@ -197,6 +197,18 @@ typedef struct mb_model {
    * mb_force_tangent_cols(m, e, s) rows and columns (docs/formulation.md). */
   const int *force_tslot;
   const int *tangent_slot;
+  /* run-time geometry (NULL / 0 when no parameter moves it): param_geometry[i]
+   * is 1 when parameter i moves joint points or body positions (set_params
+   * writes the markers' offsets and q_given), after which the simulator
+   * re-assembles at start (mb_reassemble); the nredundant constraint rows the
+   * compiler removed as redundant (redundant_row, slots unset; redundant_name
+   * describes each) must stay redundant there */
+  const unsigned char *param_geometry;
+  const mb_real *q_given, *v_given; /* the state as the file gives it (before the
+                                       compiler's assembly): the re-assembly's start */
+  int nredundant;
+  const mb_rowdef *redundant_row;
+  const char *const *redundant_name;
 } mb_model;
 
 /* How many velocity columns side s (0, 1) of force element d has in the

@@ -240,9 +240,40 @@ static void usage(const char *prog) {
           prog);
 }
 
+/* After --set moved joint points or body positions: the model re-assembled
+ * (mb_reassemble) into *assembled, a copy of m with its own initial state
+ * (*q0, *v0: the caller frees them); 0, or 2 after reporting the parameters
+ * and the cause */
+static int reassemble_sets(const mb_model *m, const char *prog, int nsets, const char *const *sets,
+                           const int *moved, mb_model *assembled, mb_real **q0, mb_real **v0) {
+  *q0 = malloc(sizeof(mb_real) * ((size_t)m->nq + 1));
+  *v0 = malloc(sizeof(mb_real) * ((size_t)m->nv + 1));
+  char why[1024];
+  if (!*q0 || !*v0) {
+    fprintf(stderr, "%s: error: out of memory\n", prog);
+    return 2;
+  }
+  if (mb_reassemble(m, *q0, *v0, why, sizeof why)) {
+    fprintf(stderr, "%s: error: --set", prog);
+    for (int i = 0; i < nsets; i++)
+      if (moved[i]) fprintf(stderr, " %s", sets[i]);
+    fprintf(stderr, " moves the assembly: %s; no results written\n", why);
+    return 2;
+  }
+  *assembled = *m;
+  assembled->q0 = *q0;
+  assembled->v0 = *v0;
+  return 0;
+}
+
 /* --set NAME=VALUE (each item of 'sets'): the model's run-time parameters
- * from their defaults, then set (m->set_params); 0, or 2 after reporting */
-static int apply_sets(const mb_model *m, const char *prog, int nsets, const char *const *sets) {
+ * from their defaults, then set (m->set_params), and the model re-assembled
+ * when they move its geometry (*m then points to *assembled, whose initial
+ * state *q0, *v0 the caller frees); 0, or 2 after reporting */
+static int apply_sets(const mb_model **model, const char *prog, int nsets, const char *const *sets,
+                      mb_model *assembled, mb_real **q0, mb_real **v0) {
+  const mb_model *m = *model;
+  int moved[64] = {0}, any_moved = 0;
   if (!nsets) return 0;
   if (!m->nparam) {
     fprintf(stderr, "%s: error: --set %s: the model has no run-time parameters ('runtime: true' in its "
@@ -278,6 +309,11 @@ static int apply_sets(const mb_model *m, const char *prog, int nsets, const char
       free(p);
       return 2;
     }
+    if (fabs(v) > 1e30) { /* the compiler's bound on a number in the model file (LIMIT_MAGNITUDE) */
+      fprintf(stderr, "%s: error: --set %s: %g is beyond the limit 1e+30 on the size of a number\n", prog, sets[i], v);
+      free(p);
+      return 2;
+    }
     if (!(v >= (double)m->param_min[k] && v <= (double)m->param_max[k])) {
       fprintf(stderr, "%s: error: --set %s: outside the parameter's range [%g, %g]\n", prog, sets[i],
               (double)m->param_min[k], (double)m->param_max[k]);
@@ -285,6 +321,8 @@ static int apply_sets(const mb_model *m, const char *prog, int nsets, const char
       return 2;
     }
     p[k] = (mb_real)v;
+    moved[i] = m->param_geometry && m->param_geometry[k];
+    any_moved |= moved[i];
   }
   const char *broken = m->set_params(m, p);
   free(p);
@@ -294,6 +332,9 @@ static int apply_sets(const mb_model *m, const char *prog, int nsets, const char
     fprintf(stderr, ": %s\n", broken);
     return 2;
   }
+  if (!any_moved) return 0;
+  if (reassemble_sets(m, prog, nsets, sets, moved, assembled, q0, v0)) return 2;
+  *model = assembled;
   return 0;
 }
 
@@ -374,7 +415,13 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
     return 2;
   }
 
-  if (apply_sets(m, argv[0], nsets, sets)) return 2;
+  mb_model assembled;           /* m re-assembled after --set moved its geometry */
+  mb_real *assembled_q0 = NULL, *assembled_v0 = NULL;
+  if (apply_sets(&m, argv[0], nsets, sets, &assembled, &assembled_q0, &assembled_v0)) {
+    free(assembled_q0);
+    free(assembled_v0);
+    return 2;
+  }
   mb_solver *ls = mb_solver_new(solver, m);
   if (!ls) {
     if (!strcmp(solver, "ldl"))
@@ -382,6 +429,7 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
               "model has not (expected %s)\n", argv[0], mb_solver_choices(m));
     else
       fprintf(stderr, "%s: error: unknown solver '%s' (expected %s)\n", argv[0], solver, mb_solver_choices(m));
+    free(assembled_q0); free(assembled_v0);
     return 2;
   }
   /* write to a temporary file of this process's own (mkstemp: two runs of one
@@ -398,6 +446,7 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
     if (fd >= 0) { close(fd); unlink(tmp); }
     tmp[0] = 0;
     ls->destroy(ls);
+    free(assembled_q0); free(assembled_v0);
     return 2;
   }
   fchmod(fd, 0644 & ~current_umask());
@@ -540,5 +589,6 @@ int mb_main(int argc, char **argv, const mb_model *m, const mb_settings *default
   mb_sim_free(&sim);
   ls->destroy(ls);
   free(w.out); free(w.angle_ref); free(w.work); free(settled_q0); free(settled_v0);
+  free(assembled_q0); free(assembled_v0);
   return rc;
 }

@@ -71,6 +71,12 @@ int mb_sim_accel(mb_sim *s, double t, const mb_real *q, const mb_real *v, mb_rea
                  mb_real *lambda);
 /* project (q, v) onto the position and velocity constraints */
 int mb_sim_project(mb_sim *s, double t, mb_real *q, mb_real *v);
+/* After set_params moved joint points or body positions (m->param_geometry):
+ * the assembly at start (reassemble.c), q (nq) from the state as given
+ * (m->q_given) onto the position constraints, v (nv) from m->v_given onto the velocity constraints, with the
+ * compiled rows still independent and the compiled redundant rows still
+ * redundant.  0, or 1 with the cause in why. */
+int mb_reassemble(const mb_model *m, mb_real *q, mb_real *v, char *why, size_t nwhy);
 void mb_sim_free(mb_sim *s);
 
 /* Static equilibrium (equilibrium.c): what mb_sim_equilibrium found */
