@@ -64,7 +64,9 @@ static const help_command commands[] = {
       {"--columns a,b+c,...", "the columns to plot (b+c: in one panel)"},
       {"--animate", "also write the browser animation NAME.html beside the CSV (see mbcc animate)"},
       {"--body B --loads FILE.csv", "instead of the outputs, write the loads on flexible body B at its "
-                                    "nodes (the joints and force elements on them; body axes) over the run (generic path)"},
+                                    "nodes (the joints and force elements on them; body axes) over the run (generic path); "
+                                    "FILE.bdf (.dat, .nas): as Nastran transient loads (DLOAD 1: TLOAD1, TABLED1, "
+                                    "FORCE/MOMENT in the FE model's basic axes)"},
       {"--set NAME=VALUE", "a run-time parameter of the model (repeatable; not recompiled: the simulator "
                            "takes the value; docs/model-format.md, Parameters)"},
       {"--equilibrium", "first move the positions to static equilibrium (forces at zero velocity, "

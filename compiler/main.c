@@ -19,6 +19,7 @@
 #include "fe.h"
 #include "flex.h"
 #include "help.h"
+#include "loads_bdf.h"
 #include "lower.h"
 #include "mb_driver.h"
 #include "order.h"
@@ -627,13 +628,60 @@ static int suggest_modes(const options *o, int ib, const fe_modes *fm) {
 }
 
 /* mbcc run --body B --loads FILE.csv: the interface loads of the flexible body over
- * a run of the model (flexible), for fatigue work: per joint on a node, the
- * force and moment on the body at the node, body axes */
+ * a run of the model (flexible), for fatigue work: per joint or force element on
+ * a node, the force and moment on the body at the node, body axes; FILE.bdf
+ * (.dat, .nas): the same as Nastran transient loads (loads_bdf.c) */
+static int export_loads_bdf(const options *o, int ib, const ir_model *ir, const node_loads *L, out_file *out) {
+  const ir_body *B = &ir->bodies[ib];
+  const ir_flex *fx = B->flex;
+  bdf_load *loads = calloc((size_t)L->nj + 1, sizeof *loads);
+  if (!loads) return 2;
+  for (int k = 0; k < L->nj; k++) {
+    loads[k].grid = fx->node_ids ? fx->node_ids[L->node[k]] : L->node[k];
+    loads[k].name = L->is_force[k] ? ir->forces[L->joint[k]].name : ir->joints[L->joint[k]].name;
+  }
+  /* an imported deck's basic axes are global at t = 0: the body axes turn
+     into them by the body's initial orientation; an inline FE model's
+     nodes are in body axes already */
+  double A0[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  if (fx->fe_path) {
+    const double *e = B->orientation;
+    A0[0] = 2 * (e[0] * e[0] + e[1] * e[1]) - 1; A0[1] = 2 * (e[1] * e[2] - e[0] * e[3]); A0[2] = 2 * (e[1] * e[3] + e[0] * e[2]);
+    A0[3] = 2 * (e[1] * e[2] + e[0] * e[3]); A0[4] = 2 * (e[0] * e[0] + e[2] * e[2]) - 1; A0[5] = 2 * (e[2] * e[3] - e[0] * e[1]);
+    A0[6] = 2 * (e[1] * e[3] - e[0] * e[2]); A0[7] = 2 * (e[2] * e[3] + e[0] * e[1]); A0[8] = 2 * (e[0] * e[0] + e[3] * e[3]) - 1;
+  }
+  char what[1024];
+  snprintf(what, sizeof what, "the loads on the nodes of flexible body '%s' of %s over a run%s%s", o->body, o->model,
+           fx->fe_path ? ", FE model " : " (inline FE model: GRID ids are its node numbers, axes its body axes)",
+           fx->fe_path ? fx->fe_path : "");
+  int n = write_loads_bdf(out->f, what, loads, L->nj, L->nrows, L->t, L->f, A0);
+  free(loads);
+  if (n < 0) {
+    fprintf(stderr, "mbcc: error: cannot write %s\n", o->loads);
+    out_file_abort(out);
+    return 2;
+  }
+  if (out_file_commit(out)) return 2;
+  printf("wrote %s: %d load channel%s (Nastran TLOAD1/TABLED1, DLOAD 1) of %d load%s on the nodes of body '%s' at %d "
+         "times\n", o->loads, n, n == 1 ? "" : "s", L->nj, L->nj > 1 ? "s" : "", o->body, L->nrows);
+  return 0;
+}
+
+static int ends_with(const char *s, const char *tail) {
+  size_t a = strlen(s), b = strlen(tail);
+  return a >= b && !strcmp(s + a - b, tail);
+}
+
 static int export_loads(const options *o, int ib, const ir_model *ir) {
   node_loads L;
   if (run_node_loads(o, ib, 0, &L)) return 2;
   out_file out;
   if (out_file_open(&out, o->loads)) { node_loads_free(&L); return 2; }
+  if (ends_with(o->loads, ".bdf") || ends_with(o->loads, ".dat") || ends_with(o->loads, ".nas")) {
+    int st = export_loads_bdf(o, ib, ir, &L, &out);
+    node_loads_free(&L);
+    return st;
+  }
   static const char *const comp[6] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
   fprintf(out.f, "t");
   for (int k = 0; k < L.nj; k++)
