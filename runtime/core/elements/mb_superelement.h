@@ -36,7 +36,7 @@ static inline mb_real mb_superelement(const mb_marker *m0, const mb_marker *cons
   for (int k = 0; k < n; k++) {
     mb_real f[6];
     for (int i = 0; i < 6; i++) {
-      const mb_real *Ki = K + (size_t)nd * (6 * k + i), *Ci = C + (size_t)nd * (6 * k + i);
+      const mb_real *Ki = K + nd * (6 * k + i), *Ci = C + nd * (6 * k + i); /* nd <= 96: int is enough */
       mb_real s = 0, e = 0;
       for (int j = 0; j < nd; j++) {
         s += Ki[j] * u[j] + Ci[j] * ud[j];
