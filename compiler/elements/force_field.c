@@ -328,7 +328,7 @@ static void lower_superelement(lmodel *L, const ir_force *F, int index, mb_force
 
 /* a superelement with more than two nodes: the wrench on each of nodes
    1..n at its point, each one's reaction on body 0 at the same point */
-static void emit_superelement(FILE *f, const lmodel *L, int k) {
+static int emit_superelement(FILE *f, const lmodel *L, int k) {
   const mb_forcedef *d = &L->force[k];
   int n = (int)L->force_prm[d->padr + MB_SUPER_N], b0 = L->marker[d->m0].body;
   fprintf(f, "    const mb_marker *mk[%d] = {", n);
@@ -342,7 +342,11 @@ static void emit_superelement(FILE *f, const lmodel *L, int k) {
     snprintf(Fj, sizeof Fj, "F + %d", 3 * j);
     snprintf(Tj, sizeof Tj, "T + %d", 3 * j);
     fprintf(f, "    /* node %d */\n", j + 1);
-    if (b >= 0) emit_add_cols(f, L->body[b].vadr, emit_cols(f, L, mk, P, Fj, Tj, "    "));
+    if (b >= 0) {
+      int nc = emit_cols(f, L, mk, P, Fj, Tj, "    ");
+      if (nc < 0) return -1;
+      emit_add_cols(f, L->body[b].vadr, nc);
+    }
     if (b0 >= 0) {
       fprintf(f, "    {\n      mb_real mF[3] = {-F[%d], -F[%d], -F[%d]}, mT[3] = {-T[%d], -T[%d], -T[%d]};\n"
                  "      mb_rigid_cols(&f%d, k%d.P, mF, mT, c); /* reaction at the same point */\n    }\n",
@@ -350,15 +354,13 @@ static void emit_superelement(FILE *f, const lmodel *L, int k) {
       emit_add_cols(f, L->body[b0].vadr, 6);
     }
   }
+  return 0;
 }
 
 /* the wrench on marker 1 at its point; the reaction on body 0 at the same point */
 static int emit_field(FILE *f, const lmodel *L, int k) {
   const mb_forcedef *d = &L->force[k];
-  if (d->kind == MB_FORCE_SUPERELEMENT) {
-    emit_superelement(f, L, k);
-    return;
-  }
+  if (d->kind == MB_FORCE_SUPERELEMENT) return emit_superelement(f, L, k);
   int b0 = L->marker[d->m0].body, b1 = L->marker[d->m1].body;
   fprintf(f, "    mb_real F[3], T[3];\n"
              "    mb_field(&k%d, &k%d, force_prm + %d, F, T, 0);\n",
