@@ -64,7 +64,9 @@ static const help_command commands[] = {
       {"--columns a,b+c,...", "the columns to plot (b+c: in one panel)"},
       {"--animate", "also write the browser animation NAME.html beside the CSV (see mbcc animate)"},
       {"--body B --loads FILE.csv", "instead of the outputs, write the loads on flexible body B at its "
-                                    "joints' nodes (body axes) over the run (generic path)"},
+                                    "nodes (the joints and force elements on them; body axes) over the run (generic path); "
+                                    "FILE.bdf (.dat, .nas): as Nastran transient loads (DLOAD 1: TLOAD1, TABLED1, "
+                                    "FORCE/MOMENT in the FE model's basic axes)"},
       {"--set NAME=VALUE", "a run-time parameter of the model (repeatable; not recompiled: the simulator "
                            "takes the value; docs/model-format.md, Parameters)"},
       {"--equilibrium", "first move the positions to static equilibrium (forces at zero velocity, "
@@ -93,8 +95,8 @@ static const help_command commands[] = {
       {"--scene S", "apply scene S of the model file"},
       {"--shapes FILE.csv", "write the mode shapes at every node"},
       {"--write-modal FILE", "write the modes as a modal file (docs/modal-file.md)"},
-      {"--suggest", "rank the modes by the loads of a rigid pre-run (the body rigid, the reactions "
-                    "of the joints on its nodes) and suggest a mode list"}}},
+      {"--suggest", "rank the modes by the loads of a rigid pre-run (the body rigid, the joints "
+                    "and force elements on its nodes) and suggest a mode list"}}},
     {"plot", "mbcc plot A.csv [B.csv ...] [-o OUT.png] [--columns a,b+c,...] [--gnuplot FILE]",
      "plot results with gnuplot, one panel per column against time",
      "Every column (or those of --columns) gets a panel; a panel shows the column of every CSV file "

@@ -20,6 +20,7 @@
 #include "fe.h"
 #include "flex.h"
 #include "help.h"
+#include "loads_bdf.h"
 #include "lower.h"
 #include "mb_driver.h"
 #include "order.h"
@@ -390,66 +391,118 @@ static int csv_numbers(char *line, double *v, int n) {
 }
 
 /* The loads on a flexible body's nodes over a run: the reactions of the
- * joints on its nodes (not distance joints), on the body, in its axes. */
+ * joints on its nodes (not distance joints) and the wrenches of the force
+ * elements attached to its nodes (point forces and torques, springs,
+ * bushings, fields, beams), on the body, in its axes. */
 typedef struct {
   int nj, nrows;
-  int *joint, *side, *node; /* per load: the joint, the body's side of it, the node */
+  int *joint, *side, *node; /* per load: the joint (or force), the body's side of it, the node */
+  int *is_force;            /* per load: 1 when 'joint' is a force element's index */
   double *t;                /* nrows */
   double *f;                /* nrows x nj x 6: Fx Fy Fz Mx My Mz, body axes */
 } node_loads;
 
 static void node_loads_free(node_loads *L) {
-  free(L->joint); free(L->side); free(L->node); free(L->t); free(L->f);
+  free(L->joint); free(L->side); free(L->node); free(L->is_force); free(L->t); free(L->f);
   memset(L, 0, sizeof *L);
 }
 
+/* a force element's side 0 reaction acts at its marker 1's point (the field
+ * family: bushing, field, beam, superelement), not at its own point */
+static int reaction_at_other_point(const ir_force *F) {
+  return F->kind == FORCE_BUSHING || F->kind == FORCE_FIELD || F->kind == FORCE_BEAM ||
+         F->kind == FORCE_SUPERELEMENT;
+}
+
+static void init_output(ir_output *out, const char *prefix, int k) {
+  out->body = out->joint = out->driver = out->node = out->mode = out->force = out->rel_node = -1;
+  out->chord[0] = out->chord[1] = -1;
+  out->component = -1;
+  out->scale = 1;
+  char name[32];
+  snprintf(name, sizeof name, "%s%d", prefix, k);
+  out->name = strdup(name);
+}
+
 /* Run the model (generic path, its simulation settings and the command's
- * options) with reaction outputs for the joints on body ib's nodes and its
- * orientation; rigid: with the body rigid (coupling: rigid).  0, or 2 after
- * reporting. */
+ * options) with reaction and force outputs for the joints and force
+ * elements on body ib's nodes and its orientation; rigid: with the body
+ * rigid (coupling: rigid).  0, or 2 after reporting. */
 static int run_node_loads(const options *o, int ib, int rigid, node_loads *L) {
   memset(L, 0, sizeof *L);
   mbc_unit u;
   if (mbc_unit_read(&u, o->model, o->scene)) return 2;
   ir_model *ir = u.ir;
   if (rigid) ir->bodies[ib].flex->coupling = COUPLING_RIGID;
-  int nj = 0, rc = 2;
-  L->joint = calloc((size_t)ir->njoints + 1, sizeof(int));
-  L->side = calloc((size_t)ir->njoints + 1, sizeof(int));
-  L->node = calloc((size_t)ir->njoints + 1, sizeof(int));
+  int nj = 0, rc = 2, nmax = ir->njoints + 2 * ir->nforces + 1;
+  L->joint = calloc((size_t)nmax, sizeof(int));
+  L->side = calloc((size_t)nmax, sizeof(int));
+  L->node = calloc((size_t)nmax, sizeof(int));
+  L->is_force = calloc((size_t)nmax, sizeof(int));
+  /* per load: the first of its lever's position outputs (3 columns each:
+     the node, then the element's other point unless on the ground), or -1 */
+  int *rel = calloc((size_t)nmax, sizeof(int));
   char dir[] = "/tmp/mbcc-loads-XXXXXX", csv[64] = "";
   FILE *f = NULL;
   double *v = NULL;
   char *line = NULL;
-  if (!L->joint || !L->side || !L->node) { fprintf(stderr, "mbcc: error: out of memory\n"); goto done; }
+  if (!L->joint || !L->side || !L->node || !L->is_force || !rel) { fprintf(stderr, "mbcc: error: out of memory\n"); goto done; }
   for (int j = 0; j < ir->njoints; j++) {
     const ir_joint *J = &ir->joints[j];
     if (!J->active || J->kind == JOINT_DISTANCE) continue;
     for (int side = 0; side < 2; side++)
       if (J->body[side] == ib && J->node[side] >= 0) {
-        L->joint[nj] = j; L->side[nj] = side; L->node[nj++] = J->node[side];
+        L->joint[nj] = j; L->side[nj] = side; L->node[nj] = J->node[side];
+        rel[nj++] = -1;
         break;
+      }
+  }
+  int nrel = 0;
+  for (int e = 0; e < ir->nforces; e++) {
+    const ir_force *F = &ir->forces[e];
+    if (!F->active || F->kind == FORCE_TYRE) continue;
+    int one = F->kind == FORCE_POINT_FORCE || F->kind == FORCE_POINT_TORQUE;
+    for (int side = 0; side < (one ? 1 : 2); side++)
+      if (F->body[side] == ib && F->node[side] >= 0) {
+        L->joint[nj] = e; L->side[nj] = one ? 1 : side; L->node[nj] = F->node[side]; L->is_force[nj] = 1;
+        rel[nj] = -1;
+        if (!one && side == 0 && reaction_at_other_point(F)) {
+          rel[nj] = nrel;
+          nrel += F->body[1] > 0 ? 2 : 1;
+        }
+        nj++;
       }
   }
   L->nj = nj;
   if (nj == 0) {
-    fprintf(stderr, "%s: error: no joint on a node of body '%s' (whose loads are asked for)\n", o->model, o->body);
+    fprintf(stderr, "%s: error: no joint or force element on a node of body '%s' (whose loads are asked for)\n",
+            o->model, o->body);
     goto done;
   }
   free_outputs(ir->outputs, ir->noutputs);
-  ir->noutputs = nj + 1;
-  ir->outputs = calloc((size_t)nj + 1, sizeof *ir->outputs);
+  ir->noutputs = nj + 1 + nrel;
+  ir->outputs = calloc((size_t)ir->noutputs, sizeof *ir->outputs);
   for (int k = 0; k <= nj && ir->outputs; k++) {
     ir_output *out = &ir->outputs[k];
-    out->body = out->joint = out->driver = out->node = out->mode = out->force = out->rel_node = -1;
-    out->chord[0] = out->chord[1] = -1;
-    out->component = -1;
-    out->scale = 1;
-    char name[32];
-    snprintf(name, sizeof name, k < nj ? "r%d" : "q", k);
-    out->name = strdup(name);
-    if (k < nj) { out->kind = OUT_REACTION; out->joint = L->joint[k]; }
+    init_output(out, k < nj ? "r" : "q", k);
+    if (k < nj && L->is_force[k]) { out->kind = OUT_FORCE; out->force = L->joint[k]; }
+    else if (k < nj) { out->kind = OUT_REACTION; out->joint = L->joint[k]; }
     else { out->kind = OUT_ORIENTATION; out->body = ib; }
+  }
+  /* the lever of a side-0 reaction: the positions of the node and of
+     marker 1's point (global) */
+  for (int k = 0; k < nj && ir->outputs; k++) {
+    if (rel[k] < 0) continue;
+    const ir_force *F = &ir->forces[L->joint[k]];
+    for (int s = 0; s < (F->body[1] > 0 ? 2 : 1); s++) {
+      ir_output *out = &ir->outputs[nj + 1 + rel[k] + s];
+      init_output(out, s ? "p" : "n", k);
+      out->kind = OUT_POSITION;
+      out->body = F->body[s];
+      out->node = F->node[s];
+      out->has_point = true;
+      memcpy(out->point, F->point[s], sizeof out->point);
+    }
   }
   u.overridden = 1;
   if (!ir->outputs || mbc_unit_finish(&u, 0) || !mkdtemp(dir)) goto done;
@@ -468,7 +521,7 @@ static int run_node_loads(const options *o, int ib, int rigid, node_loads *L) {
     args[na] = NULL;
     if (mb_main(na, args, &u.lowered->m, &set, ir->sim.solver == SOLVER_DENSE ? "dense" : "klu")) goto done;
   }
-  int ncol = 1 + 6 * nj + 4, cap = 0;
+  int ncol = 1 + 6 * nj + 4 + 3 * nrel, cap = 0;
   f = fopen(csv, "r");
   v = calloc((size_t)ncol, sizeof(double));
   line = malloc(1 << 16);
@@ -492,9 +545,20 @@ static int run_node_loads(const options *o, int ib, int rigid, node_loads *L) {
     A[6] = 2 * (e[1] * e[3] - e[0] * e[2]); A[7] = 2 * (e[2] * e[3] + e[0] * e[1]); A[8] = 2 * (e[0] * e[0] + e[3] * e[3]) - 1;
     L->t[L->nrows] = v[0];
     for (int k = 0; k < nj; k++) {
-      const double *r = v + 1 + 6 * k;
-      /* the reaction acts on the joint's body 1: on this body with its side's sign */
+      double r[6];
+      memcpy(r, v + 1 + 6 * k, sizeof r);
+      /* a joint's reaction and a force element's wrench act on its body 1: on
+         this body with its side's sign; a field's side-0 reaction acts at
+         marker 1's point, d from the node: its moment there adds d x (-F) */
       double sign = L->side[k] == 1 ? 1 : -1;
+      if (rel[k] >= 0) {
+        const ir_force *F = &ir->forces[L->joint[k]];
+        const double *p0 = v + 1 + 6 * nj + 4 + 3 * rel[k], *p1 = F->body[1] > 0 ? p0 + 3 : F->point[1];
+        double d[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+        r[3] += d[1] * r[2] - d[2] * r[1];
+        r[4] += d[2] * r[0] - d[0] * r[2];
+        r[5] += d[0] * r[1] - d[1] * r[0];
+      }
       double *out = L->f + ((size_t)L->nrows * nj + k) * 6;
       for (int c = 0; c < 3; c++) {
         out[c] = out[3 + c] = 0;
@@ -506,7 +570,7 @@ static int run_node_loads(const options *o, int ib, int rigid, node_loads *L) {
   rc = 0;
 done:
   if (f) fclose(f);
-  free(v); free(line);
+  free(v); free(line); free(rel);
   if (csv[0]) unlink(csv);
   if (strcmp(dir, "/tmp/mbcc-loads-XXXXXX")) rmdir(dir);
   mbc_unit_free(&u);
@@ -524,7 +588,7 @@ static int suggest_modes(const options *o, int ib, const fe_modes *fm) {
   printf("rigid pre-run (body '%s' rigid): ", o->body);
   fflush(stdout);
   if (run_node_loads(o, ib, 1, &L)) { printf("failed\n"); return 2; }
-  printf("%d joint%s on its nodes, %d output times\n", L.nj, L.nj > 1 ? "s" : "", L.nrows);
+  printf("%d load%s (joints and force elements) on its nodes, %d output times\n", L.nj, L.nj > 1 ? "s" : "", L.nrows);
   int nm = fm->nmodes, nn6 = 6 * fm->nnodes;
   double *amp = calloc((size_t)nm + 1, sizeof(double));
   int *order = calloc((size_t)nm + 1, sizeof(int)), *keep = calloc((size_t)nm + 1, sizeof(int));
@@ -570,20 +634,68 @@ static int suggest_modes(const options *o, int ib, const fe_modes *fm) {
 }
 
 /* mbcc run --body B --loads FILE.csv: the interface loads of the flexible body over
- * a run of the model (flexible), for fatigue work: per joint on a node, the
- * force and moment on the body at the node, body axes */
+ * a run of the model (flexible), for fatigue work: per joint or force element on
+ * a node, the force and moment on the body at the node, body axes; FILE.bdf
+ * (.dat, .nas): the same as Nastran transient loads (loads_bdf.c) */
+static int export_loads_bdf(const options *o, int ib, const ir_model *ir, const node_loads *L, out_file *out) {
+  const ir_body *B = &ir->bodies[ib];
+  const ir_flex *fx = B->flex;
+  bdf_load *loads = calloc((size_t)L->nj + 1, sizeof *loads);
+  if (!loads) return 2;
+  for (int k = 0; k < L->nj; k++) {
+    loads[k].grid = fx->node_ids ? fx->node_ids[L->node[k]] : L->node[k];
+    loads[k].name = L->is_force[k] ? ir->forces[L->joint[k]].name : ir->joints[L->joint[k]].name;
+  }
+  /* an imported deck's basic axes are global at t = 0: the body axes turn
+     into them by the body's initial orientation; an inline FE model's
+     nodes are in body axes already */
+  double A0[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  if (fx->fe_path) {
+    const double *e = B->orientation;
+    A0[0] = 2 * (e[0] * e[0] + e[1] * e[1]) - 1; A0[1] = 2 * (e[1] * e[2] - e[0] * e[3]); A0[2] = 2 * (e[1] * e[3] + e[0] * e[2]);
+    A0[3] = 2 * (e[1] * e[2] + e[0] * e[3]); A0[4] = 2 * (e[0] * e[0] + e[2] * e[2]) - 1; A0[5] = 2 * (e[2] * e[3] - e[0] * e[1]);
+    A0[6] = 2 * (e[1] * e[3] - e[0] * e[2]); A0[7] = 2 * (e[2] * e[3] + e[0] * e[1]); A0[8] = 2 * (e[0] * e[0] + e[3] * e[3]) - 1;
+  }
+  char what[1024];
+  snprintf(what, sizeof what, "the loads on the nodes of flexible body '%s' of %s over a run%s%s", o->body, o->model,
+           fx->fe_path ? ", FE model " : " (inline FE model: GRID ids are its node numbers, axes its body axes)",
+           fx->fe_path ? fx->fe_path : "");
+  int n = write_loads_bdf(out->f, what, loads, L->nj, L->nrows, L->t, L->f, A0);
+  free(loads);
+  if (n < 0) {
+    fprintf(stderr, "mbcc: error: cannot write %s\n", o->loads);
+    out_file_abort(out);
+    return 2;
+  }
+  if (out_file_commit(out)) return 2;
+  printf("wrote %s: %d load channel%s (Nastran TLOAD1/TABLED1, DLOAD 1) of %d load%s on the nodes of body '%s' at %d "
+         "times\n", o->loads, n, n == 1 ? "" : "s", L->nj, L->nj > 1 ? "s" : "", o->body, L->nrows);
+  return 0;
+}
+
+static int ends_with(const char *s, const char *tail) {
+  size_t a = strlen(s), b = strlen(tail);
+  return a >= b && !strcmp(s + a - b, tail);
+}
+
 static int export_loads(const options *o, int ib, const ir_model *ir) {
   node_loads L;
   if (run_node_loads(o, ib, 0, &L)) return 2;
   out_file out;
   if (out_file_open(&out, o->loads)) { node_loads_free(&L); return 2; }
+  if (ends_with(o->loads, ".bdf") || ends_with(o->loads, ".dat") || ends_with(o->loads, ".nas")) {
+    int st = export_loads_bdf(o, ib, ir, &L, &out);
+    node_loads_free(&L);
+    return st;
+  }
   static const char *const comp[6] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
   fprintf(out.f, "t");
   for (int k = 0; k < L.nj; k++)
     for (int c = 0; c < 6; c++) {
       const ir_flex *fx = ir->bodies[ib].flex; /* nodes by the FE file's ids when it has them */
       long id = fx->node_ids ? fx->node_ids[L.node[k]] : L.node[k];
-      fprintf(out.f, ",%s@%ld.%s", ir->joints[L.joint[k]].name, id, comp[c]);
+      fprintf(out.f, ",%s@%ld.%s", L.is_force[k] ? ir->forces[L.joint[k]].name : ir->joints[L.joint[k]].name, id,
+              comp[c]);
     }
   fputc('\n', out.f);
   for (int i = 0; i < L.nrows; i++) {
@@ -592,8 +704,8 @@ static int export_loads(const options *o, int ib, const ir_model *ir) {
     fputc('\n', out.f);
   }
   int st = out_file_commit(&out) ? 2 : 0;
-  if (!st) printf("wrote %s: the loads of %d joint%s on body '%s' (N, N m, body axes) at %d times\n", o->loads, L.nj,
-                  L.nj > 1 ? "s" : "", o->body, L.nrows);
+  if (!st) printf("wrote %s: %d load%s (joints and force elements) on the nodes of body '%s' (N, N m, body axes) at "
+                  "%d times\n", o->loads, L.nj, L.nj > 1 ? "s" : "", o->body, L.nrows);
   node_loads_free(&L);
   return st;
 }

@@ -4,7 +4,7 @@
  * the simply supported Timoshenko closed form, Craig-Bampton against the full
  * FE model, mass normalization, lumped masses, axial modes, invariance under a
  * rotation of the model, the modal data file round trip and its diagnostics,
- * static condensation (superelement), residual attachment modes (static correction, free-interface + residual
+ * static condensation (superelement, two and more nodes), residual attachment modes (static correction, free-interface + residual
  * against the full FE model, inertia relief on a free-free body), and the
  * errors for bad FE data. */
 #include "../compiler/flex/fe.c"
@@ -959,6 +959,61 @@ static void test_residual_modes(void **state) {
 
 /* --- superelement: static condensation ---------------------------------------------- */
 
+/* fe_condense_nodes with three loaded nodes (listed out of order) against the
+ * Schur complement K_BB - K_Bi K_ii^-1 K_iB of the assembled K, node 0
+ * clamped, B the loaded nodes' 18 DOFs in their order */
+static void test_condense_nodes(void **state) {
+  (void)state;
+  ir_flex fx;
+  frame3d(&fx, 3, MASS_CONSISTENT, BEAM_TIMOSHENKO);
+  int nn = fx.nnodes, n = 6 * nn;
+  const int loaded[3] = {nn - 1, 3, 6};
+  int nb = 18, ni = n - 6 - nb;
+  double *Kc = calloc((size_t)nb * nb, sizeof(double));
+  char err[512];
+  ir_loc where;
+  assert_int_equal(fe_condense_nodes(&fx, 0, loaded, 3, Kc, err, sizeof err, &where), 0);
+  fe_system sys;
+  assert_int_equal(fe_assemble(&fx, &sys, err, sizeof err), 0);
+  int *bdof = malloc((size_t)nb * sizeof(int)), *idof = malloc((size_t)ni * sizeof(int)), m = 0;
+  for (int a = 0; a < 3; a++)
+    for (int d = 0; d < 6; d++) bdof[6 * a + d] = 6 * loaded[a] + d;
+  for (int k = 1; k < nn; k++)
+    if (k != loaded[0] && k != loaded[1] && k != loaded[2])
+      for (int d = 0; d < 6; d++) idof[m++] = 6 * k + d;
+  assert_int_equal(m, ni);
+  double *Kii = malloc((size_t)ni * ni * sizeof(double)), *KiB = malloc((size_t)ni * nb * sizeof(double));
+  for (int j = 0; j < ni; j++)
+    for (int i = 0; i < ni; i++) Kii[(size_t)j * ni + i] = sys.K[(size_t)idof[j] * n + idof[i]];
+  for (int j = 0; j < nb; j++)
+    for (int i = 0; i < ni; i++) KiB[(size_t)j * ni + i] = sys.K[(size_t)bdof[j] * n + idof[i]];
+  double *X = malloc((size_t)ni * nb * sizeof(double));
+  memcpy(X, KiB, (size_t)ni * nb * sizeof(double));
+  int info = 0;
+  dpotrf_("U", &ni, Kii, &ni, &info);
+  assert_int_equal(info, 0);
+  dpotrs_("U", &ni, &nb, Kii, &ni, X, &ni, &info);
+  assert_int_equal(info, 0);
+  double worst = 0, big = 0;
+  for (int a = 0; a < nb; a++)
+    for (int b = 0; b < nb; b++) {
+      double v = sys.K[(size_t)bdof[b] * n + bdof[a]];
+      for (int i = 0; i < ni; i++) v -= KiB[(size_t)a * ni + i] * X[(size_t)b * ni + i];
+      worst = fmax(worst, fabs(v - Kc[nb * a + b]));
+      big = fmax(big, fabs(v));
+    }
+  printf("superelement, three loaded nodes: condensed K against the Schur complement: %.2e relative\n",
+         worst / big);
+  assert_true(worst <= 1e-9 * big);
+  /* the same node twice, or the clamped node loaded: errors */
+  const int twice[3] = {3, 6, 3}, clamped[2] = {3, 0};
+  assert_int_not_equal(fe_condense_nodes(&fx, 0, twice, 3, Kc, err, sizeof err, &where), 0);
+  assert_int_not_equal(fe_condense_nodes(&fx, 0, clamped, 2, Kc, err, sizeof err, &where), 0);
+  free(Kii); free(KiB); free(X); free(bdof); free(idof); free(Kc);
+  fe_system_free(&sys);
+  free_flex(&fx);
+}
+
 /* fe_condense against the Schur complement K_BB - K_Bi K_ii^-1 K_iB of the
  * assembled K (node 0 clamped, B the last node), on the 3D frame; and a
  * straight cantilever's condensed K against the closed-form beam stiffness */
@@ -1027,6 +1082,7 @@ int main(void) {
       cmocka_unit_test(test_craig_bampton),
       cmocka_unit_test(test_residual_modes),
       cmocka_unit_test(test_condense),
+      cmocka_unit_test(test_condense_nodes),
       cmocka_unit_test(test_normalization_and_masses),
       cmocka_unit_test(test_modal_file),
       cmocka_unit_test(test_errors),

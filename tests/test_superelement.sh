@@ -8,7 +8,10 @@
 #     and the axial part P sin(a) L/(EA) projected on y (the condensed K is
 #     in global axes);
 #  3. generated and generic paths agree;
-#  4. bad input: an interface node that is not a GRID, one node only.
+#  4. three interface nodes (a beam held at one end, two bodies on it): the
+#     rest deflections against beam theory, generated = generic;
+#  5. bad input: an interface node that is not a GRID, one node only, fewer
+#     bodies than nodes, interface nodes tied by an RBE2 (singular).
 set -u
 cd "$(dirname "$0")/.."
 . tests/shell_setup.sh
@@ -63,7 +66,66 @@ model turned.bdf "$(awk -v c=$c 'BEGIN { printf "%.17g", 0.5 * c }')" 0.25 "[1, 
 check turned.csv "$(awk -v P=$P -v L=$L -v E=$E -v I=$I -v A=$A -v c=$c -v s=$s \
   'BEGIN { printf "%.17g", 0.25 - P * c * L^3 / (3 * E * I) * c - P * s * L / (E * A) * s }')" "turned 30 degrees" 0.25
 
+# --- three interface nodes: the same cantilever, 1 m of 8 CBARs with I ten
+# times larger, held at GRID 1 by the ground, carrying a 2 kg body at GRID 5
+# (x = 0.5) and a 1 kg body at GRID 9 (x = 1): the rest deflections against
+# beam theory's superposition of two point loads (P at a: y(x) = P x^2
+# (3a - x) / 6EI for x <= a, P a^2 (3x - a) / 6EI beyond), which the
+# coupling between the two loaded nodes (the condensed K's off-diagonal
+# blocks) decides
+awk 'BEGIN {
+  print "BEGIN BULK"
+  for (k = 1; k <= 9; k++) printf "GRID,%d,,%.17g,0.,0.\n", k, (k - 1) * 0.125
+  for (e = 1; e <= 8; e++) printf "CBAR,%d,1,%d,%d,0.,0.,1.\n", e, e, e + 1
+  print "PBAR,1,1,1.e-4,8.3333333333e-9,8.3333333333e-9,1.406e-8"
+  print "MAT1,1,2.1e11,,.3,7850."
+  print "ENDDATA" }' > three.bdf
+three() { # interface bodies file
+  cat > "$3" <<YAML
+name: superelement_three_nodes
+gravity: [0, -9.81, 0]
+bodies:
+  mid: {type: rigid, mass: 2.0, inertia: [1.0e-3, 1.0e-3, 1.0e-3], position: [0.5, 0, 0]}
+  tip: {type: rigid, mass: 1.0, inertia: [1.0e-3, 1.0e-3, 1.0e-3], position: [1.0, 0, 0]}
+forces:
+  bracket:
+    type: superelement
+    bodies: $2
+    fe_file: three.bdf
+    interface: $1
+    damping_ratio: 0.002
+outputs:
+  - {name: mid_y, type: position, body: mid, component: y}
+  - {name: tip_y, type: position, body: tip, component: y}
+simulation: {end_time: 4.0, output_step: 0.01}
+YAML
+}
+three "[1, 5, 9]" "[ground, mid, tip]" three.yaml
+"$MBCC" run three.yaml -o three.csv --plot none --quiet > run4.log 2>&1 || { cat run4.log; err "run three nodes"; }
+"$MBCC" run three.yaml --path generic -o three_generic.csv --plot none --quiet > run5.log 2>&1 ||
+  { cat run5.log; err "run three nodes, generic"; }
+awk -F, 'END { E = 2.1e11; I = 8.3333333333e-9; g = 9.81; P1 = 2 * g; P2 = g; a = 0.5; L = 1
+    want[2] = -(P1 * a^3 / (3 * E * I) + P2 * a^2 * (3 * L - a) / (6 * E * I))
+    want[3] = -(P1 * a^2 * (3 * L - a) / (6 * E * I) + P2 * L^3 / (3 * E * I))
+    for (c = 2; c <= 3; c++) { d = ($c - want[c]) / want[c]; if (d < 0) d = -d
+      printf "three nodes: %s y %.12g, beam theory %.12g (relative error %.2e)\n", c == 2 ? "mid" : "tip", $c, want[c], d
+      if (!(d < 1e-6)) bad = 1 }
+    exit bad }' three.csv || err "three nodes: the rest deflections differ from beam theory"
+cmp -s <(tail -1 three.csv | cut -c1-14) <(tail -1 three_generic.csv | cut -c1-14) ||
+  err "three nodes: generated and generic paths differ: $(tail -1 three.csv) vs $(tail -1 three_generic.csv)"
+
 # bad input
+three "[1, 5, 9]" "[ground, mid]" bad3.yaml
+"$MBCC" check bad3.yaml > bad3.log 2>&1; rc=$?
+[ $rc -eq 2 ] && grep -q "bad3.yaml:[0-9]*:[0-9]*: error: 'bodies': a superelement with 3 interface nodes takes a list of 3 bodies" bad3.log ||
+  { cat bad3.log; err "three nodes, two bodies: exit $rc"; }
+# GRIDs 4 and 6 tied to GRID 5 by one RBE2: as interface nodes they cannot move apart
+awk '/^ENDDATA/ { print "RBE2,20,5,123456,4,6" } { print }' three.bdf > tied.bdf
+three "[1, 4, 6]" "[ground, mid, tip]" bad4.yaml
+sed -i 's/fe_file: three.bdf/fe_file: tied.bdf/' bad4.yaml
+"$MBCC" check bad4.yaml > bad4.log 2>&1; rc=$?
+[ $rc -eq 2 ] && grep -q "bad4.yaml:[0-9]*:[0-9]*: error: superelement 'bracket': .*flexibility is singular" bad4.log ||
+  { cat bad4.log; err "interface nodes tied by an RBE2: exit $rc"; }
 model straight.bdf 0.5 0 "[1, 12]" bad1.yaml
 "$MBCC" check bad1.yaml > bad1.log 2>&1; rc=$?
 [ $rc -eq 2 ] && grep -q "bad1.yaml:[0-9]*:[0-9]*: error: 'interface': node 12 is not a node id" bad1.log ||

@@ -344,7 +344,7 @@ static void emit_force_tables(emit_ctx *cx) {
     fprintf(f, "  /* force '%s' (", F->name);
     loc_comment(f, L, F->loc);
     fprintf(f, ") */\n  {.kind = %s, .m0 = %d, .m1 = %d, .padr = %d, .pnum = %d",
-            force_element(F->kind)->runtime_kind_name,
+            d->kind == MB_FORCE_SUPERELEMENT ? "MB_FORCE_SUPERELEMENT" : force_element(F->kind)->runtime_kind_name,
             d->m0, d->m1, d->padr, d->pnum);
     if (d->lnum) fprintf(f, ", .ladr = %d, .lnum = %d", d->ladr, d->lnum);
     if (d->snum) fprintf(f, ", .sadr = %d, .snum = %d", d->sadr, d->snum);
@@ -792,6 +792,8 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
   for (int i = 0; i < m->nforce; i++) {
     use[L->force[i].m0] = 2;
     if (L->force[i].m1 >= 0) use[L->force[i].m1] = 2;
+    if (L->force[i].kind == MB_FORCE_SUPERELEMENT) /* its nodes 2.. follow marker m1 */
+      for (int j = 1; j < (int)L->force_prm[L->force[i].padr + MB_SUPER_N]; j++) use[L->force[i].m1 + j] = 2;
   }
   for (int r = 0; r < m->nrow; r++) {
     char u = emit_row_is_special(&L->row[r]) ? 1 : 2;

@@ -23,7 +23,7 @@
 static const char *const core_files[] = {
     "mb_types.h", "mb_math.h", "mb_kernels.h", "mb_flex.h", "mb_model.h", "model_generic.c", "mb_step.h",
     "mb_step.c", "elements/mb_field.h", "elements/mb_force_point.h", "elements/mb_spring.h",
-    "elements/mb_tyre.h"};
+    "elements/mb_tyre.h", "elements/mb_superelement.h"};
 /* the package's folders (core_files and template_files name files in them) */
 static const char *const subdirs[] = {"board", "elements"};
 /* templates/embedded/<name>, written as <name> with @MODEL@ / @UMODEL@ filled */

@@ -164,30 +164,82 @@ static void parse_beam_force(mapping *m, ir_force *f) {
   memcpy(f->axes + 6, z, sizeof z);
 }
 
+/* 'bodies' of a superelement with more than two nodes: n names, one per
+ * interface node (body 0 holds node 0) */
+static bool get_super_bodies(mapping *m, ir_force *f, int n) {
+  reader *r = m->r;
+  yaml_node_t *list = map_get(m, "bodies");
+  if (list == NULL || list->type != YAML_SEQUENCE_NODE || seq_length(list) != n) {
+    error_at(r, list ? loc_of(list) : m->loc, "'bodies': a superelement with %d interface nodes takes a list "
+             "of %d bodies, one per node (got %s)", n, n, list ? show_node(r, list) : "none");
+    return false;
+  }
+  f->super_body = calloc((size_t)n, sizeof *f->super_body);
+  if (!f->super_body) return false;
+  bool ok = true;
+  for (int k = 0; k < n; k++) {
+    yaml_node_t *item = seq_item(r, list, k);
+    f->super_body[k] = resolve_name(r, item, NAME_BODY, "bodies");
+    ok = ok && f->super_body[k] >= 0;
+    if (k < 2) f->body_loc[k] = loc_of(item);
+  }
+  if (!ok) return false;
+  f->body[0] = f->super_body[0];
+  f->body[1] = f->super_body[1];
+  return true;
+}
+
 /* superelement: a massless FE model (fe_file) statically condensed to its
- * two 'interface' nodes, clamped to body 0 at the first and loaded by body 1
- * at the second (seed 001 section 2.2.3); the FE model's coordinates are
- * global at t = 0, damping = damping_ratio * stiffness */
+ * 'interface' nodes (seed 001 section 2.2.3), node k attached to body k of
+ * 'bodies'.  The condensed stiffness is that of nodes 1.. with node 0 held
+ * (the free-free one is singular: rigid-body motion), and the element acts
+ * on the motion of each node relative to node 0.  With two nodes it is a
+ * field (MB_FORCE_FIELD), with more an MB_FORCE_SUPERELEMENT.  The FE
+ * model's coordinates are global at t = 0, damping = damping_ratio *
+ * stiffness */
 static void parse_superelement(mapping *m, ir_force *f) {
   reader *r = m->r;
-  get_body_pair(m, f->body, f->body_loc);
+  yaml_node_t *bodies = map_get(m, "bodies");
+  bool pair = bodies == NULL || bodies->type != YAML_SEQUENCE_NODE || seq_length(bodies) <= 2;
+  if (pair) get_body_pair(m, f->body, f->body_loc);
   get_nonnegative(m, "damping_ratio", false, &f->damping_ratio);
   ir_flex *fx = calloc(1, sizeof *fx);
   if (!fx) return;
-  int nodes[2];
-  if (read_superelement_fe(m, f->name, fx, nodes)) {
+  int *nodes = NULL, count = 0;
+  bool ok = read_superelement_fe(m, f->name, fx, &nodes, &count);
+  if (ok && (count > 2 || !pair)) { /* a list of bodies, one per node */
+    if (!pair || (bodies && bodies->type == YAML_SEQUENCE_NODE)) ok = get_super_bodies(m, f, count);
+    else ok = false; /* no list: get_body_pair said so */
+  }
+  if (ok) {
     char err[1024];
     ir_loc where;
-    if (fe_condense(fx, nodes[0], nodes[1], f->K, err, sizeof err, &where)) {
+    int nl = 6 * (count - 1);
+    double *K = count == 2 ? f->K : calloc((size_t)nl * (size_t)nl, sizeof *K);
+    if (K && fe_condense_nodes(fx, nodes[0], nodes + 1, count - 1, K, err, sizeof err, &where)) {
       error_at(r, where.line > 0 && !fx->fe_path && !fx->fe_source ? where : m->loc, "superelement '%s': %s",
                f->name, err);
-    } else {
+    } else if (K) {
       for (int i = 0; i < 2; i++) memcpy(f->point[i], fx->nodes + 3 * nodes[i], sizeof f->point[i]);
-      for (int i = 0; i < 36; i++) f->C[i] = f->damping_ratio * f->K[i];
       static const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
       memcpy(f->axes, identity, sizeof identity);
+      if (count == 2) {
+        for (int i = 0; i < 36; i++) f->C[i] = f->damping_ratio * f->K[i];
+      } else {
+        f->nsuper = count;
+        f->super_K = K;
+        K = NULL;
+        f->super_C = calloc((size_t)nl * (size_t)nl, sizeof *f->super_C);
+        f->super_point = calloc(3 * (size_t)count, sizeof *f->super_point);
+        if (f->super_C && f->super_point) {
+          for (int i = 0; i < nl * nl; i++) f->super_C[i] = f->damping_ratio * f->super_K[i];
+          for (int k = 0; k < count; k++) memcpy(f->super_point + 3 * k, fx->nodes + 3 * nodes[k], 3 * sizeof(double));
+        }
+      }
     }
+    if (K != f->K) free(K);
   }
+  free(nodes);
   free_flex(fx);
 }
 
@@ -244,18 +296,71 @@ static void lower_beam(lmodel *L, const ir_force *F, int index, mb_forcedef *d) 
 }
 
 /* superelement: the condensed K in global axes (at t = 0), d0 the offset of
-   the loaded node from the clamped one */
+   the loaded node(s) from node 0 */
 static void lower_superelement(lmodel *L, const ir_force *F, int index, mb_forcedef *d) {
   (void)index;
+  if (F->nsuper > 2) {
+    static const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    int n = F->nsuper - 1, nl = 6 * n;
+    d->kind = MB_FORCE_SUPERELEMENT;
+    d->m0 = lower_force_marker(L, F, 0, identity);
+    for (int k = 0; k < n; k++) { /* markers m1 .. m1 + n - 1, in a row */
+      ir_force node = *F;
+      node.body[1] = F->super_body[k + 1];
+      node.node[1] = -1;
+      memcpy(node.point[1], F->super_point + 3 * (k + 1), sizeof node.point[1]);
+      int mk = lower_force_marker(L, &node, 1, identity);
+      if (k == 0) d->m1 = mk;
+    }
+    double *prm = lower_force_prm(L, d, mb_superelement_nprm(n));
+    prm[MB_SUPER_N] = n;
+    for (int k = 0; k < n; k++)
+      for (int i = 0; i < 3; i++) prm[MB_SUPER_D0 + 3 * k + i] = F->super_point[3 * (k + 1) + i] - F->super_point[i];
+    memcpy(prm + MB_SUPER_D0 + 3 * n, F->super_K, (size_t)nl * nl * sizeof *prm);
+    memcpy(prm + MB_SUPER_D0 + 3 * n + nl * nl, F->super_C, (size_t)nl * nl * sizeof *prm);
+    return;
+  }
   double *prm = lower_field_common(L, F, d);
   for (int i = 0; i < 3; i++) prm[MB_FIELD_D0 + i] = F->point[1][i] - F->point[0][i];
   memcpy(prm + MB_FIELD_K, F->K, 36 * sizeof *prm);
   memcpy(prm + MB_FIELD_C, F->C, 36 * sizeof *prm);
 }
 
+/* a superelement with more than two nodes: the wrench on each of nodes
+   1..n at its point, each one's reaction on body 0 at the same point */
+static int emit_superelement(FILE *f, const lmodel *L, int k) {
+  const mb_forcedef *d = &L->force[k];
+  int n = (int)L->force_prm[d->padr + MB_SUPER_N], b0 = L->marker[d->m0].body;
+  fprintf(f, "    const mb_marker *mk[%d] = {", n);
+  for (int j = 0; j < n; j++) fprintf(f, "%s&k%d", j ? ", " : "", d->m1 + j);
+  fprintf(f, "};\n    mb_real F[%d], T[%d];\n    mb_superelement(&k%d, mk, force_prm + %d, F, T);\n", 3 * n, 3 * n,
+          d->m0, d->padr);
+  for (int j = 0; j < n; j++) {
+    int mk = d->m1 + j, b = L->marker[mk].body;
+    char P[32], Fj[16], Tj[16];
+    snprintf(P, sizeof P, "k%d.P", mk);
+    snprintf(Fj, sizeof Fj, "F + %d", 3 * j);
+    snprintf(Tj, sizeof Tj, "T + %d", 3 * j);
+    fprintf(f, "    /* node %d */\n", j + 1);
+    if (b >= 0) {
+      int nc = emit_cols(f, L, mk, P, Fj, Tj, "    ");
+      if (nc < 0) return -1;
+      emit_add_cols(f, L->body[b].vadr, nc);
+    }
+    if (b0 >= 0) {
+      fprintf(f, "    {\n      mb_real mF[3] = {-F[%d], -F[%d], -F[%d]}, mT[3] = {-T[%d], -T[%d], -T[%d]};\n"
+                 "      mb_rigid_cols(&f%d, k%d.P, mF, mT, c); /* reaction at the same point */\n    }\n",
+              3 * j, 3 * j + 1, 3 * j + 2, 3 * j, 3 * j + 1, 3 * j + 2, b0, mk);
+      emit_add_cols(f, L->body[b0].vadr, 6);
+    }
+  }
+  return 0;
+}
+
 /* the wrench on marker 1 at its point; the reaction on body 0 at the same point */
 static int emit_field(FILE *f, const lmodel *L, int k) {
   const mb_forcedef *d = &L->force[k];
+  if (d->kind == MB_FORCE_SUPERELEMENT) return emit_superelement(f, L, k);
   int b0 = L->marker[d->m0].body, b1 = L->marker[d->m1].body;
   fprintf(f, "    mb_real F[3], T[3];\n"
              "    mb_field(&k%d, &k%d, force_prm + %d, F, T, 0);\n",

@@ -1630,11 +1630,24 @@ done:
 
 int fe_condense(const ir_flex *fx, int clamped, int loaded, double K6[36], char *err, size_t nerr,
                 ir_loc *where) {
+  return fe_condense_nodes(fx, clamped, &loaded, 1, K6, err, nerr, where);
+}
+
+int fe_condense_nodes(const ir_flex *fx, int clamped, const int *loaded, int nloaded, double *Kc, char *err,
+                      size_t nerr, ir_loc *where) {
   fe_ctx cc = {err, nerr, where}, *c = &cc;
   if (where) *where = no_loc;
-  int nnodes = fx->nnodes, ndof = 6 * nnodes, rc = -1;
-  if (clamped < 0 || clamped >= nnodes || loaded < 0 || loaded >= nnodes || clamped == loaded)
-    return fail_at(c, fx->loc, "a superelement needs two different nodes of its FE model");
+  int nnodes = fx->nnodes, ndof = 6 * nnodes, rc = -1, nl = 6 * nloaded;
+  if (clamped < 0 || clamped >= nnodes || nloaded < 1)
+    return fail_at(c, fx->loc, "a superelement needs at least two different nodes of its FE model");
+  for (int a = 0; a < nloaded; a++) {
+    if (loaded[a] < 0 || loaded[a] >= nnodes || loaded[a] == clamped)
+      return fail_at(c, fx->loc, "a superelement needs %s different nodes of its FE model",
+                     nloaded == 1 ? "two" : "its interface nodes to be");
+    for (int b = 0; b < a; b++)
+      if (loaded[a] == loaded[b])
+        return fail_at(c, fx->loc, "superelement: interface node %ld is listed twice", node_name(fx, loaded[a]));
+  }
   ir_flex held = *fx; /* the clamped node as the only reference, no interface */
   held.reference = &clamped;
   held.nreference = 1;
@@ -1644,7 +1657,7 @@ int fe_condense(const ir_flex *fx, int clamped, int loaded, double K6[36], char 
   held.nresidual = 0;
   char *state = xcalloc((size_t)ndof, 1), *is_int = xcalloc((size_t)nnodes, 1), *is_ref = xcalloc((size_t)nnodes, 1);
   int *perm = xcalloc((size_t)ndof, sizeof(int)), *where_f = xcalloc((size_t)ndof, sizeof(int));
-  double *Kf = NULL, *F = NULL;
+  double *Kf = NULL, *F = NULL, *U = NULL, *G = NULL;
   fe_system sys = {0, NULL, NULL};
   if (!state || !is_int || !is_ref || !perm || !where_f) { fail_at(c, fx->loc, "out of memory"); goto done; }
   if (dof_states(&held, state, is_int, c)) goto done;
@@ -1659,56 +1672,75 @@ int fe_condense(const ir_flex *fx, int clamped, int loaded, double K6[36], char 
     if (!state[i]) { where_f[i] = nf; perm[nf++] = i; }
   }
   Kf = xcalloc((size_t)nf * (size_t)nf, sizeof(double));
-  F = xcalloc((size_t)nf * 6, sizeof(double));
-  if (!Kf || !F) { fail_at(c, fx->loc, "out of memory"); goto done; }
+  F = xcalloc((size_t)nf * (size_t)nl, sizeof(double));
+  U = xcalloc((size_t)nf * (size_t)nl, sizeof(double));
+  G = xcalloc((size_t)nl * (size_t)nl, sizeof(double));
+  if (!Kf || !F || !U || !G) { fail_at(c, fx->loc, "out of memory"); goto done; }
   gather(sys.K, ndof, perm, nf, perm, nf, Kf);
+  /* with the first node held the FE model must have no mechanism (its
+     free-free K is singular by nature: the element works relative to that node) */
   if (check_definite(&held, Kf, nf, perm, 0, c)) goto done;
-  /* unit loads on the loaded node's 6 DOFs (an RBE2-dependent DOF's through its link) */
-  for (int d = 0; d < 6; d++) {
-    int i = 6 * loaded + d;
-    double *f = F + (size_t)d * nf;
-    if (state[i] == 0) {
-      f[where_f[i]] = 1;
-    } else if (state[i] == 2) {
-      for (int l = 0; l < fx->nlinks; l++) {
-        const ir_rigid_link *L = &fx->links[l];
-        if (L->dependent != loaded || !(L->dofs >> d & 1)) continue;
-        double coef[6];
-        fe_link_row(fx, L, d, coef);
-        for (int a = 0; a < 6; a++)
-          if (where_f[6 * L->independent + a] >= 0) f[where_f[6 * L->independent + a]] += coef[a];
+  /* unit loads on the loaded nodes' DOFs (an RBE2-dependent DOF's through its link) */
+  for (int a = 0; a < nloaded; a++)
+    for (int d = 0; d < 6; d++) {
+      int i = 6 * loaded[a] + d;
+      double *f = F + (size_t)(6 * a + d) * nf;
+      if (state[i] == 0) {
+        f[where_f[i]] = 1;
+      } else if (state[i] == 2) {
+        for (int l = 0; l < fx->nlinks; l++) {
+          const ir_rigid_link *L = &fx->links[l];
+          if (L->dependent != loaded[a] || !(L->dofs >> d & 1)) continue;
+          double coef[6];
+          fe_link_row(fx, L, d, coef);
+          for (int k = 0; k < 6; k++)
+            if (where_f[6 * L->independent + k] >= 0) f[where_f[6 * L->independent + k]] += coef[k];
+        }
+      } else {
+        fail_at(c, fx->loc, "superelement: DOF %s of node %ld is fixed (an SPC), so the condensed stiffness "
+                "is infinite", dof_names[d], node_name(fx, loaded[a]));
+        goto done;
       }
-    } else {
-      fail_at(c, fx->loc, "superelement: DOF %s of node %ld is fixed (an SPC), so the condensed stiffness "
-              "is infinite", dof_names[d], node_name(fx, loaded));
-      goto done;
     }
-  }
-  /* the loaded node's flexibility G = f^T K^-1 f (6 x 6), K6 = G^-1 */
-  int info = 0, six = 6;
-  double G[36];
-  double *U = xcalloc((size_t)nf * 6, sizeof(double));
-  if (!U) { fail_at(c, fx->loc, "out of memory"); goto done; }
-  memcpy(U, F, (size_t)nf * 6 * sizeof(double));
+  /* the loaded nodes' flexibility G = f^T K^-1 f (nl x nl), Kc = G^-1: the
+     Schur complement of K onto the loaded DOFs, the first node held */
+  int info = 0;
+  memcpy(U, F, (size_t)nf * (size_t)nl * sizeof(double));
   dpotrf_("U", &nf, Kf, &nf, &info);
-  if (info == 0) dpotrs_("U", &nf, &six, Kf, &nf, U, &nf, &info);
-  if (info == 0) mul("T", "N", 6, 6, nf, F, nf, U, nf, G, 6);
-  free(U);
+  if (info == 0) dpotrs_("U", &nf, &nl, Kf, &nf, U, &nf, &info);
+  if (info == 0) mul("T", "N", nl, nl, nf, F, nf, U, nf, G, nl);
   if (info != 0) { fail_at(c, fx->loc, "superelement: the stiffness with the first node clamped is singular"); goto done; }
-  for (int j = 0; j < 6; j++)
-    for (int i = 0; i < j; i++) G[6 * j + i] = G[6 * i + j] = 0.5 * (G[6 * j + i] + G[6 * i + j]);
-  /* the inverse, by solving G K6 = I */
-  memset(K6, 0, 36 * sizeof(double));
-  for (int i = 0; i < 6; i++) K6[7 * i] = 1;
-  dpotrf_("U", &six, G, &six, &info);
-  if (info == 0) dpotrs_("U", &six, &six, G, &six, K6, &six, &info);
-  if (info != 0) { fail_at(c, fx->loc, "superelement: the loaded node's flexibility is singular"); goto done; }
-  for (int j = 0; j < 6; j++)
-    for (int i = 0; i < j; i++) K6[6 * j + i] = K6[6 * i + j] = 0.5 * (K6[6 * j + i] + K6[6 * i + j]);
+  for (int j = 0; j < nl; j++)
+    for (int i = 0; i < j; i++) G[(size_t)nl * j + i] = G[(size_t)nl * i + j] = 0.5 * (G[(size_t)nl * j + i] + G[(size_t)nl * i + j]);
+  /* the inverse, by solving G Kc = I */
+  memset(Kc, 0, (size_t)nl * (size_t)nl * sizeof(double));
+  for (int i = 0; i < nl; i++) Kc[(size_t)(nl + 1) * i] = 1;
+  dpotrf_("U", &nl, G, &nl, &info);
+  if (info == 0) {
+    /* a pivot far below the largest diagonal: interface DOFs that cannot
+       move apart (two interface nodes tied by one RBE2, say) */
+    double dmax = 0, dmin = INFINITY;
+    for (int i = 0; i < nl; i++) {
+      double p = G[(size_t)(nl + 1) * i] * G[(size_t)(nl + 1) * i];
+      dmax = fmax(dmax, p);
+      dmin = fmin(dmin, p);
+    }
+    if (!(dmin > 1e-13 * dmax)) info = 1;
+  }
+  if (info == 0) dpotrs_("U", &nl, &nl, G, &nl, Kc, &nl, &info);
+  if (info != 0) {
+    fail_at(c, fx->loc, "superelement: the interface nodes' flexibility is singular (interface DOFs that "
+            "cannot move independently of each other, e.g. nodes tied by one RBE2), so the condensed "
+            "stiffness is infinite");
+    goto done;
+  }
+  for (int j = 0; j < nl; j++)
+    for (int i = 0; i < j; i++)
+      Kc[(size_t)nl * j + i] = Kc[(size_t)nl * i + j] = 0.5 * (Kc[(size_t)nl * j + i] + Kc[(size_t)nl * i + j]);
   rc = 0;
 done:
   fe_system_free(&sys);
-  free(state); free(is_int); free(is_ref); free(perm); free(where_f); free(Kf); free(F);
+  free(state); free(is_int); free(is_ref); free(perm); free(where_f); free(Kf); free(F); free(U); free(G);
   return rc;
 }
 

@@ -92,6 +92,13 @@ int fe_section_rows(const ir_flex *fx, int e, int end, const fe_modes *fm, doubl
  * or nonzero with err. */
 int fe_condense(const ir_flex *fx, int clamped, int loaded, double K6[36], char *err, size_t nerr,
                 ir_loc *where);
+/* The same for any number of loaded nodes (a superelement with more than
+ * two interface nodes): Kc, (6 nloaded)^2 row-major, the stiffness of the
+ * loaded nodes' DOFs (in their order) with 'clamped' held, the Schur
+ * complement of K onto them.  Errors: a mechanism with 'clamped' held, a
+ * loaded DOF fixed by an SPC, or loaded DOFs that cannot move apart. */
+int fe_condense_nodes(const ir_flex *fx, int clamped, const int *loaded, int nloaded, double *Kc, char *err,
+                      size_t nerr, ir_loc *where);
 
 /* Write m (its selected modes) as a modal data file (docs/modal-file.md);
  * 'description' may be NULL.  Returns 0, or nonzero with err. */

@@ -489,6 +489,48 @@ static int resolve_cord(nas_deck *d, nas_cord *cs, int n, nas_cord *c) {
   return 0;
 }
 
+/* a direction given in system cs (NULL: basic) in basic */
+static void cord_dir_to_basic(const nas_cord *cs, const double v[3], double out[3]) {
+  double t[3] = {v[0], v[1], v[2]};
+  for (int j = 0; j < 3; j++) out[j] = cs ? cs->axes[j] * t[0] + cs->axes[3 + j] * t[1] + cs->axes[6 + j] * t[2] : t[j];
+}
+
+/* DOF components (bits 0..5) given in the displacement system cs of GRID
+ * gid (NULL: basic) as basic components.  A set of translations (or of
+ * rotations) constrains the span of those cs axes; it maps onto basic
+ * components when that span is also spanned by basic axes (the whole set,
+ * or cs axes along basic axes), else it is an error at field i of card c:
+ * a constraint along a skew direction would need a DOF transformation. */
+static int basic_components(nas_deck *d, const nas_card *c, int i, const nas_cord *cs, long gid, unsigned comps,
+                            unsigned *out) {
+  *out = comps;
+  if (!cs) return 1;
+  *out = 0;
+  for (int h = 0; h < 2; h++) { /* translations, rotations */
+    unsigned set = comps >> (3 * h) & 7u;
+    double P[9] = {0}; /* the projector onto the span of the set's axes, basic */
+    for (int a = 0; a < 3; a++)
+      if (set >> a & 1)
+        for (int j = 0; j < 3; j++)
+          for (int k = 0; k < 3; k++) P[3 * j + k] += cs->axes[3 * a + j] * cs->axes[3 * a + k];
+    int aligned = 1;
+    for (int j = 0; j < 3; j++)
+      for (int k = 0; k < 3; k++) {
+        double want = j != k ? 0 : P[3 * j + j] > 0.5 ? 1 : 0;
+        aligned &= fabs(P[3 * j + k] - want) < 1e-9;
+      }
+    if (!aligned) {
+      nas_error(d, c->file, field_loc(c, i), "%s: components %s of GRID %ld are in its displacement system "
+                "CD %ld, whose axes are skew to the basic axes: only whole sets (123, 456) or components along "
+                "basic axes are supported", c->name, field(c, i)->text, gid, cs->id);
+      return 0;
+    }
+    for (int j = 0; j < 3; j++)
+      if (P[3 * j + j] > 0.5) *out |= 1u << (3 * h + j);
+  }
+  return 1;
+}
+
 /* section properties of a PBARL shape (Nastran's dimensions: DIM1.. in
  * field 9 on); I1 bends in the element's x-y plane (about z), I2 in x-z */
 static int pbarl_section(nas_deck *d, const nas_card *c, nas_prop *p) {
@@ -613,6 +655,16 @@ static int grid_ref(nas_deck *d, const nas_card *c, int i, const char *what, con
   return 1;
 }
 
+static void push_link(ir_rigid_link **links, int *n, int *cap, ir_rigid_link l) {
+  if (*n == *cap) {
+    *cap = *cap ? 2 * *cap : 16;
+    ir_rigid_link *grown = realloc(*links, (size_t)*cap * sizeof *grown);
+    if (!grown) out_of_memory();
+    *links = grown;
+  }
+  (*links)[(*n)++] = l;
+}
+
 static const char *const known_ignored[] = {"PARAM", "EIGRL", "EIGR", NULL};
 
 int fe_import_nastran(const char *path, ir_flex *fx, double **global) {
@@ -631,6 +683,9 @@ int fe_import_nastran(const char *path, ir_flex *fx, double **global) {
     else if (!strcmp(n, "CONM2")) nmass++;
     else if (!strcmp(n, "RBE2")) nrbe++;
     else if (!strcmp(n, "SPC") || !strcmp(n, "SPC1")) {
+    } else if (!strcmp(n, "CORD2C") || !strcmp(n, "CORD2S") || !strncmp(n, "CORD1", 5)) {
+      nas_error(&d, d.cards[i].file, d.cards[i].loc, "%s: only rectangular systems given by three points "
+                "(CORD2R) are supported, not cylindrical, spherical or CORD1 systems", n);
     } else {
       int known = 0;
       for (int k = 0; known_ignored[k]; k++) known |= !strcmp(n, known_ignored[k]);
@@ -646,7 +701,14 @@ int fe_import_nastran(const char *path, ir_flex *fx, double **global) {
   nas_prop *ps = nas_alloc((size_t)nprop, sizeof *ps);
   nas_mat *ms = nas_alloc((size_t)nmat, sizeof *ms);
   long *ids = nas_alloc((size_t)ngrid, sizeof *ids), *sorted = nas_alloc(2 * (size_t)ngrid, sizeof *sorted);
-  long *cp = nas_alloc((size_t)ngrid, sizeof *cp);
+  long *cp = nas_alloc((size_t)ngrid, sizeof *cp), *cd = nas_alloc((size_t)ngrid, sizeof *cd);
+  unsigned *ps_comps = nas_alloc((size_t)ngrid, sizeof *ps_comps);
+  const nas_cord **gcd = nas_alloc((size_t)ngrid, sizeof *gcd); /* displacement systems (NULL: basic) */
+  /* CBAR/CBEAM offsets: the element's ends as nodes of their own, appended
+     after the GRIDs, each the dependent of an all-DOF RBE2 on its GRID */
+  double *off_x = NULL;
+  long *off_id = NULL;
+  int noff = 0, capoff = 0;
   const nas_card **grid_card = nas_alloc((size_t)ngrid, sizeof *grid_card);
   double *x = nas_alloc(3 * (size_t)ngrid, sizeof *x);
   unsigned char *fixed = nas_alloc(6 * (size_t)ngrid, 1);
@@ -757,18 +819,17 @@ int fe_import_nastran(const char *path, ir_flex *fx, double **global) {
       }
       nprop++;
     } else if (!strcmp(c->name, "GRID")) {
-      long id, cd, seid;
+      long id, seid;
       unsigned comps = 0;
       double p[3];
       if (!get_int(&d, c, 1, "ID", 1, 0, &id) || !get_int(&d, c, 2, "CP", 0, 0, &cp[ngrid]) ||
           !get_real(&d, c, 3, "X1", 0, 0, &p[0]) || !get_real(&d, c, 4, "X2", 0, 0, &p[1]) ||
-          !get_real(&d, c, 5, "X3", 0, 0, &p[2]) || !get_int(&d, c, 6, "CD", 0, 0, &cd) ||
+          !get_real(&d, c, 5, "X3", 0, 0, &p[2]) || !get_int(&d, c, 6, "CD", 0, 0, &cd[ngrid]) ||
           !get_int(&d, c, 8, "SEID", 0, 0, &seid))
         continue;
       if (!is_blank(c, 7) && !get_components(&d, c, 7, &comps)) continue;
-      if (cd != 0) {
-        nas_error(&d, c->file, field_loc(c, 6), "GRID %ld: a displacement coordinate system (CD %ld) is "
-                  "not supported: the DOFs are in the basic system", id, cd);
+      if (cd[ngrid] < 0) {
+        nas_error(&d, c->file, field_loc(c, 6), "GRID %ld: CD must be 0 or a CORD2R (got %ld)", id, cd[ngrid]);
         continue;
       }
       if (seid != 0) {
@@ -778,8 +839,7 @@ int fe_import_nastran(const char *path, ir_flex *fx, double **global) {
       ids[ngrid] = id;
       grid_card[ngrid] = c;
       memcpy(x + 3 * ngrid, p, sizeof p);
-      for (int k = 0; k < 6; k++)
-        if (comps >> k & 1) fixed[6 * ngrid + k] = 1;
+      ps_comps[ngrid] = comps; /* in CD: applied once the systems are known */
       ngrid++;
     }
   }
@@ -799,6 +859,18 @@ int fe_import_nastran(const char *path, ir_flex *fx, double **global) {
       cord_to_basic(s, x + 3 * k, p);
       memcpy(x + 3 * k, p, sizeof p);
     }
+    if (cd[k] != 0) {
+      gcd[k] = find_cord(cs, ncord, cd[k]);
+      if (!gcd[k]) {
+        nas_error(&d, grid_card[k]->file, field_loc(grid_card[k], 6), "GRID %ld: displacement coordinate "
+                  "system %ld is not defined (only CORD2R)", ids[k], cd[k]);
+        continue;
+      }
+    }
+    unsigned comps;
+    if (ps_comps[k] && basic_components(&d, grid_card[k], 7, gcd[k], ids[k], ps_comps[k], &comps))
+      for (int b = 0; b < 6; b++)
+        if (comps >> b & 1) fixed[6 * k + b] = 1;
   }
   qsort(sorted, (size_t)ngrid, 2 * sizeof *sorted, cmp_long_first);
   for (int k = 1; k < ngrid; k++)
@@ -835,17 +907,12 @@ int fe_import_nastran(const char *path, ir_flex *fx, double **global) {
                   p->card->name, p->id, p->mid);
         continue;
       }
-      double ax[3], len;
-      for (int k = 0; k < 3; k++) ax[k] = x[3 * gb + k] - x[3 * ga + k];
-      len = norm3v(ax);
-      if (ga == gb || !(len > 0)) {
+      if (ga == gb) {
         nas_error(&d, c->file, c->loc, "%s %ld: its two GRIDs coincide (zero length)", c->name, eid);
         continue;
       }
-      double v[3] = {0, 0, 0};
-      if (rod) { /* no bending: any axis across it */
-        v[fabs(ax[0]) <= fabs(ax[1]) && fabs(ax[0]) <= fabs(ax[2]) ? 0 : fabs(ax[1]) <= fabs(ax[2]) ? 1 : 2] = 1;
-      } else {
+      double v[3] = {0, 0, 0}, w[2][3] = {{0, 0, 0}, {0, 0, 0}}; /* orientation, offsets WA, WB */
+      if (!rod) {
         const char *t5 = field(c, 5)->text;
         int g0 = t5[0] && !strchr(t5, '.') && !strchr(t5, 'E') && is_blank(c, 6) && is_blank(c, 7);
         if (g0) {
@@ -856,23 +923,44 @@ int fe_import_nastran(const char *path, ir_flex *fx, double **global) {
                    !get_real(&d, c, 7, "X3", 0, 0, &v[2])) {
           continue;
         }
+        /* OFFT: the system of the orientation vector (G: GA's displacement
+           system, B: basic), then of the offsets at A and at B (G: that end's
+           displacement system; O, the element's system, is not read) */
         const char *offt = field(c, 8)->text;
-        if (offt[0] && strcmp(offt, "GGG")) {
-          nas_error(&d, c->file, field_loc(c, 8), "%s %ld: OFFT/BIT '%s' is not supported (GGG only)",
-                    c->name, eid, offt);
+        if (offt[0] && strcmp(offt, "GGG") && strcmp(offt, "BGG")) {
+          nas_error(&d, c->file, field_loc(c, 8), "%s %ld: OFFT '%s' is not supported (GGG or BGG: offsets in "
+                    "the element system, O, are not)", c->name, eid, offt);
           continue;
         }
+        if (!g0) cord_dir_to_basic(offt[0] == 'B' ? NULL : gcd[ga], v, v);
         int bad = 0;
-        for (int k = 9; k <= 18 && !bad; k++)
+        for (int k = 9; k <= 18 && !bad; k++) {
+          if (k >= 11 && k <= 16) continue; /* the offsets */
           if (!is_blank(c, k)) {
             double val = 0;
             const char *t = field(c, k)->text;
             bad = !(parse_real(t, &val) && val == 0) && strcmp(t, "0");
             if (bad)
-              nas_error(&d, c->file, field_loc(c, k), "%s %ld: pin flags, offsets and warping are not "
-                        "supported (field %d is '%s')", c->name, eid, k + 1, t);
+              nas_error(&d, c->file, field_loc(c, k), "%s %ld: pin flags and warping are not supported "
+                        "(field %d is '%s')", c->name, eid, k + 1, t);
           }
+        }
+        for (int k = 0; k < 6 && !bad; k++) bad = !get_real(&d, c, 11 + k, k < 3 ? "WA" : "WB", 0, 0, &w[k / 3][k % 3]);
         if (bad) continue;
+        cord_dir_to_basic(gcd[ga], w[0], w[0]);
+        cord_dir_to_basic(gcd[gb], w[1], w[1]);
+      }
+      /* the element runs between its ends, the GRIDs moved by the offsets */
+      double ax[3], len;
+      for (int k = 0; k < 3; k++) ax[k] = x[3 * gb + k] + w[1][k] - x[3 * ga + k] - w[0][k];
+      len = norm3v(ax);
+      if (!(len > 0)) {
+        nas_error(&d, c->file, c->loc, "%s %ld: its two ends coincide (zero length)", c->name, eid);
+        continue;
+      }
+      if (rod) { /* no bending: any axis across it */
+        v[fabs(ax[0]) <= fabs(ax[1]) && fabs(ax[0]) <= fabs(ax[2]) ? 0 : fabs(ax[1]) <= fabs(ax[2]) ? 1 : 2] = 1;
+      } else {
         double cr[3];
         cross3(ax, v, cr);
         if (!(norm3v(cr) > 1e-6 * len * norm3v(v))) {
@@ -881,11 +969,27 @@ int fe_import_nastran(const char *path, ir_flex *fx, double **global) {
           continue;
         }
       }
+      int end_node[2] = {ga, gb};
+      for (int e = 0; e < 2; e++) {
+        if (w[e][0] == 0 && w[e][1] == 0 && w[e][2] == 0) continue;
+        if (noff == capoff) {
+          capoff = capoff ? 2 * capoff : 16;
+          double *nx = realloc(off_x, 3 * (size_t)capoff * sizeof *nx);
+          long *ni = realloc(off_id, (size_t)capoff * sizeof *ni);
+          if (!nx || !ni) out_of_memory();
+          off_x = nx;
+          off_id = ni;
+        }
+        for (int k = 0; k < 3; k++) off_x[3 * noff + k] = x[3 * end_node[e] + k] + w[e][k];
+        off_id[noff] = -(10 * eid + 1 + e); /* no GRID id is negative */
+        push_link(&links, &nlinks, &capl, (ir_rigid_link){end_node[e], ngrid + noff, 63, field_loc(c, 11 + 3 * e)});
+        end_node[e] = ngrid + noff++;
+      }
       eids[nel] = eid;
       ir_beam *b = &beams[nel++];
       memset(b, 0, sizeof *b);
-      b->node[0] = ga;
-      b->node[1] = gb;
+      b->node[0] = end_node[0];
+      b->node[1] = end_node[1];
       b->theory = p->timoshenko ? BEAM_TIMOSHENKO : BEAM_EULER_BERNOULLI;
       b->E = m->E;
       b->G = m->G;
@@ -959,6 +1063,7 @@ int fe_import_nastran(const char *path, ir_flex *fx, double **global) {
           nas_error(&d, c->file, field_loc(c, 4 + 3 * k), "SPC: an enforced displacement is not supported");
           break;
         }
+        if (!basic_components(&d, c, 3 + 3 * k, gcd[g], ids[g], comps, &comps)) break;
         for (int b = 0; b < 6; b++)
           if (comps >> b & 1) fixed[6 * g + b] = 1;
       }
@@ -975,16 +1080,19 @@ int fe_import_nastran(const char *path, ir_flex *fx, double **global) {
           }
           for (long id = lo + 1; id < hi; id++) {
             int g = grid_index(sorted, ngrid, id);
-            if (g >= 0)
+            unsigned basic;
+            if (g >= 0 && basic_components(&d, c, 2, gcd[g], ids[g], comps, &basic))
               for (int b = 0; b < 6; b++)
-                if (comps >> b & 1) fixed[6 * g + b] = 1;
+                if (basic >> b & 1) fixed[6 * g + b] = 1;
           }
           continue;
         }
         int g;
-        if (!grid_ref(&d, c, k, "G", sorted, ngrid, &g)) break;
+        unsigned basic;
+        if (!grid_ref(&d, c, k, "G", sorted, ngrid, &g) || !basic_components(&d, c, 2, gcd[g], ids[g], comps, &basic))
+          break;
         for (int b = 0; b < 6; b++)
-          if (comps >> b & 1) fixed[6 * g + b] = 1;
+          if (basic >> b & 1) fixed[6 * g + b] = 1;
       }
     } else if (!strcmp(c->name, "RBE2")) {
       long eid;
@@ -998,27 +1106,23 @@ int fe_import_nastran(const char *path, ir_flex *fx, double **global) {
         if (is_blank(c, k)) continue;
         if (strchr(field(c, k)->text, '.')) break; /* ALPHA (thermal): ignored */
         int g;
-        if (!grid_ref(&d, c, k, "GM", sorted, ngrid, &g)) break;
+        unsigned dofs;
+        if (!grid_ref(&d, c, k, "GM", sorted, ngrid, &g) || !basic_components(&d, c, 3, gcd[g], ids[g], comps, &dofs))
+          break;
         if (g == gn) {
           nas_error(&d, c->file, field_loc(c, k), "RBE2 %ld: GRID %ld is both independent and dependent", eid, ids[g]);
           break;
         }
         int clash = 0;
         for (int l = 0; l < nlinks && !clash; l++)
-          clash = (links[l].dependent == g && (links[l].dofs & comps)) || links[l].independent == g ||
+          clash = (links[l].dependent == g && (links[l].dofs & dofs)) || links[l].independent == g ||
                   links[l].dependent == gn;
         if (clash) {
           nas_error(&d, c->file, field_loc(c, k), "RBE2 %ld: GRID %ld is dependent in two RBE2s, or "
                     "RBE2s are chained (an independent GRID dependent on another RBE2)", eid, ids[g]);
           break;
         }
-        if (nlinks == capl) {
-          capl = capl ? 2 * capl : 16;
-          ir_rigid_link *l = realloc(links, (size_t)capl * sizeof *l);
-          if (!l) out_of_memory();
-          links = l;
-        }
-        links[nlinks++] = (ir_rigid_link){gn, g, comps, field_loc(c, k)};
+        push_link(&links, &nlinks, &capl, (ir_rigid_link){gn, g, dofs, field_loc(c, k)});
         count++;
       }
       if (count == 0 && d.errors == 0)
@@ -1026,6 +1130,21 @@ int fe_import_nastran(const char *path, ir_flex *fx, double **global) {
     }
   }
   if (d.errors) goto done;
+  if (noff) { /* the offset ends after the GRIDs */
+    long *all_ids = nas_alloc((size_t)(ngrid + noff), sizeof *all_ids);
+    double *all_x = nas_alloc(3 * (size_t)(ngrid + noff), sizeof *all_x);
+    unsigned char *all_fixed = nas_alloc(6 * (size_t)(ngrid + noff), 1);
+    memcpy(all_ids, ids, (size_t)ngrid * sizeof *ids);
+    memcpy(all_ids + ngrid, off_id, (size_t)noff * sizeof *ids);
+    memcpy(all_x, x, 3 * (size_t)ngrid * sizeof *x);
+    memcpy(all_x + 3 * ngrid, off_x, 3 * (size_t)noff * sizeof *x);
+    memcpy(all_fixed, fixed, 6 * (size_t)ngrid);
+    free(ids); free(x); free(fixed);
+    ids = all_ids;
+    x = all_x;
+    fixed = all_fixed;
+    ngrid += noff;
+  }
   /* the model */
   fx->nnodes = ngrid;
   fx->node_ids = ids;
@@ -1052,7 +1171,8 @@ int fe_import_nastran(const char *path, ir_flex *fx, double **global) {
   *global = x;
   x = NULL;
 done:
-  free(cs); free(ps); free(ms); free(ids); free(sorted); free(cp); free(grid_card); free(x);
+  free(cs); free(ps); free(ms); free(ids); free(sorted); free(cp); free(cd); free(ps_comps); free(gcd);
+  free(off_x); free(off_id); free(grid_card); free(x);
   free(fixed); free(beams); free(eids); free(pms); free(links);
   for (int i = 0; i < d.ncards; i++) free(d.cards[i].f);
   free(d.cards);

@@ -283,6 +283,13 @@ typedef struct {
   ir_beam beam;
   double damping_ratio;
   ir_tyre tyre;
+  /* superelement with more than two interface nodes: nsuper nodes, node k
+     on body super_body[k] at global point super_point[3k..] (nodes 0 and 1
+     also in body[], point[]); super_K, super_C: (6 (nsuper - 1))^2
+     row-major, nodes 1.. with node 0 held; 0 / NULL otherwise */
+  int nsuper;
+  int *super_body;
+  double *super_point, *super_K, *super_C;
   bool active;
 } ir_force;
 

@@ -677,17 +677,18 @@ static int *to_flex_node_list(reader *r, yaml_node_t *n, const char *label, cons
   return out;
 }
 
-/* A superelement's FE model ('fe_file' of force 'owner') and its two nodes
- * ('interface': [clamped, loaded], numbered as the file numbers them).  The
- * nodes stay in global axes (fx->nodes).  Returns false after an error. */
-bool read_superelement_fe(mapping *m, const char *owner, ir_flex *fx, int nodes[2]) {
+/* A superelement's FE model ('fe_file' of force 'owner') and its nodes
+ * ('interface': [node 0, loaded nodes...], numbered as the file numbers
+ * them; *nodes allocated, *count of them, 2 or more).  The nodes stay in
+ * global axes (fx->nodes).  Returns false after an error. */
+bool read_superelement_fe(mapping *m, const char *owner, ir_flex *fx, int **nodes, int *count) {
   reader *r = m->r;
   ir_body owner_body;
   memset(&owner_body, 0, sizeof owner_body);
   owner_body.name = (char *)owner;
   fx->loc = m->loc;
   yaml_node_t *file = map_require(m, "fe_file", true, "an FE file");
-  yaml_node_t *itf = map_require(m, "interface", true, "[clamped node, loaded node]");
+  yaml_node_t *itf = map_require(m, "interface", true, "[node 0, loaded nodes ...]");
   if (!file) return false;
   int errors = diag_errors();
   double *global = parse_fe_file(m, &owner_body, fx);
@@ -698,13 +699,14 @@ bool read_superelement_fe(mapping *m, const char *owner, ir_flex *fx, int nodes[
     fe_import_to_body(fx, identity);
   }
   if (!itf) return false;
-  int count = 0;
-  int *list = to_flex_node_list(r, itf, "'interface'", fx, fx->nnodes, &count);
-  bool ok = list && count == 2 && diag_errors() == errors;
-  if (list && count != 2)
-    error_at(r, loc_of(itf), "'interface': a superelement takes 2 nodes [clamped, loaded] (got %d)", count);
-  if (ok) { nodes[0] = list[0]; nodes[1] = list[1]; }
-  free(list);
+  *count = 0;
+  int *list = to_flex_node_list(r, itf, "'interface'", fx, fx->nnodes, count);
+  bool ok = list && *count >= 2 && *count <= 1 + MB_SUPER_MAX_NODES && diag_errors() == errors;
+  if (list && (*count < 2 || *count > 1 + MB_SUPER_MAX_NODES))
+    error_at(r, loc_of(itf), "'interface': a superelement takes 2 nodes or more, at most %d [node 0 (held, "
+             "the element's frame), loaded nodes ...] (got %d)", 1 + MB_SUPER_MAX_NODES, *count);
+  if (ok) *nodes = list;
+  else free(list);
   return ok;
 }
 
@@ -1939,6 +1941,10 @@ void ir_free(ir_model *m) {
   free(m->drivers);
   for (int i = 0; i < m->nforces; i++) {
     free(m->forces[i].name);
+    free(m->forces[i].super_body);
+    free(m->forces[i].super_point);
+    free(m->forces[i].super_K);
+    free(m->forces[i].super_C);
     free(m->forces[i].scale.table);
     free(m->forces[i].stiffness.table);
     free(m->forces[i].damping.table);

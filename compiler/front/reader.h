@@ -20,9 +20,9 @@ extern const char *const theory_names[]; /* 'theory' of a beam */
 
 /* a file name given in the model, relative to the model file's directory */
 char *model_relative_path(reader *r, const yaml_node_t *n);
-/* a superelement's FE model from 'fe_file' and its 2 'interface' nodes
-   (compiler/elements/force_field.c); node positions global */
-bool read_superelement_fe(mapping *m, const char *owner, ir_flex *fx, int nodes[2]);
+/* a superelement's FE model from 'fe_file' and its 'interface' nodes (2 or
+   more, *nodes allocated; compiler/elements/force_field.c); node positions global */
+bool read_superelement_fe(mapping *m, const char *owner, ir_flex *fx, int **nodes, int *count);
 /* one entry of the top-level 'roads' (compiler/elements/force_tyre.c) */
 void parse_road(reader *r, yaml_node_t *key, yaml_node_t *value);
 /* the components of a tyre output, NULL-terminated (output_element.c) */

@@ -785,6 +785,7 @@ static void prune_model(ir_model *model, chosen_scene *s) {
   for (int f = 0; f < nf; f++) {
     const ir_force *F = &model->forces[f];
     force_gone[f] = removed[F->body[0]] || (F->body[1] >= 0 && removed[F->body[1]]);
+    for (int k = 2; k < F->nsuper; k++) force_gone[f] = force_gone[f] || removed[F->super_body[k]];
     if (force_gone[f]) {
       pruned_add(model, "force '%s'%s", F->name, "");
       gone_add(s, "forces", F->name);
@@ -833,11 +834,13 @@ static void prune_model(ir_model *model, chosen_scene *s) {
     if (f < nf) force_to[f] = force_gone[f] ? -1 : count;
     if (f < nf && force_gone[f]) {
       free(F->name); free(F->scale.table); free(F->stiffness.table); free(F->damping.table);
+      free(F->super_body); free(F->super_point); free(F->super_K); free(F->super_C);
       continue;
     }
     forces[count] = *F;
     for (int side = 0; side < 2; side++)
       if (forces[count].body[side] >= 0) forces[count].body[side] = body_to[forces[count].body[side]];
+    for (int k = 0; k < forces[count].nsuper; k++) forces[count].super_body[k] = body_to[forces[count].super_body[k]];
     count++;
   }
   free(model->forces);

@@ -18,6 +18,7 @@
 #include "elements/mb_field.h"
 #include "elements/mb_force_point.h"
 #include "elements/mb_spring.h"
+#include "elements/mb_superelement.h"
 #include "elements/mb_tyre.h"
 
 #ifdef __cplusplus
@@ -65,12 +66,16 @@ typedef enum {
   MB_FORCE_TORQUE,    /* elements/mb_force_point.h */
   MB_FORCE_SPRING,    /* elements/mb_spring.h */
   MB_FORCE_FIELD,     /* elements/mb_field.h: fields, bushings, beams */
-  MB_FORCE_TYRE       /* elements/mb_tyre.h: tyre on a road (one marker, the wheel centre) */
+  MB_FORCE_TYRE,      /* elements/mb_tyre.h: tyre on a road (one marker, the wheel centre) */
+  MB_FORCE_SUPERELEMENT /* elements/mb_superelement.h: more than two nodes (markers m0, then
+                           m1 .. m1 + n - 1); no tangent: an implicit method's Newton
+                           sees its stiffness only through the residual */
 } mb_force_kind;
 
 typedef struct {
   mb_force_kind kind;
-  int m0, m1;        /* markers; m1 = -1 for one-marker kinds (point force, torque) */
+  int m0, m1;        /* markers; m1 = -1 for one-marker kinds (point force, torque); a
+                        superelement's nodes 1..n are markers m1 .. m1 + n - 1 */
   int padr, pnum;    /* reals in force_prm (layout: the kind's MB_<KIND>_* offsets) */
   int ladr, lnum;    /* force laws in force_law (spring: stiffness, damping) */
   int sadr, snum;    /* internal state (e.g. a tyre's slip relaxation) in the caller's

@@ -191,6 +191,20 @@ static mb_real forces_eval(const mb_model *m, mb_real t, const mb_real *q, const
       add_wrench(m, F, MK, d->m0, q, Fv, T, f);
       break;
     }
+    case MB_FORCE_SUPERELEMENT: {
+      int n = (int)prm[MB_SUPER_N];
+      const mb_marker *mk[MB_SUPER_MAX_NODES];
+      mb_real Fv[3 * MB_SUPER_MAX_NODES], T[3 * MB_SUPER_MAX_NODES];
+      for (int k = 0; k < n; k++) mk[k] = &MK[d->m1 + k];
+      E += mb_superelement(m0, mk, prm, Fv, T);
+      for (int k = 0; k < n; k++) {
+        mb_real mF[3], mT[3];
+        for (int j = 0; j < 3; j++) { mF[j] = -Fv[3 * k + j]; mT[j] = -T[3 * k + j]; }
+        add_wrench(m, F, MK, d->m1 + k, q, Fv + 3 * k, T + 3 * k, f);
+        add_wrench_at(m, F, b0, mk[k]->P, mF, mT, f); /* reaction at the same point */
+      }
+      break;
+    }
     }
   }
   return E;
@@ -454,6 +468,13 @@ void mb_model_energy(const mb_model *m, mb_real t, const mb_real *q, const mb_re
     case MB_FORCE_SPRING: U += mb_spring(&MK[d->m0], &MK[d->m1], prm, m->force_law + d->ladr, F0, F1, 0); break;
     case MB_FORCE_FIELD: U += mb_field(&MK[d->m0], &MK[d->m1], prm, F0, F1, 0); break;
     case MB_FORCE_TYRE: U += mb_tyre(&MK[d->m0], prm, F0, F1, 0, 0); break;
+    case MB_FORCE_SUPERELEMENT: {
+      const mb_marker *mk[MB_SUPER_MAX_NODES];
+      mb_real Fs[3 * MB_SUPER_MAX_NODES], Ts[3 * MB_SUPER_MAX_NODES];
+      for (int k = 0; k < (int)prm[MB_SUPER_N]; k++) mk[k] = &MK[d->m1 + k];
+      U += mb_superelement(&MK[d->m0], mk, prm, Fs, Ts);
+      break;
+    }
     }
   }
   (void)t;
@@ -488,6 +509,14 @@ static void force_wrench_markers(const mb_model *m, int k, mb_real t, const mb_f
   case MB_FORCE_TYRE: /* one marker, the wheel centre: force and torque on the wheel */
     mb_tyre(&MK[d->m0], prm, Fv, T, 0, 0);
     break;
+  case MB_FORCE_SUPERELEMENT: { /* the wrench on its node 1 (marker m1) */
+    const mb_marker *mk[MB_SUPER_MAX_NODES];
+    mb_real Fs[3 * MB_SUPER_MAX_NODES], Ts[3 * MB_SUPER_MAX_NODES];
+    for (int k = 0; k < (int)prm[MB_SUPER_N]; k++) mk[k] = &MK[d->m1 + k];
+    mb_superelement(&MK[d->m0], mk, prm, Fs, Ts);
+    for (int j = 0; j < 3; j++) { Fv[j] = Fs[j]; T[j] = Ts[j]; }
+    break;
+  }
   }
 }
 

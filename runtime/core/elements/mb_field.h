@@ -31,10 +31,10 @@ enum {
  * derivatives (row-major) of marker 1's wrench [F; T] with respect to its
  * displacement [dP1; dphi1] (global; dphi1 a small rotation, R1 -> (I + dphi1~) R1),
  * then the 6x6 with respect to its velocities [V1; W1]. */
-static inline mb_real mb_field(const mb_marker *m0, const mb_marker *m1, const mb_real *prm,
-                               mb_real F[3], mb_real T[3], mb_real *tangent) {
-  const mb_real *K = prm + MB_FIELD_K, *C = prm + MB_FIELD_C, *pre = prm + MB_FIELD_PRE;
-  mb_real d[3], dd[3], wd[3], u[6], ud[6], Rr[9], f[6], wxd[3];
+/* the relative displacement u and rate ud of marker 1 from marker 0 (mb_field's) */
+static inline void mb_field_relative(const mb_marker *m0, const mb_marker *m1, const mb_real d0[3], mb_real u[6],
+                                     mb_real ud[6]) {
+  mb_real d[3], dd[3], wd[3], Rr[9], wxd[3];
   for (int j = 0; j < 3; j++) {
     d[j] = m1->P[j] - m0->P[j];
     wd[j] = m1->W[j] - m0->W[j];
@@ -42,7 +42,7 @@ static inline mb_real mb_field(const mb_marker *m0, const mb_marker *m1, const m
   mb_cross3(m0->W, d, wxd);
   for (int j = 0; j < 3; j++) dd[j] = m1->V[j] - m0->V[j] - wxd[j];
   mb_mul3t(m0->R, d, u);
-  for (int j = 0; j < 3; j++) u[j] -= prm[MB_FIELD_D0 + j];
+  for (int j = 0; j < 3; j++) u[j] -= d0[j];
   mb_mul3t(m0->R, dd, ud);
   /* relative rotation R0^T R1 and its rotation vector */
   for (int i = 0; i < 3; i++)
@@ -53,6 +53,13 @@ static inline mb_real mb_field(const mb_marker *m0, const mb_marker *m1, const m
   mb_real ang = MB_ATAN2(sn, cs), fac = (sn > MB_R(1e-12)) ? ang / sn : 1;
   for (int j = 0; j < 3; j++) u[3 + j] = fac * v[j];
   mb_mul3t(m0->R, wd, ud + 3);
+}
+
+static inline mb_real mb_field(const mb_marker *m0, const mb_marker *m1, const mb_real *prm,
+                               mb_real F[3], mb_real T[3], mb_real *tangent) {
+  const mb_real *K = prm + MB_FIELD_K, *C = prm + MB_FIELD_C, *pre = prm + MB_FIELD_PRE;
+  mb_real u[6], ud[6], f[6];
+  mb_field_relative(m0, m1, prm + MB_FIELD_D0, u, ud);
   mb_real E = 0;
   for (int i = 0; i < 6; i++) {
     f[i] = pre[i];
