@@ -549,6 +549,10 @@ static void emit_flex_tables(emit_ctx *cx, int b) {
   ARR(node_x, 3 * nn)
   ARR(node_X, 3 * nm * nn)
   ARR(node_Psi, 3 * nm * nn)
+  if (x->stiff_P) { /* geometric stiffening (compiler/flex/stiffening.c) */
+    ARR(stiff_P, 3 * nm * nm)
+    ARR(stiff_R, 9 * nm * nm)
+  }
 #undef ARR
   int nbk = 6 + nm;
   snprintf(nm_, sizeof nm_, "flex%d_mslot", b);
@@ -560,8 +564,10 @@ static void emit_flex_tables(emit_ctx *cx, int b) {
   fprintf(f, ", flex%d_S1, ", b);
   vec(f, x->J0, 9);
   fprintf(f, ",\n  flex%d_E, flex%d_F, flex%d_G, flex%d_C0, flex%d_CPsi, flex%d_Mff, flex%d_stiffness,\n"
-             "  flex%d_damping, %d, flex%d_node_x, flex%d_node_X, flex%d_node_Psi};\n",
+             "  flex%d_damping, %d, flex%d_node_x, flex%d_node_X, flex%d_node_Psi",
           b, b, b, b, b, b, b, b, nn, b, b, b);
+  if (x->stiff_P) fprintf(f, ", flex%d_stiff_P, flex%d_stiff_R", b, b);
+  fputs("};\n", f);
 }
 
 /* "c->name[k] = c0 + sum_t coef_t * v[idx_t];" with the nonzero terms only,
@@ -769,9 +775,12 @@ static void emit_eval(emit_ctx *cx) {
     fprintf(f, "  /* body '%s' */\n", B->name);
     if (B->kind == MB_BODY_FLEXIBLE) {
       int nbk = 6 + B->nm;
-      fprintf(f, "  {\n    mb_real AS[9], AS1[%d];\n    mb_flex_step cs;\n    flex%d_contract(q + %d, v + %d, &cs);\n"
-                 "    mb_flex_forces(&flex%d, &cs, &f%d, q + %d, v + %d, (const mb_real[3])",
-              B->nm ? 3 * B->nm : 1, b, B->qadr + 7, B->vadr + 6, b, b, B->qadr + 7, B->vadr + 6); /* ISO C: no zero-size array */
+      fprintf(f, "  {\n    mb_real AS[9], AS1[%d];\n    mb_flex_step cs;\n    flex%d_contract(q + %d, v + %d, &cs);\n",
+              B->nm ? 3 * B->nm : 1, b, B->qadr + 7, B->vadr + 6); /* ISO C: no zero-size array */
+      if (B->flex->stiff_P) /* geometric stiffening: its terms added to the contractions */
+        fprintf(f, "    mb_flex_stiffen(&flex%d, q + %d, v + %d, &cs);\n", b, B->qadr + 7, B->vadr + 6);
+      fprintf(f, "    mb_flex_forces(&flex%d, &cs, &f%d, q + %d, v + %d, (const mb_real[3])",
+              b, b, B->qadr + 7, B->vadr + 6);
       vec(f, m->gravity, 3);
       fprintf(f, ", rhs + %d);\n", B->vadr);
       fprintf(f, "    /* the mass blocks that move (mb_flex_assemble without m I and Mff, set by init) */\n"

@@ -37,6 +37,13 @@ typedef struct {
   const mb_real *node_x;    /* 3 per node */
   const mb_real *node_X;    /* per node 3 x nm (column j at node_X + 3 (k nm + j)) */
   const mb_real *node_Psi;  /* per node 3 x nm, likewise */
+  /* geometric stiffening (docs/formulation.md section 12.1; NULL: off): the
+     second-order (foreshortening) displacement d_k = 1/2 sum_ij w_i w_j D_kij
+     of the nodes enters T through P_ij = sum_k m_k D_kij and
+     R_ij = sum_k m_k D_kij x_k^T, computed at compile time from the beam
+     elements' geometric stiffness (compiler/flex/stiffening.c) */
+  const mb_real *stiff_P;   /* nm x nm 3-vectors, P_ij at stiff_P + 3 (i nm + j) */
+  const mb_real *stiff_R;   /* nm x nm 3x3 (row-major), R_ij at stiff_R + 9 (i nm + j) */
 } mb_flex;
 
 /* left Jacobian of SO(3) at theta and its time derivative along thetad:
@@ -172,6 +179,10 @@ typedef struct {
   mb_real Fw[9 * MB_MAX_MODES]; /* Fw_j at Fw + 9 j (zero unless coupling is partial or full) */
   mb_real Gw[3 * MB_MAX_MODES]; /* Gw_j at Gw + 3 j: column j of M_thf */
   mb_real Gd[3 * MB_MAX_MODES]; /* Gd_j at Gd + 3 j */
+  /* geometric stiffening only (mb_flex_stiffen): Pw_j = sum_i w_i P_ij,
+     Rw_j = sum_i w_i R_ij, Rwd = sum_j wd_j Rw_j, and the sums over wd_i wd_j
+     of P_ij and R_ij */
+  mb_real Pw[3 * MB_MAX_MODES], Rw[9 * MB_MAX_MODES], Rwd[9], Pdd[3], Rdd[9];
 } mb_flex_step;
 
 static inline void mb_flex_contract(const mb_flex *fx, const mb_real *w, const mb_real *wd,
@@ -211,6 +222,67 @@ static inline void mb_flex_contract(const mb_flex *fx, const mb_real *w, const m
     }
 }
 
+/* U = eps(R): U_a = eps_abc R_cb (the sum over the nodes of m_k x_k x D_k
+ * from that of m_k D_k x_k^T) */
+static inline void mb_flex_stiff_cross(const mb_real R[9], mb_real U[3]) {
+  U[0] = R[7] - R[5];
+  U[1] = R[2] - R[6];
+  U[2] = R[3] - R[1];
+}
+
+/* Geometric stiffening (fx->stiff_P set): the terms the nodes' second-order
+ * displacement d_k(w) adds to the contractions c of mb_flex_contract, kept to
+ * the products of the rigid velocities with d_k (docs/formulation.md 12.1):
+ *   S += 1/2 sum_j w_j Pw_j,  S1wd += sum_j wd_j Pw_j   (A S1 column j += A Pw_j),
+ *   J += 2 tr(Rww) I - Rww - Rww^T,  Rww = 1/2 sum_j w_j Rw_j,
+ *   Gw_j += eps(Rw_j)  (column j of M_thf),
+ * and the sums mb_flex_forces needs for the matching velocity terms. */
+static inline void mb_flex_stiffen(const mb_flex *fx, const mb_real *w, const mb_real *wd,
+                                   mb_flex_step *c) {
+  int nm = fx->nm;
+  mb_real Rww[9] = {0}, dS[3] = {0};
+  for (int i = 0; i < 3; i++) c->Pdd[i] = 0;
+  for (int i = 0; i < 9; i++) c->Rwd[i] = c->Rdd[i] = 0;
+  for (int j = 0; j < nm; j++) {
+    mb_real *Pw = c->Pw + 3 * j, *Rw = c->Rw + 9 * j, Pd[3] = {0}, Rd[9] = {0};
+    for (int i = 0; i < 3; i++) Pw[i] = 0;
+    for (int i = 0; i < 9; i++) Rw[i] = 0;
+    for (int a = 0; a < nm; a++) {
+      const mb_real *P = fx->stiff_P + 3 * (a * nm + j), *R = fx->stiff_R + 9 * (a * nm + j);
+      for (int i = 0; i < 3; i++) { Pw[i] += w[a] * P[i]; Pd[i] += wd[a] * P[i]; }
+      for (int i = 0; i < 9; i++) { Rw[i] += w[a] * R[i]; Rd[i] += wd[a] * R[i]; }
+    }
+    for (int i = 0; i < 3; i++) {
+      dS[i] += MB_R(0.5) * w[j] * Pw[i];
+      c->S1wd[i] += wd[j] * Pw[i];
+      c->Pdd[i] += wd[j] * Pd[i];
+    }
+    for (int i = 0; i < 9; i++) {
+      Rww[i] += MB_R(0.5) * w[j] * Rw[i];
+      c->Rwd[i] += wd[j] * Rw[i];
+      c->Rdd[i] += wd[j] * Rd[i];
+    }
+    mb_real U[3];
+    mb_flex_stiff_cross(Rw, U);
+    for (int i = 0; i < 3; i++) c->Gw[3 * j + i] += U[i];
+  }
+  mb_real tr = Rww[0] + Rww[4] + Rww[8];
+  for (int i = 0; i < 3; i++) {
+    c->S[i] += dS[i];
+    for (int l = 0; l < 3; l++) c->J[3 * i + l] += 2 * tr * (i == l) - Rww[3 * i + l] - Rww[3 * l + i];
+  }
+}
+
+/* the second-order part of S: 1/2 sum_ij w_i w_j P_ij (0 without stiffening) */
+static inline void mb_flex_stiff_S(const mb_flex *fx, const mb_real *w, mb_real dS[3]) {
+  int nm = fx->nm;
+  dS[0] = dS[1] = dS[2] = 0;
+  if (!fx->stiff_P) return;
+  for (int a = 0; a < nm; a++)
+    for (int j = 0; j < nm; j++)
+      for (int i = 0; i < 3; i++) dS[i] += MB_R(0.5) * w[a] * w[j] * fx->stiff_P[3 * (a * nm + j) + i];
+}
+
 /* The blocks of the flexible body's mass matrix that change with the motion
  * and are not contractions already in c:  AS = A S~ (M_rth = -AS, M_thr =
  * -AS^T) and AS1 = A S1 (3 x nm by columns; M_rf = AS1, M_fr = AS1^T).  The
@@ -220,7 +292,12 @@ static inline void mb_flex_mass_moving(const mb_flex *fx, const mb_flex_step *c,
   const mb_real *S = c->S;
   mb_real Sx[9] = {0, -S[2], S[1], S[2], 0, -S[0], -S[1], S[0], 0};
   mb_matmul3(f->A, Sx, AS);
-  for (int j = 0; j < fx->nm; j++) mb_mul3(f->A, fx->S1 + 3 * j, AS1 + 3 * j);
+  for (int j = 0; j < fx->nm; j++) {
+    mb_real col[3] = {fx->S1[3 * j], fx->S1[3 * j + 1], fx->S1[3 * j + 2]};
+    if (fx->stiff_P) /* d S / d w_j with the second-order part */
+      for (int i = 0; i < 3; i++) col[i] += c->Pw[3 * j + i];
+    mb_mul3(f->A, col, AS1 + 3 * j);
+  }
 }
 
 /* The flexible body's forces fb (6+nm), coordinates [rd; w'; wd]: gravity g
@@ -265,6 +342,29 @@ static inline void mb_flex_forces(const mb_flex *fx, const mb_flex_step *c, cons
     fb[6 + j] = -(mb_dot3(wl, Bw) - ww * (B[0] + B[4] + B[8])) - 2 * mb_dot3(wl, c->Gd + 3 * j) +
                 mb_dot3(fx->S1 + 3 * j, Ag) - fx->stiffness[j] * w[j] - fx->damping[j] * wd[j];
   }
+  if (fx->stiff_P) { /* geometric stiffening: docs/formulation.md 12.1 */
+    /* s_r -= A sum_ij wd_i wd_j P_ij */
+    mb_mul3(f->A, c->Pdd, t);
+    for (int i = 0; i < 3; i++) fb[i] -= t[i];
+    /* s_th -= dJ' w' + eps(Rdd) + w' x eps(Rwd),  dJ' = 2 tr(Rwd) I - Rwd - Rwd^T */
+    const mb_real *Rd = c->Rwd;
+    mb_real trd = Rd[0] + Rd[4] + Rd[8], Ud[3], Udd[3], wU[3];
+    mb_flex_stiff_cross(Rd, Ud);
+    mb_flex_stiff_cross(c->Rdd, Udd);
+    mb_cross3(wl, Ud, wU);
+    for (int i = 0; i < 3; i++) {
+      mb_real dJw = 2 * trd * wl[i];
+      for (int l = 0; l < 3; l++) dJw -= (Rd[3 * i + l] + Rd[3 * l + i]) * wl[l];
+      fb[3 + i] -= dJw + Udd[i] + wU[i];
+    }
+    /* s_f,j += |w'|^2 tr Rw_j - w'^T Rw_j w' + Pw_j . A^T g (the stiffening) */
+    for (int j = 0; j < nm; j++) {
+      const mb_real *R = c->Rw + 9 * j;
+      mb_real Rw3[3];
+      mb_mul3(R, wl, Rw3);
+      fb[6 + j] += ww * (R[0] + R[4] + R[8]) - mb_dot3(wl, Rw3) + mb_dot3(c->Pw + 3 * j, Ag);
+    }
+  }
 }
 
 /* The flexible body's mass matrix Mb ((6+nm)^2, row-major, coordinates
@@ -305,6 +405,7 @@ static inline void mb_flex_body(const mb_flex *fx, const mb_frame *f, const mb_r
                                 mb_real *fb) {
   mb_flex_step c;
   mb_flex_contract(fx, w, wd, &c);
+  if (fx->stiff_P) mb_flex_stiffen(fx, w, wd, &c);
   mb_flex_assemble(fx, &c, f, w, wd, g, Mb, fb);
 }
 

@@ -424,8 +424,10 @@ void mb_model_energy(const mb_model *m, mb_real t, const mb_real *q, const mb_re
       mb_real Mb[(6 + MB_MAX_MODES) * (6 + MB_MAX_MODES)], fb[6 + MB_MAX_MODES], S[3], AS[3];
       T += mb_flex_kinetic(fx, &F[b], w, v + B->vadr + 6, Mb, fb);
       /* gravity: -g . (m r + A S(w));  elastic: 1/2 sum k_j w_j^2 */
+      mb_real dS[3];
       mb_modal3(fx->S1, fx->nm, w, S);
-      for (int i = 0; i < 3; i++) S[i] += fx->S0[i];
+      mb_flex_stiff_S(fx, w, dS); /* geometric stiffening: the second-order part */
+      for (int i = 0; i < 3; i++) S[i] += fx->S0[i] + dS[i];
       mb_mul3(F[b].A, S, AS);
       U -= mb_dot3(m->gravity, AS) + fx->mass * mb_dot3(m->gravity, F[b].r);
       for (int j = 0; j < fx->nm; j++) U += MB_R(0.5) * fx->stiffness[j] * w[j] * w[j];
