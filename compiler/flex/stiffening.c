@@ -198,8 +198,8 @@ int flex_stiffening_build(const ir_flex *fx, const fe_modes *fm, flex_data *out,
   }
   clean(out->stiff_P, 3 * (size_t)nm * (size_t)nm);
   clean(out->stiff_R, 9 * (size_t)nm * (size_t)nm);
-  out->flex.stiff_P = out->stiff_P;
-  out->flex.stiff_R = out->stiff_R;
+  out->stiff.P = out->stiff_P;
+  out->stiff.R = out->stiff_R;
   st = 0;
 done:
   free(freeidx);

@@ -307,7 +307,7 @@ static void generic_eval(const mb_model *m, mb_real t, const mb_real *q, const m
     if (B->kind == MB_BODY_FLEXIBLE) {
       mb_real Mb[(6 + MB_MAX_MODES) * (6 + MB_MAX_MODES)];
       int nb = 6 + B->nm;
-      mb_flex_body(B->flex, &F[b], q + B->qadr + 7, v + B->vadr + 6, m->gravity, Mb, f);
+      mb_flex_body_stiff(B->flex, B->stiff, &F[b], q + B->qadr + 7, v + B->vadr + 6, m->gravity, Mb, f);
       for (int i = 0; i < nb * nb; i++)
         if (K->T || B->mslotf[i] >= 0) put(K, B->mslotf[i], B->vadr + i / nb, B->vadr + i % nb, Mb[i]);
       continue;
@@ -422,11 +422,11 @@ void mb_model_energy(const mb_model *m, mb_real t, const mb_real *q, const mb_re
       const mb_flex *fx = B->flex;
       const mb_real *w = q + B->qadr + 7;
       mb_real Mb[(6 + MB_MAX_MODES) * (6 + MB_MAX_MODES)], fb[6 + MB_MAX_MODES], S[3], AS[3];
-      T += mb_flex_kinetic(fx, &F[b], w, v + B->vadr + 6, Mb, fb);
+      T += mb_flex_kinetic(fx, B->stiff, &F[b], w, v + B->vadr + 6, Mb, fb);
       /* gravity: -g . (m r + A S(w));  elastic: 1/2 sum k_j w_j^2 */
       mb_real dS[3];
       mb_modal3(fx->S1, fx->nm, w, S);
-      mb_flex_stiff_S(fx, w, dS); /* geometric stiffening: the second-order part */
+      mb_flex_stiff_S(B->stiff, fx, w, dS); /* geometric stiffening: the second-order part */
       for (int i = 0; i < 3; i++) S[i] += fx->S0[i] + dS[i];
       mb_mul3(F[b].A, S, AS);
       U -= mb_dot3(m->gravity, AS) + fx->mass * mb_dot3(m->gravity, F[b].r);
@@ -856,7 +856,7 @@ void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_r
           mb_real Mb[(6 + MB_MAX_MODES) * (6 + MB_MAX_MODES)], fb[6 + MB_MAX_MODES];
           static const mb_real zero[3] = {0, 0, 0};
           const mb_real *vb = v + B->vadr;
-          mb_flex_body(B->flex, &F[b], q + B->qadr + 7, vb + 6, zero, Mb, fb);
+          mb_flex_body_stiff(B->flex, B->stiff, &F[b], q + B->qadr + 7, vb + 6, zero, Mb, fb);
           for (int i = 0; i < 3; i++) {
             p[i] = h[i] = 0;
             for (int l = 0; l < nb; l++) {
