@@ -210,10 +210,16 @@ int flex_reduce(const ir_model *ir, flex_product *out) {
       flex_product_free(out);
       return 2;
     }
-    if (flex_build(B->flex, &out->modes[b], &out->data[b], err, sizeof err) ||
-        (B->flex->geometric_stiffening &&
-         flex_stiffening_build(B->flex, &out->modes[b], &out->data[b], err, sizeof err))) {
+    if (flex_build(B->flex, &out->modes[b], &out->data[b], err, sizeof err)) {
       diag_error(ir->path, B->loc, "flexible body '%s': %s", B->name, err);
+      flex_product_free(out);
+      return 2;
+    }
+    if (B->flex->geometric_stiffening &&
+        flex_stiffening_build(B->flex, &out->modes[b], &out->data[b], err, sizeof err)) {
+      /* at the option's key (line 0 when a scene gave it: at the body) */
+      ir_loc at = B->flex->stiffening_loc.line > 0 ? B->flex->stiffening_loc : B->loc;
+      diag_error(ir->path, at, "flexible body '%s': %s", B->name, err);
       flex_product_free(out);
       return 2;
     }
