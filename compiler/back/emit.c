@@ -569,7 +569,8 @@ static void emit_flex_tables(emit_ctx *cx, int b) {
     real_array(f, nm_, B->stiff->P, 3 * nm * nm);
     snprintf(nm_, sizeof nm_, "flex%d_stiff_R", b);
     real_array(f, nm_, B->stiff->R, 9 * nm * nm);
-    fprintf(f, "static const mb_flex_stiff flex%d_stiff = {flex%d_stiff_P, flex%d_stiff_R};\n", b, b, b);
+    fprintf(f, "static const mb_flex_stiff flex%d_stiff = {flex%d_stiff_P, flex%d_stiff_R, mb_flex_body_stiff};\n",
+            b, b, b);
   }
 }
 

@@ -200,6 +200,7 @@ int flex_stiffening_build(const ir_flex *fx, const fe_modes *fm, flex_data *out,
   clean(out->stiff_R, 9 * (size_t)nm * (size_t)nm);
   out->stiff.P = out->stiff_P;
   out->stiff.R = out->stiff_R;
+  out->stiff.body = mb_flex_body_stiff;
   st = 0;
 done:
   free(freeidx);

@@ -45,9 +45,14 @@ typedef struct {
  * P_ij = sum_k m_k D_kij and R_ij = sum_k m_k D_kij x_k^T, computed at compile
  * time from the beam elements' geometric stiffness (compiler/flex/stiffening.c).
  * Apart from mb_flex (whose initializers in generated code are positional). */
-typedef struct {
+typedef struct mb_flex_stiff {
   const mb_real *P; /* nm x nm 3-vectors, P_ij at P + 3 (i nm + j) */
   const mb_real *R; /* nm x nm 3x3 (row-major), R_ij at R + 9 (i nm + j) */
+  /* mb_flex_body_stiff, called by the generic library through this pointer so
+     that the stiffening's code is linked only into models that use it (the
+     embedded flash budget) */
+  void (*body)(const mb_flex *fx, const struct mb_flex_stiff *st, const mb_frame *f, const mb_real *w,
+               const mb_real *wd, const mb_real g[3], mb_real *Mb, mb_real *fb);
 } mb_flex_stiff;
 
 /* left Jacobian of SO(3) at theta and its time derivative along thetad:
@@ -441,7 +446,9 @@ static inline void mb_flex_body_stiff(const mb_flex *fx, const mb_flex_stiff *st
 static inline void mb_flex_body(const mb_flex *fx, const mb_frame *f, const mb_real *w,
                                 const mb_real *wd, const mb_real g[3], mb_real *Mb,
                                 mb_real *fb) {
-  mb_flex_body_stiff(fx, 0, f, w, wd, g, Mb, fb);
+  mb_flex_step c;
+  mb_flex_contract(fx, w, wd, &c);
+  mb_flex_assemble(fx, &c, f, w, wd, g, Mb, fb);
 }
 
 /* kinetic energy 1/2 v^T M v of a flexible body, elastic energy 1/2 w^T K w */
