@@ -3,7 +3,7 @@
  * joint type and driver profile; generalized spring forces against finite
  * differences of the potential energy; M and the gyroscopic forces against
  * hand-derived values; the generated evaluation against the generic one. */
-// models: fd_all fd_springs spatial_joints slider_crank slider_crank_flexible slider_crank_flexible@virtual2 free_flexible
+// models: fd_all fd_springs spatial_joints slider_crank slider_crank_flexible slider_crank_flexible@virtual2 free_flexible free_flexible_stiff
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,6 +16,7 @@
 #include "slider_crank_flexible.h"
 #include "slider_crank_flexible_virtual2.h"
 #include "free_flexible.h"
+#include "free_flexible_stiff.h"
 
 typedef struct {
   const mb_model *m;
@@ -217,16 +218,23 @@ static void test_constraints_flexible(void **state) {
  * s_f = -d/dt(M_f. v) + dT/dw;  w' (quasi-velocities, Boltzmann-Hamel):
  * s_th = -d/dt(M_th. v) - w' x (M_th. v) + u x A^T rd, u = w' x S + S1 wd,
  * with T = 1/2 v^T M v and d/dt along q (+) tau v at constant v. */
-static void flex_mass(const mb_flex *fx, const double *q, const double *v, double *Mb, double *fb) {
+static void flex_mass(const mb_flex *fx, const mb_flex_stiff *st, const double *q, const double *v, double *Mb,
+                      double *fb) {
   static const double zero[3] = {0, 0, 0};
   mb_frame f;
   mb_frame_rigid(q, v, &f);
-  mb_flex_body(fx, &f, q + 7, v + 6, zero, Mb, fb);
+  mb_flex_body_stiff(fx, st, &f, q + 7, v + 6, zero, Mb, fb);
 }
 
-static void test_flexible_inertia(void **state) {
-  (void)state;
-  const mb_model *m = &free_flexible_model;
+/* S = S0 + S1 w (+ the second-order part with geometric stiffening) */
+static void flex_first_moment(const mb_flex *fx, const mb_flex_stiff *st, const double *w, double S[3]) {
+  double dS[3];
+  mb_modal3(fx->S1, fx->nm, w, S);
+  mb_flex_stiff_S(st, fx, w, dS);
+  for (int i = 0; i < 3; i++) S[i] += fx->S0[i] + dS[i];
+}
+
+static void check_flexible_inertia(const mb_model *m) {
   const mb_body *B = &m->body[0];
   const mb_flex *fx = B->flex;
   int nm = fx->nm, n = 6 + nm;
@@ -234,7 +242,7 @@ static void test_flexible_inertia(void **state) {
   assert_true(n <= 64);
   for (int trial = 0; trial < 5; trial++) {
     random_state(m, q, v);
-    flex_mass(fx, q, v, Mb, fb);
+    flex_mass(fx, B->stiff, q, v, Mb, fb);
     /* s = fb + K w + C wd (no gravity here) */
     double s[64];
     for (int i = 0; i < n; i++) s[i] = fb[i];
@@ -242,8 +250,8 @@ static void test_flexible_inertia(void **state) {
     double h = 1e-6 / fmax(1, sqrt(mb_dot3(v + 3, v + 3)));
     moved(m, q, v, h, qp);
     moved(m, q, v, -h, qm);
-    flex_mass(fx, qp, v, Mp, fp);
-    flex_mass(fx, qm, v, Mm, fp);
+    flex_mass(fx, B->stiff, qp, v, Mp, fp);
+    flex_mass(fx, B->stiff, qm, v, Mm, fp);
     double dMv[64], Mv[64];
     for (int i = 0; i < n; i++) {
       dMv[i] = Mv[i] = 0;
@@ -258,9 +266,14 @@ static void test_flexible_inertia(void **state) {
     /* rotation: -d/dt(M_th. v) - w' x (M_th. v) + u x A^T rd */
     double A[9], S[3], S1wd[3], u[3], Ard[3], t1[3], t2[3];
     mb_euler_to_A(q + 3, A);
-    mb_modal3(fx->S1, nm, q + 7, S);
-    for (int i = 0; i < 3; i++) S[i] += fx->S0[i];
-    mb_modal3(fx->S1, nm, v + 6, S1wd);
+    flex_first_moment(fx, B->stiff, q + 7, S);
+    { /* dS/dt = dS/dw wd by central differences */
+      double wp[64], wm[64], Sp[3], Sm[3], e = 1e-4;
+      for (int j = 0; j < nm; j++) { wp[j] = q[7 + j] + e * v[6 + j]; wm[j] = q[7 + j] - e * v[6 + j]; }
+      flex_first_moment(fx, B->stiff, wp, Sp);
+      flex_first_moment(fx, B->stiff, wm, Sm);
+      for (int i = 0; i < 3; i++) S1wd[i] = (Sp[i] - Sm[i]) / (2 * e);
+    }
     mb_cross3(v + 3, S, u);
     for (int i = 0; i < 3; i++) u[i] += S1wd[i];
     mb_mul3t(A, v, Ard);
@@ -274,8 +287,8 @@ static void test_flexible_inertia(void **state) {
       memcpy(qm, q, sizeof(double) * (size_t)m->nq);
       qp[7 + j] += e;
       qm[7 + j] -= e;
-      flex_mass(fx, qp, v, Mp, fp);
-      flex_mass(fx, qm, v, Mm, fp);
+      flex_mass(fx, B->stiff, qp, v, Mp, fp);
+      flex_mass(fx, B->stiff, qm, v, Mm, fp);
       for (int i = 0; i < n; i++)
         for (int l = 0; l < n; l++) {
           Tp += 0.5 * v[i] * Mp[n * i + l] * v[l];
@@ -291,8 +304,17 @@ static void test_flexible_inertia(void **state) {
       if (err > 1e-6) print_error("s[%d] = %.12g, from Lagrange's equations %.12g\n", i, s[i], ref[i]);
     }
   }
-  print_message("free_flexible: quadratic-velocity forces against Lagrange's equations: worst %.2e\n", worst);
+  print_message("%s: quadratic-velocity forces against Lagrange's equations: worst %.2e\n", m->name, worst);
   assert_true(worst < 1e-6);
+}
+
+static void test_flexible_inertia(void **state) {
+  (void)state;
+  check_flexible_inertia(&free_flexible_model);
+  /* with geometric stiffening: its terms must be Lagrange's too, and present
+     (the stiffening's share of the modal forces, so that this is no repeat) */
+  check_flexible_inertia(&free_flexible_stiff_model);
+  assert_non_null(free_flexible_stiff_model.body[0].stiff);
 }
 
 /* generalized forces of conservative elements = -dU/dq (v = 0: no damping, no gyroscopic terms) */
@@ -359,8 +381,8 @@ static void test_generated_equals_generic(void **state) {
   (void)state;
   const mb_model *models[] = {&fd_all_model, &fd_springs_model, &spatial_joints_model, &slider_crank_model,
                               &slider_crank_flexible_model, &slider_crank_flexible_virtual2_model,
-                              &free_flexible_model};
-  for (int k = 0; k < 7; k++) {
+                              &free_flexible_model, &free_flexible_stiff_model};
+  for (int k = 0; k < 8; k++) {
     const mb_model *m = models[k];
     mb_model g = generic_twin(m);
     evaluator a, b;

@@ -445,6 +445,7 @@ static void emit_tables(emit_ctx *cx) {
       ivec(f, B->mslot, 12);
       if (B->kind == MB_BODY_FLEXIBLE)
         fprintf(f, ", .nm = %d, .flex = &flex%d, .mslotf = flex%d_mslot", B->nm, b, b);
+      if (B->kind == MB_BODY_FLEXIBLE && B->stiff) fprintf(f, ", .stiff = &flex%d_stiff", b);
       fputs("},\n", f);
     }
     fputs("};\n", f);
@@ -622,8 +623,17 @@ static void emit_flex_tables(emit_ctx *cx, int b) {
   fprintf(f, ", flex%d_S1, ", b);
   vec(f, x->J0, 9);
   fprintf(f, ",\n  flex%d_E, flex%d_F, flex%d_G, flex%d_C0, flex%d_CPsi, flex%d_Mff, flex%d_stiffness,\n"
-             "  flex%d_damping, %d, flex%d_node_x, flex%d_node_X, flex%d_node_Psi};\n",
+             "  flex%d_damping, %d, flex%d_node_x, flex%d_node_X, flex%d_node_Psi",
           b, b, b, b, b, b, b, b, nn, b, b, b);
+  fputs("};\n", f);
+  if (B->stiff) { /* geometric stiffening (compiler/flex/stiffening.c) */
+    snprintf(nm_, sizeof nm_, "flex%d_stiff_P", b);
+    real_array(f, nm_, B->stiff->P, 3 * nm * nm);
+    snprintf(nm_, sizeof nm_, "flex%d_stiff_R", b);
+    real_array(f, nm_, B->stiff->R, 9 * nm * nm);
+    fprintf(f, "static const mb_flex_stiff flex%d_stiff = {flex%d_stiff_P, flex%d_stiff_R, mb_flex_body_stiff};\n",
+            b, b, b);
+  }
 }
 
 /* "c->name[k] = c0 + sum_t coef_t * v[idx_t];" with the nonzero terms only,
@@ -834,15 +844,25 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
     fprintf(f, "  /* body '%s' */\n", B->name);
     if (B->kind == MB_BODY_FLEXIBLE) {
       int nbk = 6 + B->nm;
-      fprintf(f, "  {\n    mb_real AS[9], AS1[%d];\n    mb_flex_step cs;\n    flex%d_contract(q + %d, v + %d, &cs);\n"
-                 "    mb_flex_forces(&flex%d, &cs, &f%d, q + %d, v + %d, (const mb_real[3])",
-              B->nm ? 3 * B->nm : 1, b, B->qadr + 7, B->vadr + 6, b, b, B->qadr + 7, B->vadr + 6); /* ISO C: no zero-size array */
+      fprintf(f, "  {\n    mb_real AS[9], AS1[%d];\n    mb_flex_step cs;\n    flex%d_contract(q + %d, v + %d, &cs);\n",
+              B->nm ? 3 * B->nm : 1, b, B->qadr + 7, B->vadr + 6); /* ISO C: no zero-size array */
+      if (B->stiff) /* geometric stiffening: its terms added to the contractions */
+        fprintf(f, "    mb_flex_stiffen(&flex%d_stiff, &flex%d, q + %d, v + %d, &cs);\n", b, b, B->qadr + 7,
+                B->vadr + 6);
+      fprintf(f, "    mb_flex_forces(&flex%d, &cs, &f%d, q + %d, v + %d, (const mb_real[3])",
+              b, b, B->qadr + 7, B->vadr + 6);
       vec(f, m->gravity, 3);
       fprintf(f, ", rhs + %d);\n", B->vadr);
+      if (B->stiff) {
+        fprintf(f, "    mb_flex_stiff_forces(&flex%d, &cs, &f%d, (const mb_real[3])", b, b);
+        vec(f, m->gravity, 3);
+        fprintf(f, ", rhs + %d);\n", B->vadr);
+      }
       fprintf(f, "    /* the mass blocks that move (mb_flex_assemble without m I and Mff, set by init) */\n"
                  "    mb_flex_mass_moving(&flex%d, &cs, &f%d, AS, AS1);\n", b, b);
+      if (B->stiff) fprintf(f, "    mb_flex_stiff_mass(&flex%d, &cs, &f%d, AS1);\n", b, b);
       for (int i = 0; i < nbk * nbk; i++)
-        if (B->mslotf[i] >= 0 && flex_mass_entry(B->flex, i / nbk, i % nbk) == 2) {
+        if (B->mslotf[i] >= 0 && flex_mass_entry(B->flex, B->stiff, i / nbk, i % nbk) == 2) {
           char e[48];
           flex_moving_entry(e, sizeof e, i / nbk, i % nbk);
           fprintf(f, "    Kx[%d] = %s;\n", B->mslotf[i], e);
@@ -940,14 +960,14 @@ static void emit_init(emit_ctx *cx) {
     if (B->kind == MB_BODY_FLEXIBLE) {
       /* the constant entries of the mass block: computed by the kernel at rest */
       int nbk = 6 + B->nm, any = 0;
-      for (int i = 0; i < nbk * nbk; i++) any |= B->mslotf[i] >= 0 && flex_mass_entry(B->flex, i / nbk, i % nbk) == 1;
+      for (int i = 0; i < nbk * nbk; i++) any |= B->mslotf[i] >= 0 && flex_mass_entry(B->flex, B->stiff, i / nbk, i % nbk) == 1;
       if (!any) continue;
       fprintf(f, "  { /* body '%s': constant mass entries */\n    mb_real Mb[%d], fb[%d], w[%d] = {0};\n"
                  "    mb_frame f0 = {{0, 0, 0}, {1, 0, 0, 0, 1, 0, 0, 0, 1}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};\n"
                  "    mb_flex_body(&flex%d, &f0, w, w, w, Mb, fb);\n",
               B->name, nbk * nbk, nbk, nbk, b);
       for (int i = 0; i < nbk * nbk; i++)
-        if (B->mslotf[i] >= 0 && flex_mass_entry(B->flex, i / nbk, i % nbk) == 1)
+        if (B->mslotf[i] >= 0 && flex_mass_entry(B->flex, B->stiff, i / nbk, i % nbk) == 1)
           fprintf(f, "    Kx[%d] = Mb[%d];\n", B->mslotf[i], i);
       fputs("  }\n", f);
       continue;

@@ -146,12 +146,13 @@ int flex_build(const ir_flex *fx, const fe_modes *fm, flex_data *out, char *err,
 void flex_data_free(flex_data *d) {
   free(d->S1); free(d->E); free(d->F); free(d->G); free(d->C0); free(d->CPsi); free(d->Mff);
   free(d->stiffness); free(d->damping); free(d->node_x); free(d->node_X); free(d->node_Psi);
+  free(d->stiff_P); free(d->stiff_R);
   memset(d, 0, sizeof *d);
 }
 
 /* Which entries of the (6+nm)^2 mass block can be nonzero, and which of those
  * never change: 0 none, 1 constant, 2 varying. */
-int flex_mass_entry(const mb_flex *f, int i, int l) {
+int flex_mass_entry(const mb_flex *f, const mb_flex_stiff *st, int i, int l) {
   int nm = f->nm, n = 6 + nm;
   if (i < 0 || l < 0 || i >= n || l >= n) return 0;
   int bi = i < 3 ? 0 : i < 6 ? 1 : 2, bl = l < 3 ? 0 : l < 6 ? 1 : 2;
@@ -159,11 +160,15 @@ int flex_mass_entry(const mb_flex *f, int i, int l) {
   if (bi > bl) { int t = i; i = l; l = t; t = bi; bi = bl; bl = t; }
   double S1n = 0;
   for (int k = 0; k < 3 * nm; k++) S1n += fabs(f->S1[k]);
+  for (size_t k = 0; st && k < 3 * (size_t)nm * (size_t)nm; k++) S1n += fabs(st->P[k]);
   if (bi == 0 && bl == 0) return i == l ? 1 : 0;
   if (bi == 0 && bl == 1) return fabs(f->S0[0]) + fabs(f->S0[1]) + fabs(f->S0[2]) + S1n > 0 ? 2 : 0;
   if (bi == 0 && bl == 2) {
     int j = l - 6;
-    return fabs(f->S1[3 * j]) + fabs(f->S1[3 * j + 1]) + fabs(f->S1[3 * j + 2]) > 0 ? 2 : 0;
+    double Pj = 0; /* geometric stiffening: d S / d w_j gains sum_a w_a P_aj */
+    for (int a = 0; st && a < nm; a++)
+      for (int i = 0; i < 3; i++) Pj += fabs(st->P[3 * ((size_t)a * nm + j) + i]);
+    return fabs(f->S1[3 * j]) + fabs(f->S1[3 * j + 1]) + fabs(f->S1[3 * j + 2]) + Pj > 0 ? 2 : 0;
   }
   if (bi == 1 && bl == 1) return cst ? (f->J0[3 * (i - 3) + (l - 3)] != 0 ? 1 : 0) : 2;
   if (bi == 1 && bl == 2) return cst ? (f->C0[3 * (l - 6) + (i - 3)] != 0 ? 1 : 0) : 2;
@@ -207,6 +212,14 @@ int flex_reduce(const ir_model *ir, flex_product *out) {
     }
     if (flex_build(B->flex, &out->modes[b], &out->data[b], err, sizeof err)) {
       diag_error(ir->path, B->loc, "flexible body '%s': %s", B->name, err);
+      flex_product_free(out);
+      return 2;
+    }
+    if (B->flex->geometric_stiffening &&
+        flex_stiffening_build(B->flex, &out->modes[b], &out->data[b], err, sizeof err)) {
+      /* at the option's key (line 0 when a scene gave it: at the body) */
+      ir_loc at = B->flex->stiffening_loc.line > 0 ? B->flex->stiffening_loc : B->loc;
+      diag_error(ir->path, at, "flexible body '%s': %s", B->name, err);
       flex_product_free(out);
       return 2;
     }

@@ -11,12 +11,18 @@ typedef struct {
   mb_flex flex; /* points into the arrays below */
   double *S1, *E, *F, *G, *C0, *CPsi, *Mff, *stiffness, *damping;
   double *node_x, *node_X, *node_Psi;
+  double *stiff_P, *stiff_R; /* geometric stiffening (NULL: off), stiffening.c */
+  mb_flex_stiff stiff;       /* points into them */
 } flex_data;
 
 int flex_build(const ir_flex *fx, const fe_modes *fm, flex_data *out, char *err, size_t nerr);
 void flex_data_free(flex_data *d);
+/* Geometric stiffening (compiler/flex/stiffening.c): the tables P_ij, R_ij
+ * of mb_flex from the beams' geometric stiffness under the static axial
+ * forces of unit inertia loads; sets out->stiff.  0, or -1 with err. */
+int flex_stiffening_build(const ir_flex *fx, const fe_modes *fm, flex_data *out, char *err, size_t nerr);
 /* 0: structurally zero, 1: constant, 2: varying entry (i, l) of the mass block */
-int flex_mass_entry(const mb_flex *f, int i, int l);
+int flex_mass_entry(const mb_flex *f, const mb_flex_stiff *st, int i, int l);
 
 /* fe_compute_modes with diagnostics at the faulty element; 0 or 2 */
 int flex_compute_modes(const char *path, const ir_body *B, fe_modes *fm);

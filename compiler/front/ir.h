@@ -137,6 +137,8 @@ typedef struct ir_flex {
   double *ratios;          /* DAMPING_LIST, one per selected mode */
   int nratios;
   ir_coupling coupling;
+  bool geometric_stiffening; /* second-order (foreshortening) terms: compiler/flex/stiffening.c */
+  ir_loc stiffening_loc;     /* of the key, when given */
   ir_loc loc;
 } ir_flex;
 

@@ -1184,7 +1184,7 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
       "nodes",   "beams",     "section",     "material", "theory",           "mass",
       "point_masses", "reference", "interface", "modes", "damping", "coupling", "modal_file",
       "fe_file", "initial_modes", "initial_mode_rates", "eigensolver", "sections", "materials",
-      "nonstructural_mass", "node_names", "residual_modes", NULL};
+      "nonstructural_mass", "node_names", "residual_modes", "geometric_stiffening", NULL};
   map_reject(m, "inertia", "flexible body '%s': its inertia comes from its FE model", b->name);
   map_check_keys(m, keys);
   ir_flex *fx = xcalloc(1, sizeof *fx);
@@ -1193,6 +1193,14 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
   fx->select = MODES_ALL;
   fx->coupling = COUPLING_FULL;
   fx->damping = DAMPING_BANDS; /* seed 001 section 2.6: the three-band default */
+  {
+    static const char *const flag_names[] = {"false", "true", NULL};
+    int on = 0;
+    yaml_node_t *gs = map_get(m, "geometric_stiffening");
+    if (gs != NULL) fx->stiffening_loc = loc_of(gs);
+    if (get_choice(m, "geometric_stiffening", "geometric_stiffening setting", flag_names, false, &on))
+      fx->geometric_stiffening = on == 1;
+  }
   yaml_node_t *orientation = map_get(m, "orientation");
   if (orientation != NULL) parse_orientation(r, orientation, m->what, b->orientation);
   get_vector(m, "velocity", 3, false, b->velocity);

@@ -257,6 +257,7 @@ lmodel *lower_model(const ir_model *ir, const flex_product *flex) {
     if (B->kind == BODY_FLEXIBLE) {
       d->kind = MB_BODY_FLEXIBLE;
       d->flex = &L->flexd[b].flex;
+      d->stiff = L->flexd[b].stiff_P ? &L->flexd[b].stiff : NULL; /* geometric stiffening */
       d->nm = d->flex->nm;
       d->mass = d->flex->mass;
       memcpy(d->J, d->flex->J0, sizeof d->J);
@@ -609,7 +610,7 @@ int lower_pattern(lmodel *L) {
       int nbk = 6 + B->nm;
       for (int i = 0; i < nbk; i++)
         for (int l = 0; l < nbk; l++)
-          if (flex_mass_entry(B->flex, i, l)) E[ne++] = (entry){B->vadr + i, B->vadr + l};
+          if (flex_mass_entry(B->flex, B->stiff, i, l)) E[ne++] = (entry){B->vadr + i, B->vadr + l};
       continue;
     }
     if (B->kind != MB_BODY_RIGID) continue;
@@ -667,7 +668,7 @@ int lower_pattern(lmodel *L) {
       if (!L->mslotf[b]) return -1;
       for (int i = 0; i < nbk; i++)
         for (int l = 0; l < nbk; l++)
-          L->mslotf[b][nbk * i + l] = flex_mass_entry(B->flex, i, l)
+          L->mslotf[b][nbk * i + l] = flex_mass_entry(B->flex, B->stiff, i, l)
                                           ? find_slot(L->Kp, L->Ki, B->vadr + i, B->vadr + l)
                                           : -1;
       B->mslotf = L->mslotf[b];

@@ -39,6 +39,22 @@ typedef struct {
   const mb_real *node_Psi;  /* per node 3 x nm, likewise */
 } mb_flex;
 
+/* Geometric stiffening of a flexible body (docs/formulation.md section 12.1;
+ * the option geometric_stiffening): the second-order (foreshortening)
+ * displacement d_k = 1/2 sum_ij w_i w_j D_kij of the nodes enters T through
+ * P_ij = sum_k m_k D_kij and R_ij = sum_k m_k D_kij x_k^T, computed at compile
+ * time from the beam elements' geometric stiffness (compiler/flex/stiffening.c).
+ * Apart from mb_flex (whose initializers in generated code are positional). */
+typedef struct mb_flex_stiff {
+  const mb_real *P; /* nm x nm 3-vectors, P_ij at P + 3 (i nm + j) */
+  const mb_real *R; /* nm x nm 3x3 (row-major), R_ij at R + 9 (i nm + j) */
+  /* mb_flex_body_stiff, called by the generic library through this pointer so
+     that the stiffening's code is linked only into models that use it (the
+     embedded flash budget) */
+  void (*body)(const mb_flex *fx, const struct mb_flex_stiff *st, const mb_frame *f, const mb_real *w,
+               const mb_real *wd, const mb_real g[3], mb_real *Mb, mb_real *fb);
+} mb_flex_stiff;
+
 /* The coefficients of a node rotation exp(T), T = theta~, p = |theta|:
  *   exp(T) = I + s1 T + c1 T^2               (Rodrigues: s1 = sin p / p, c1 = (1 - cos p) / p^2)
  *   Jl = I + a T + b T^2                     (left Jacobian: a = c1, b = (p - sin p) / p^3,
@@ -185,6 +201,10 @@ typedef struct {
   mb_real Fw[9 * MB_MAX_MODES]; /* Fw_j at Fw + 9 j (zero unless coupling is partial or full) */
   mb_real Gw[3 * MB_MAX_MODES]; /* Gw_j at Gw + 3 j: column j of M_thf */
   mb_real Gd[3 * MB_MAX_MODES]; /* Gd_j at Gd + 3 j */
+  /* geometric stiffening only (mb_flex_stiffen): Pw_j = sum_i w_i P_ij,
+     Rw_j = sum_i w_i R_ij, Rwd = sum_j wd_j Rw_j, and the sums over wd_i wd_j
+     of P_ij and R_ij */
+  mb_real Pw[3 * MB_MAX_MODES], Rw[9 * MB_MAX_MODES], Rwd[9], Pdd[3], Rdd[9];
 } mb_flex_step;
 
 static inline void mb_flex_contract(const mb_flex *fx, const mb_real *w, const mb_real *wd,
@@ -224,6 +244,68 @@ static inline void mb_flex_contract(const mb_flex *fx, const mb_real *w, const m
     }
 }
 
+/* U = eps(R): U_a = eps_abc R_cb (the sum over the nodes of m_k x_k x D_k
+ * from that of m_k D_k x_k^T) */
+static inline void mb_flex_stiff_cross(const mb_real R[9], mb_real U[3]) {
+  U[0] = R[7] - R[5];
+  U[1] = R[2] - R[6];
+  U[2] = R[3] - R[1];
+}
+
+/* Geometric stiffening (st of the body): the terms the nodes' second-order
+ * displacement d_k(w) adds to the contractions c of mb_flex_contract, kept to
+ * the products of the rigid velocities with d_k (docs/formulation.md 12.1):
+ *   S += 1/2 sum_j w_j Pw_j,  S1wd += sum_j wd_j Pw_j   (A S1 column j += A Pw_j),
+ *   J += 2 tr(Rww) I - Rww - Rww^T,  Rww = 1/2 sum_j w_j Rw_j,
+ *   Gw_j += eps(Rw_j)  (column j of M_thf),
+ * and the sums mb_flex_forces needs for the matching velocity terms. */
+static inline void mb_flex_stiffen(const mb_flex_stiff *st, const mb_flex *fx, const mb_real *w,
+                                   const mb_real *wd, mb_flex_step *c) {
+  int nm = fx->nm;
+  mb_real Rww[9] = {0}, dS[3] = {0};
+  for (int i = 0; i < 3; i++) c->Pdd[i] = 0;
+  for (int i = 0; i < 9; i++) c->Rwd[i] = c->Rdd[i] = 0;
+  for (int j = 0; j < nm; j++) {
+    mb_real *Pw = c->Pw + 3 * j, *Rw = c->Rw + 9 * j, Pd[3] = {0}, Rd[9] = {0};
+    for (int i = 0; i < 3; i++) Pw[i] = 0;
+    for (int i = 0; i < 9; i++) Rw[i] = 0;
+    for (int a = 0; a < nm; a++) {
+      const mb_real *P = st->P + 3 * (a * nm + j), *R = st->R + 9 * (a * nm + j);
+      for (int i = 0; i < 3; i++) { Pw[i] += w[a] * P[i]; Pd[i] += wd[a] * P[i]; }
+      for (int i = 0; i < 9; i++) { Rw[i] += w[a] * R[i]; Rd[i] += wd[a] * R[i]; }
+    }
+    for (int i = 0; i < 3; i++) {
+      dS[i] += MB_R(0.5) * w[j] * Pw[i];
+      c->S1wd[i] += wd[j] * Pw[i];
+      c->Pdd[i] += wd[j] * Pd[i];
+    }
+    for (int i = 0; i < 9; i++) {
+      Rww[i] += MB_R(0.5) * w[j] * Rw[i];
+      c->Rwd[i] += wd[j] * Rw[i];
+      c->Rdd[i] += wd[j] * Rd[i];
+    }
+    mb_real U[3];
+    mb_flex_stiff_cross(Rw, U);
+    for (int i = 0; i < 3; i++) c->Gw[3 * j + i] += U[i];
+  }
+  mb_real tr = Rww[0] + Rww[4] + Rww[8];
+  for (int i = 0; i < 3; i++) {
+    c->S[i] += dS[i];
+    for (int l = 0; l < 3; l++) c->J[3 * i + l] += 2 * tr * (i == l) - Rww[3 * i + l] - Rww[3 * l + i];
+  }
+}
+
+/* the second-order part of S: 1/2 sum_ij w_i w_j P_ij (0 without stiffening: st NULL) */
+static inline void mb_flex_stiff_S(const mb_flex_stiff *st, const mb_flex *fx, const mb_real *w,
+                                   mb_real dS[3]) {
+  int nm = fx->nm;
+  dS[0] = dS[1] = dS[2] = 0;
+  if (!st) return;
+  for (int a = 0; a < nm; a++)
+    for (int j = 0; j < nm; j++)
+      for (int i = 0; i < 3; i++) dS[i] += MB_R(0.5) * w[a] * w[j] * st->P[3 * (a * nm + j) + i];
+}
+
 /* The blocks of the flexible body's mass matrix that change with the motion
  * and are not contractions already in c:  AS = A S~ (M_rth = -AS, M_thr =
  * -AS^T) and AS1 = A S1 (3 x nm by columns; M_rf = AS1, M_fr = AS1^T).  The
@@ -234,6 +316,16 @@ static inline void mb_flex_mass_moving(const mb_flex *fx, const mb_flex_step *c,
   mb_real Sx[9] = {0, -S[2], S[1], S[2], 0, -S[0], -S[1], S[0], 0};
   mb_matmul3(f->A, Sx, AS);
   for (int j = 0; j < fx->nm; j++) mb_mul3(f->A, fx->S1 + 3 * j, AS1 + 3 * j);
+}
+
+/* geometric stiffening: d S / d w_j gains Pw_j, so A S1 column j gains A Pw_j */
+static inline void mb_flex_stiff_mass(const mb_flex *fx, const mb_flex_step *c, const mb_frame *f,
+                                      mb_real *AS1) {
+  for (int j = 0; j < fx->nm; j++) {
+    mb_real t[3];
+    mb_mul3(f->A, c->Pw + 3 * j, t);
+    for (int i = 0; i < 3; i++) AS1[3 * j + i] += t[i];
+  }
 }
 
 /* The flexible body's forces fb (6+nm), coordinates [rd; w'; wd]: gravity g
@@ -280,6 +372,37 @@ static inline void mb_flex_forces(const mb_flex *fx, const mb_flex_step *c, cons
   }
 }
 
+/* The geometric stiffening's forces (added to fb of mb_flex_forces) from the
+ * contractions of mb_flex_stiffen: Lagrange's equations of its terms of T
+ * (docs/formulation.md 12.1) and of gravity's work on the second-order part. */
+static inline void mb_flex_stiff_forces(const mb_flex *fx, const mb_flex_step *c, const mb_frame *f,
+                                        const mb_real g[3], mb_real *fb) {
+  const mb_real *wl = f->wl;
+  mb_real t[3], Ag[3], ww = mb_dot3(wl, wl);
+  mb_mul3t(f->A, g, Ag);
+  /* s_r -= A sum_ij wd_i wd_j P_ij */
+  mb_mul3(f->A, c->Pdd, t);
+  for (int i = 0; i < 3; i++) fb[i] -= t[i];
+  /* s_th -= dJ' w' + eps(Rdd) + w' x eps(Rwd),  dJ' = 2 tr(Rwd) I - Rwd - Rwd^T */
+  const mb_real *Rd = c->Rwd;
+  mb_real trd = Rd[0] + Rd[4] + Rd[8], Ud[3], Udd[3], wU[3];
+  mb_flex_stiff_cross(Rd, Ud);
+  mb_flex_stiff_cross(c->Rdd, Udd);
+  mb_cross3(wl, Ud, wU);
+  for (int i = 0; i < 3; i++) {
+    mb_real dJw = 2 * trd * wl[i];
+    for (int l = 0; l < 3; l++) dJw -= (Rd[3 * i + l] + Rd[3 * l + i]) * wl[l];
+    fb[3 + i] -= dJw + Udd[i] + wU[i];
+  }
+  /* s_f,j += |w'|^2 tr Rw_j - w'^T Rw_j w' + Pw_j . A^T g: the stiffening */
+  for (int j = 0; j < fx->nm; j++) {
+    const mb_real *R = c->Rw + 9 * j;
+    mb_real Rw3[3];
+    mb_mul3(R, wl, Rw3);
+    fb[6 + j] += ww * (R[0] + R[4] + R[8]) - mb_dot3(wl, Rw3) + mb_dot3(c->Pw + 3 * j, Ag);
+  }
+}
+
 /* The flexible body's mass matrix Mb ((6+nm)^2, row-major, coordinates
  * [rd; w'; wd]) and its forces fb (6+nm) (mb_flex_forces), from the
  * contractions c of mb_flex_contract.  The generated code stores the moving
@@ -312,7 +435,27 @@ static inline void mb_flex_assemble(const mb_flex *fx, const mb_flex_step *c, co
   mb_flex_forces(fx, c, f, w, wd, g, fb);
 }
 
-/* mb_flex_assemble of mb_flex_contract (the generic path's one call) */
+/* mb_flex_assemble of mb_flex_contract (the generic path's one call), with
+ * the geometric stiffening's terms when st is not NULL */
+static inline void mb_flex_body_stiff(const mb_flex *fx, const mb_flex_stiff *st, const mb_frame *f,
+                                      const mb_real *w, const mb_real *wd, const mb_real g[3],
+                                      mb_real *Mb, mb_real *fb) {
+  mb_flex_step c;
+  mb_flex_contract(fx, w, wd, &c);
+  if (st) mb_flex_stiffen(st, fx, w, wd, &c);
+  mb_flex_assemble(fx, &c, f, w, wd, g, Mb, fb);
+  if (!st) return;
+  int n = 6 + fx->nm;
+  mb_real dAS1[3 * MB_MAX_MODES] = {0};
+  mb_flex_stiff_mass(fx, &c, f, dAS1);
+  for (int j = 0; j < fx->nm; j++)
+    for (int i = 0; i < 3; i++) {
+      Mb[n * i + 6 + j] += dAS1[3 * j + i];
+      Mb[n * (6 + j) + i] += dAS1[3 * j + i];
+    }
+  mb_flex_stiff_forces(fx, &c, f, g, fb);
+}
+
 static inline void mb_flex_body(const mb_flex *fx, const mb_frame *f, const mb_real *w,
                                 const mb_real *wd, const mb_real g[3], mb_real *Mb,
                                 mb_real *fb) {
@@ -322,12 +465,12 @@ static inline void mb_flex_body(const mb_flex *fx, const mb_frame *f, const mb_r
 }
 
 /* kinetic energy 1/2 v^T M v of a flexible body, elastic energy 1/2 w^T K w */
-static inline mb_real mb_flex_kinetic(const mb_flex *fx, const mb_frame *f, const mb_real *w,
-                                      const mb_real *wd, mb_real *Mb, mb_real *fb) {
+static inline mb_real mb_flex_kinetic(const mb_flex *fx, const mb_flex_stiff *st, const mb_frame *f,
+                                      const mb_real *w, const mb_real *wd, mb_real *Mb, mb_real *fb) {
   static const mb_real zero[3] = {0, 0, 0};
   int n = 6 + fx->nm;
   mb_real T = 0, v[6 + MB_MAX_MODES];
-  mb_flex_body(fx, f, w, wd, zero, Mb, fb);
+  mb_flex_body_stiff(fx, st, f, w, wd, zero, Mb, fb);
   for (int i = 0; i < 3; i++) { v[i] = f->rd[i]; v[3 + i] = f->wl[i]; }
   for (int j = 0; j < fx->nm; j++) v[6 + j] = wd[j];
   for (int i = 0; i < n; i++)

@@ -37,6 +37,7 @@ typedef struct {
   int nm;            /* flexible: modes (coordinates qadr+7.., vadr+6..) */
   const mb_flex *flex;   /* flexible: invariants and node shapes; else NULL */
   const int *mslotf;     /* flexible: Kx slots of the (6+nm)^2 mass block, row-major; -1: none */
+  const mb_flex_stiff *stiff; /* flexible with geometric stiffening: its tables; else NULL */
 } mb_body;
 
 typedef struct {

@@ -314,6 +314,15 @@ void mb_model_force_tangent(const mb_model *m, mb_real t, const mb_real *q, cons
   }
 }
 
+/* a flexible body's mass block and forces: mb_flex_body, or with geometric
+ * stiffening mb_flex_body_stiff through the body's pointer (its code is then
+ * the model's, not the library's: the embedded flash budget) */
+static void flex_block(const mb_body *B, const mb_frame *f, const mb_real *w, const mb_real *wd,
+                       const mb_real g[3], mb_real *Mb, mb_real *fb) {
+  if (B->stiff) B->stiff->body(B->flex, B->stiff, f, w, wd, g, Mb, fb);
+  else mb_flex_body(B->flex, f, w, wd, g, Mb, fb);
+}
+
 /* The evaluation of both generic variants: entries of K go to the fixed
  * pattern's slots (K written by the caller's init for constants), or, on
  * the general path, every entry of every element block goes to triplets. */
@@ -330,7 +339,7 @@ static void generic_eval(const mb_model *m, mb_real t, const mb_real *q, const m
     if (B->kind == MB_BODY_FLEXIBLE) {
       mb_real Mb[(6 + MB_MAX_MODES) * (6 + MB_MAX_MODES)];
       int nb = 6 + B->nm;
-      mb_flex_body(B->flex, &F[b], q + B->qadr + 7, v + B->vadr + 6, m->gravity, Mb, f);
+      flex_block(B, &F[b], q + B->qadr + 7, v + B->vadr + 6, m->gravity, Mb, f);
       for (int i = 0; i < nb * nb; i++)
         if (K->T || B->mslotf[i] >= 0) put(K, B->mslotf[i], B->vadr + i / nb, B->vadr + i % nb, Mb[i]);
       continue;
@@ -445,10 +454,21 @@ void mb_model_energy(const mb_model *m, mb_real t, const mb_real *q, const mb_re
       const mb_flex *fx = B->flex;
       const mb_real *w = q + B->qadr + 7;
       mb_real Mb[(6 + MB_MAX_MODES) * (6 + MB_MAX_MODES)], fb[6 + MB_MAX_MODES], S[3], AS[3];
-      T += mb_flex_kinetic(fx, &F[b], w, v + B->vadr + 6, Mb, fb);
+      { /* 1/2 v^T Mb v (mb_flex_kinetic through the one flex_block) */
+        static const mb_real zero[3] = {0, 0, 0};
+        int nb = 6 + fx->nm;
+        mb_real vb[6 + MB_MAX_MODES];
+        flex_block(B, &F[b], w, v + B->vadr + 6, zero, Mb, fb);
+        for (int i = 0; i < 3; i++) { vb[i] = F[b].rd[i]; vb[3 + i] = F[b].wl[i]; }
+        for (int j = 0; j < fx->nm; j++) vb[6 + j] = v[B->vadr + 6 + j];
+        for (int i = 0; i < nb; i++)
+          for (int l = 0; l < nb; l++) T += MB_R(0.5) * vb[i] * Mb[nb * i + l] * vb[l];
+      }
       /* gravity: -g . (m r + A S(w));  elastic: 1/2 sum k_j w_j^2 */
+      mb_real dS[3];
       mb_modal3(fx->S1, fx->nm, w, S);
-      for (int i = 0; i < 3; i++) S[i] += fx->S0[i];
+      mb_flex_stiff_S(B->stiff, fx, w, dS); /* geometric stiffening: the second-order part */
+      for (int i = 0; i < 3; i++) S[i] += fx->S0[i] + dS[i];
       mb_mul3(F[b].A, S, AS);
       U -= mb_dot3(m->gravity, AS) + fx->mass * mb_dot3(m->gravity, F[b].r);
       for (int j = 0; j < fx->nm; j++) U += MB_R(0.5) * fx->stiffness[j] * w[j] * w[j];
@@ -910,7 +930,7 @@ void mb_model_outputs(const mb_model *m, mb_real t, const mb_real *q, const mb_r
           mb_real Mb[(6 + MB_MAX_MODES) * (6 + MB_MAX_MODES)], fb[6 + MB_MAX_MODES];
           static const mb_real zero[3] = {0, 0, 0};
           const mb_real *vb = v + B->vadr;
-          mb_flex_body(B->flex, &F[b], q + B->qadr + 7, vb + 6, zero, Mb, fb);
+          flex_block(B, &F[b], q + B->qadr + 7, vb + 6, zero, Mb, fb);
           for (int i = 0; i < 3; i++) {
             p[i] = h[i] = 0;
             for (int l = 0; l < nb; l++) {
