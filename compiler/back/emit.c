@@ -847,20 +847,20 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
       fprintf(f, "  {\n    mb_real AS[9], AS1[%d];\n    mb_flex_step cs;\n    flex%d_contract(q + %d, v + %d, &cs);\n",
               B->nm ? 3 * B->nm : 1, b, B->qadr + 7, B->vadr + 6); /* ISO C: no zero-size array */
       if (B->stiff) /* geometric stiffening: its terms added to the contractions */
-        fprintf(f, "    mb_flex_stiffen(&flex%d_stiff, &flex%d, q + %d, v + %d, &cs);\n", b, b, B->qadr + 7,
-                B->vadr + 6);
+        fprintf(f, "    mb_flex_stiff_step ss;\n    mb_flex_stiffen(&flex%d_stiff, &flex%d, q + %d, v + %d, &cs, &ss);\n",
+                b, b, B->qadr + 7, B->vadr + 6);
       fprintf(f, "    mb_flex_forces(&flex%d, &cs, &f%d, q + %d, v + %d, (const mb_real[3])",
               b, b, B->qadr + 7, B->vadr + 6);
       vec(f, m->gravity, 3);
       fprintf(f, ", rhs + %d);\n", B->vadr);
       if (B->stiff) {
-        fprintf(f, "    mb_flex_stiff_forces(&flex%d, &cs, &f%d, (const mb_real[3])", b, b);
+        fprintf(f, "    mb_flex_stiff_forces(&flex%d, &ss, &f%d, (const mb_real[3])", b, b);
         vec(f, m->gravity, 3);
         fprintf(f, ", rhs + %d);\n", B->vadr);
       }
       fprintf(f, "    /* the mass blocks that move (mb_flex_assemble without m I and Mff, set by init) */\n"
                  "    mb_flex_mass_moving(&flex%d, &cs, &f%d, AS, AS1);\n", b, b);
-      if (B->stiff) fprintf(f, "    mb_flex_stiff_mass(&flex%d, &cs, &f%d, AS1);\n", b, b);
+      if (B->stiff) fprintf(f, "    mb_flex_stiff_mass(&flex%d, &ss, &f%d, AS1);\n", b, b);
       for (int i = 0; i < nbk * nbk; i++)
         if (B->mslotf[i] >= 0 && flex_mass_entry(B->flex, B->stiff, i / nbk, i % nbk) == 2) {
           char e[48];

@@ -201,11 +201,15 @@ typedef struct {
   mb_real Fw[9 * MB_MAX_MODES]; /* Fw_j at Fw + 9 j (zero unless coupling is partial or full) */
   mb_real Gw[3 * MB_MAX_MODES]; /* Gw_j at Gw + 3 j: column j of M_thf */
   mb_real Gd[3 * MB_MAX_MODES]; /* Gd_j at Gd + 3 j */
-  /* geometric stiffening only (mb_flex_stiffen): Pw_j = sum_i w_i P_ij,
-     Rw_j = sum_i w_i R_ij, Rwd = sum_j wd_j Rw_j, and the sums over wd_i wd_j
-     of P_ij and R_ij */
-  mb_real Pw[3 * MB_MAX_MODES], Rw[9 * MB_MAX_MODES], Rwd[9], Pdd[3], Rdd[9];
 } mb_flex_step;
+
+/* The geometric stiffening's own contractions (mb_flex_stiffen): Pw_j =
+ * sum_i w_i P_ij, Rw_j = sum_i w_i R_ij, Rwd = sum_j wd_j Rw_j, and the sums
+ * over wd_i wd_j of P_ij and R_ij.  Apart from mb_flex_step, so that a body
+ * without the option keeps its small stack (embedded targets). */
+typedef struct {
+  mb_real Pw[3 * MB_MAX_MODES], Rw[9 * MB_MAX_MODES], Rwd[9], Pdd[3], Rdd[9];
+} mb_flex_stiff_step;
 
 static inline void mb_flex_contract(const mb_flex *fx, const mb_real *w, const mb_real *wd,
                                     mb_flex_step *c) {
@@ -260,13 +264,13 @@ static inline void mb_flex_stiff_cross(const mb_real R[9], mb_real U[3]) {
  *   Gw_j += eps(Rw_j)  (column j of M_thf),
  * and the sums mb_flex_forces needs for the matching velocity terms. */
 static inline void mb_flex_stiffen(const mb_flex_stiff *st, const mb_flex *fx, const mb_real *w,
-                                   const mb_real *wd, mb_flex_step *c) {
+                                   const mb_real *wd, mb_flex_step *c, mb_flex_stiff_step *sc) {
   int nm = fx->nm;
   mb_real Rww[9] = {0}, dS[3] = {0};
-  for (int i = 0; i < 3; i++) c->Pdd[i] = 0;
-  for (int i = 0; i < 9; i++) c->Rwd[i] = c->Rdd[i] = 0;
+  for (int i = 0; i < 3; i++) sc->Pdd[i] = 0;
+  for (int i = 0; i < 9; i++) sc->Rwd[i] = sc->Rdd[i] = 0;
   for (int j = 0; j < nm; j++) {
-    mb_real *Pw = c->Pw + 3 * j, *Rw = c->Rw + 9 * j, Pd[3] = {0}, Rd[9] = {0};
+    mb_real *Pw = sc->Pw + 3 * j, *Rw = sc->Rw + 9 * j, Pd[3] = {0}, Rd[9] = {0};
     for (int i = 0; i < 3; i++) Pw[i] = 0;
     for (int i = 0; i < 9; i++) Rw[i] = 0;
     for (int a = 0; a < nm; a++) {
@@ -277,12 +281,12 @@ static inline void mb_flex_stiffen(const mb_flex_stiff *st, const mb_flex *fx, c
     for (int i = 0; i < 3; i++) {
       dS[i] += MB_R(0.5) * w[j] * Pw[i];
       c->S1wd[i] += wd[j] * Pw[i];
-      c->Pdd[i] += wd[j] * Pd[i];
+      sc->Pdd[i] += wd[j] * Pd[i];
     }
     for (int i = 0; i < 9; i++) {
       Rww[i] += MB_R(0.5) * w[j] * Rw[i];
-      c->Rwd[i] += wd[j] * Rw[i];
-      c->Rdd[i] += wd[j] * Rd[i];
+      sc->Rwd[i] += wd[j] * Rw[i];
+      sc->Rdd[i] += wd[j] * Rd[i];
     }
     mb_real U[3];
     mb_flex_stiff_cross(Rw, U);
@@ -319,11 +323,11 @@ static inline void mb_flex_mass_moving(const mb_flex *fx, const mb_flex_step *c,
 }
 
 /* geometric stiffening: d S / d w_j gains Pw_j, so A S1 column j gains A Pw_j */
-static inline void mb_flex_stiff_mass(const mb_flex *fx, const mb_flex_step *c, const mb_frame *f,
+static inline void mb_flex_stiff_mass(const mb_flex *fx, const mb_flex_stiff_step *sc, const mb_frame *f,
                                       mb_real *AS1) {
   for (int j = 0; j < fx->nm; j++) {
     mb_real t[3];
-    mb_mul3(f->A, c->Pw + 3 * j, t);
+    mb_mul3(f->A, sc->Pw + 3 * j, t);
     for (int i = 0; i < 3; i++) AS1[3 * j + i] += t[i];
   }
 }
@@ -375,19 +379,19 @@ static inline void mb_flex_forces(const mb_flex *fx, const mb_flex_step *c, cons
 /* The geometric stiffening's forces (added to fb of mb_flex_forces) from the
  * contractions of mb_flex_stiffen: Lagrange's equations of its terms of T
  * (docs/formulation.md 12.1) and of gravity's work on the second-order part. */
-static inline void mb_flex_stiff_forces(const mb_flex *fx, const mb_flex_step *c, const mb_frame *f,
+static inline void mb_flex_stiff_forces(const mb_flex *fx, const mb_flex_stiff_step *sc, const mb_frame *f,
                                         const mb_real g[3], mb_real *fb) {
   const mb_real *wl = f->wl;
   mb_real t[3], Ag[3], ww = mb_dot3(wl, wl);
   mb_mul3t(f->A, g, Ag);
   /* s_r -= A sum_ij wd_i wd_j P_ij */
-  mb_mul3(f->A, c->Pdd, t);
+  mb_mul3(f->A, sc->Pdd, t);
   for (int i = 0; i < 3; i++) fb[i] -= t[i];
   /* s_th -= dJ' w' + eps(Rdd) + w' x eps(Rwd),  dJ' = 2 tr(Rwd) I - Rwd - Rwd^T */
-  const mb_real *Rd = c->Rwd;
+  const mb_real *Rd = sc->Rwd;
   mb_real trd = Rd[0] + Rd[4] + Rd[8], Ud[3], Udd[3], wU[3];
   mb_flex_stiff_cross(Rd, Ud);
-  mb_flex_stiff_cross(c->Rdd, Udd);
+  mb_flex_stiff_cross(sc->Rdd, Udd);
   mb_cross3(wl, Ud, wU);
   for (int i = 0; i < 3; i++) {
     mb_real dJw = 2 * trd * wl[i];
@@ -396,10 +400,10 @@ static inline void mb_flex_stiff_forces(const mb_flex *fx, const mb_flex_step *c
   }
   /* s_f,j += |w'|^2 tr Rw_j - w'^T Rw_j w' + Pw_j . A^T g: the stiffening */
   for (int j = 0; j < fx->nm; j++) {
-    const mb_real *R = c->Rw + 9 * j;
+    const mb_real *R = sc->Rw + 9 * j;
     mb_real Rw3[3];
     mb_mul3(R, wl, Rw3);
-    fb[6 + j] += ww * (R[0] + R[4] + R[8]) - mb_dot3(wl, Rw3) + mb_dot3(c->Pw + 3 * j, Ag);
+    fb[6 + j] += ww * (R[0] + R[4] + R[8]) - mb_dot3(wl, Rw3) + mb_dot3(sc->Pw + 3 * j, Ag);
   }
 }
 
@@ -441,19 +445,20 @@ static inline void mb_flex_body_stiff(const mb_flex *fx, const mb_flex_stiff *st
                                       const mb_real *w, const mb_real *wd, const mb_real g[3],
                                       mb_real *Mb, mb_real *fb) {
   mb_flex_step c;
+  mb_flex_stiff_step sc;
   mb_flex_contract(fx, w, wd, &c);
-  if (st) mb_flex_stiffen(st, fx, w, wd, &c);
+  if (st) mb_flex_stiffen(st, fx, w, wd, &c, &sc);
   mb_flex_assemble(fx, &c, f, w, wd, g, Mb, fb);
   if (!st) return;
   int n = 6 + fx->nm;
   mb_real dAS1[3 * MB_MAX_MODES] = {0};
-  mb_flex_stiff_mass(fx, &c, f, dAS1);
+  mb_flex_stiff_mass(fx, &sc, f, dAS1);
   for (int j = 0; j < fx->nm; j++)
     for (int i = 0; i < 3; i++) {
       Mb[n * i + 6 + j] += dAS1[3 * j + i];
       Mb[n * (6 + j) + i] += dAS1[3 * j + i];
     }
-  mb_flex_stiff_forces(fx, &c, f, g, fb);
+  mb_flex_stiff_forces(fx, &sc, f, g, fb);
 }
 
 static inline void mb_flex_body(const mb_flex *fx, const mb_frame *f, const mb_real *w,
