@@ -323,6 +323,36 @@ static int keep_removed_rows(lmodel *L, const int *keep) {
   return 0;
 }
 
+/* A rotation driver's row is phi = sin(angle - th), zero at th and at th + pi:
+ * Newton from the model's configuration finds the second when the profile
+ * starts more than 90 degrees from it, and the mechanism would then run half
+ * a turn off, its driver effort with the wrong sign.  The row evaluated
+ * against th + pi/2 is -cos(angle - th): positive there.  0 or 2 (reported). */
+static int check_driver_branches(lmodel *L, evalbuf *e) {
+  mb_model *m = &L->m;
+  for (int r = 0; r < m->nc; r++) {
+    if (L->row[r].kind != MB_PRIM_ROT) continue;
+    int p = L->row[r].profile;
+    mb_profile given = L->profile[p];
+    mb_real th[3];
+    mb_profile_eval(&given, 0, th);
+    L->profile[p] = (mb_profile){.kind = MB_PROFILE_CONSTANT, .c = {th[0] + 0.5 * acos(-1.0)}, .nc = 1};
+    evaluate(m, e, L->q0, L->v0);
+    double minus_cos = e->phi[r];
+    L->profile[p] = given;
+    if (minus_cos > 0) {
+      diag_error(L->ir->path, L->row_loc[r],
+                 "%s, which starts at %.6g rad; a rotation driver counts from the configuration "
+                 "the model gives, and the assembly found the joint half a turn from that, at "
+                 "%.6g rad: start the profile within 90 degrees of 0 and give the bodies the angle "
+                 "instead", L->row_desc[r], th[0], remainder(th[0] - acos(-1.0), 2 * acos(-1.0)));
+      return 2;
+    }
+  }
+  evaluate(m, e, L->q0, L->v0);
+  return 0;
+}
+
 int assemble_model(lmodel *L, int verbose) {
   mb_model *m = &L->m;
   const char *file = L->ir->path;
@@ -373,6 +403,7 @@ int assemble_model(lmodel *L, int verbose) {
   }
   if (verbose && it > 0)
     fprintf(stderr, "%s: note: assembly: positions corrected in %d Newton iteration(s)\n", file, it);
+  if (check_driver_branches(L, &e)) goto out;
 
   /* 2. redundant rows: those the basis leaves out; driver rows lead */
   evaluate(m, &e, L->q0, L->v0);
