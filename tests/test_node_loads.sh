@@ -56,7 +56,7 @@ awk 'NR == FNR { plane[$1] = $2; next }
     exit bad }' planes.txt suggest.log || { cat suggest.log planes.txt; err "the ranking by the point force"; }
 
 # --- a beam element from the tip to the ground: its reaction's lever ------------
-sed 's|^  push: .*|&\n  stay: {type: beam, bodies: [beam, ground], nodes: [5, ~], points: [[1, 0, 0], [1.5, 0, 0]], section: {area: 1.0e-4, Iy: 1.0e-9, Iz: 1.0e-9, J: 2.0e-9}, material: {E: 2.1e11, nu: 0.3, density: 7850}}|' \
+sed 's|^  push: .*|&\n  stay: {type: beam, bodies: [ground, beam], nodes: [~, 5], points: [[1.5, 0, 0], [1, 0, 0]], section: {area: 1.0e-4, Iy: 1.0e-9, Iz: 1.0e-9, J: 2.0e-9}, material: {E: 2.1e11, nu: 0.3, density: 7850}}|' \
   tip.yaml > stay.yaml
 sed 's|^simulation:|outputs:\n  - {name: tip, type: position, body: beam, node: 5}\n&|' stay.yaml > stay_tip.yaml
 "$MBCC" run stay.yaml --body beam --loads stay.csv > run2.log 2>&1 || { cat run2.log; err "run --loads with the stay"; }

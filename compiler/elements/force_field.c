@@ -89,6 +89,17 @@ static bool to_matrix6(reader *r, yaml_node_t *n, const char *label, double out[
   return ok;
 }
 
+/* The kernels apply a field-type element's reaction on side 0 (the wrench at
+ * point 1) through body 0's frame as if it were rigid: on an FE node it would
+ * miss the flexible body's modes (a conservative bushing gained energy without
+ * bound).  Until that side carries node columns, refuse it. */
+static void refuse_node_on_side0(mapping *m, const ir_force *f, const char *what) {
+  if (f->node[0] < 0) return;
+  error_at(m->r, m->loc, "%s: its first body ('bodies'[0]) is on an FE node, where the element's reaction "
+           "would act on the body frame and not on the modes; list the flexible body second "
+           "(two FE nodes cannot be joined by one %s yet)", what, what);
+}
+
 /* 'bodies' and one 'point' for both sides, or the point of the node given
  * ('node' / 'nodes'): a bushing's or a field's */
 static void parse_pair_at_point(mapping *m, ir_force *f) {
@@ -102,6 +113,7 @@ static void parse_pair_at_point(mapping *m, ir_force *f) {
     if (!given)
       memcpy(f->point[f->node[0] >= 0 ? 1 : 0], f->point[f->node[0] >= 0 ? 0 : 1], sizeof f->point[0]);
   }
+  refuse_node_on_side0(m, f, f->kind == FORCE_FIELD ? "field" : "bushing");
 }
 
 /* field: a general 6x6 stiffness and damping between two bodies (seed 001 3.2.6) */
@@ -133,6 +145,7 @@ static void parse_beam_force(mapping *m, ir_force *f) {
   bool given = points != NULL && to_vector_list(r, points, "'points'", 2, 3, &f->point[0][0]);
   if (on_nodes)
     check_node_point(r, r->model, points ? loc_of(points) : m->loc, f->body, f->node, given, &f->point[0][0]);
+  refuse_node_on_side0(m, f, "beam");
   int th = 0;
   if (get_choice(m, "theory", "beam theory", theory_names, false, &th)) f->beam.theory = (ir_beam_theory)th;
   f->beam.yaxis[1] = 1;
