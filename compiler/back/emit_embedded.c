@@ -97,9 +97,9 @@ static int has_power_law(const lmodel *L) {
  * kernel out (mb_spring.h: no powf, no newlib errno and reentrancy data), one
  * without tyres the tyre (mb_tyre.h: no asinf), and mb_step.c keeps only the
  * package's integrator. */
-static int has_tyre(const lmodel *L) {
+static int has_force_kind(const lmodel *L, mb_force_kind kind) {
   for (int k = 0; k < L->m.nforce; k++)
-    if (L->force[k].kind == MB_FORCE_TYRE) return 1;
+    if (L->force[k].kind == kind) return 1;
   return 0;
 }
 
@@ -112,9 +112,12 @@ static int package_settings(const char *path, const mbc_unit *u, int integrator)
   if (!has_power_law(u->lowered))
     fputs("\n/* the model has no power-law spring: its kernel (and powf) is left out */\n"
           "#define MB_NO_POWER_LAW 1\n", f);
-  if (!has_tyre(u->lowered))
+  if (!has_force_kind(u->lowered, MB_FORCE_TYRE))
     fputs("\n/* the model has no tyre: the element (and asinf) is left out */\n"
           "#define MB_NO_TYRE 1\n", f);
+  if (!has_force_kind(u->lowered, MB_FORCE_SUPERELEMENT))
+    fputs("\n/* the model has no superelement: its kernel is left out */\n"
+          "#define MB_NO_SUPERELEMENT 1\n", f);
   fprintf(f, "\n/* the package steps with one integrator: mb_step.c leaves the other out */\n"
              "#define MB_STEP_INTEGRATOR_ONLY %d\n", integrator == 2 ? 2 : 0);
   return fclose(f) ? 2 : 0;

@@ -26,6 +26,18 @@ static inline int mb_superelement_nprm(int n) { return 1 + 3 * n + 72 * n * n; }
  * force F[3k..] and torque T[3k..] on node k (k = 0..n-1 for nodes 1..n) at
  * its point are R0 (-K u - C ud) of its rows; the reaction of each acts on
  * node 0's body at that same point.  Returns 1/2 u^T K u. */
+#ifdef MB_NO_SUPERELEMENT
+/* An embedded package of a model without superelements defines
+ * MB_NO_SUPERELEMENT (in its mb_types.h): the element is left out of its
+ * flash.  A superelement reaching it gives NaN, which the step reports
+ * (MB_ERR_NONFINITE). */
+static inline mb_real mb_superelement(const mb_marker *m0, const mb_marker *const *mk, const mb_real *prm,
+                                      mb_real *F, mb_real *T) {
+  (void)m0, (void)mk;
+  for (int k = 0; k < 3 * (int)prm[MB_SUPER_N]; k++) F[k] = T[k] = (mb_real)NAN;
+  return (mb_real)NAN;
+}
+#else
 static inline mb_real mb_superelement(const mb_marker *m0, const mb_marker *const *mk, const mb_real *prm,
                                       mb_real *F, mb_real *T) {
   int n = (int)prm[MB_SUPER_N], nd = 6 * n;
@@ -50,5 +62,7 @@ static inline mb_real mb_superelement(const mb_marker *m0, const mb_marker *cons
   }
   return E;
 }
+
+#endif /* MB_NO_SUPERELEMENT */
 
 #endif
