@@ -62,6 +62,23 @@ static void pass_on(int sig) {
     if (running_many[i] > 0) kill(running_many[i], sig);
 }
 
+/* the child's side of a fork: the caller's signal actions and mask back,
+ * death with mbcc, then argv */
+static _Noreturn void exec_child(char *const argv[], const struct sigaction old[3], const sigset_t *saved, pid_t parent) {
+  static const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
+  for (int i = 0; i < 3; i++) sigaction(sigs[i], &old[i], NULL);
+  sigprocmask(SIG_SETMASK, saved, NULL);
+#ifdef __linux__
+  prctl(PR_SET_PDEATHSIG, SIGTERM);
+  if (getppid() != parent) _exit(128 + SIGTERM); /* mbcc died before prctl */
+#else
+  (void)parent;
+#endif
+  execvp(argv[0], argv);
+  fprintf(stderr, "mbcc: error: cannot run '%s': %s\n", argv[0], strerror(errno));
+  _exit(127);
+}
+
 int proc_run(char *const argv[]) { return proc_run_watch(argv, NULL, NULL); }
 
 int proc_run_watch(char *const argv[], void (*tick)(void *), void *user) {
@@ -81,19 +98,7 @@ int proc_run_watch(char *const argv[], void (*tick)(void *), void *user) {
   for (int i = 0; i < 3; i++) sigaction(sigs[i], &sa, &old[i]);
   pid_t parent = getpid();
   pid_t pid = fork();
-  if (pid == 0) {
-    for (int i = 0; i < 3; i++) sigaction(sigs[i], &old[i], NULL);
-    sigprocmask(SIG_SETMASK, &saved, NULL);
-#ifdef __linux__
-    prctl(PR_SET_PDEATHSIG, SIGTERM);
-    if (getppid() != parent) _exit(128 + SIGTERM); /* mbcc died before prctl */
-#else
-    (void)parent;
-#endif
-    execvp(argv[0], argv);
-    fprintf(stderr, "mbcc: error: cannot run '%s': %s\n", argv[0], strerror(errno));
-    _exit(127);
-  }
+  if (pid == 0) exec_child(argv, old, &saved, parent);
   running = pid;
   sigprocmask(SIG_SETMASK, &saved, NULL);
   int status = 0, rc;
@@ -122,23 +127,6 @@ int proc_run_watch(char *const argv[], void (*tick)(void *), void *user) {
     raise(received);
   }
   return rc;
-}
-
-/* the child's side of a fork: the caller's signal actions and mask back,
- * death with mbcc, then argv */
-static void exec_child(char *const argv[], const struct sigaction old[3], const sigset_t *saved, pid_t parent) {
-  static const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
-  for (int i = 0; i < 3; i++) sigaction(sigs[i], &old[i], NULL);
-  sigprocmask(SIG_SETMASK, saved, NULL);
-#ifdef __linux__
-  prctl(PR_SET_PDEATHSIG, SIGTERM);
-  if (getppid() != parent) _exit(128 + SIGTERM);
-#else
-  (void)parent;
-#endif
-  execvp(argv[0], argv);
-  fprintf(stderr, "mbcc: error: cannot run '%s': %s\n", argv[0], strerror(errno));
-  _exit(127);
 }
 
 int proc_run_many(char **const argvs[], int n, int jobs) {
