@@ -62,6 +62,22 @@ static void pass_on(int sig) {
     if (running_many[i] > 0) kill(running_many[i], sig);
 }
 
+/* SIGINT, SIGTERM and SIGHUP passed on to the children (pass_on), with the
+ * three blocked until the caller unblocks them (saved): none may fall between
+ * a child's creation and 'running' naming it.  old: the actions to restore;
+ * block: the three */
+static void catch_signals(struct sigaction old[3], sigset_t *saved, sigset_t *block) {
+  static const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = pass_on;
+  sigemptyset(&sa.sa_mask);
+  sigemptyset(block);
+  for (int i = 0; i < 3; i++) sigaddset(block, sigs[i]);
+  sigprocmask(SIG_BLOCK, block, saved);
+  for (int i = 0; i < 3; i++) sigaction(sigs[i], &sa, &old[i]);
+}
+
 /* the child's side of a fork: the caller's signal actions and mask back,
  * death with mbcc, then argv */
 static _Noreturn void exec_child(char *const argv[], const struct sigaction old[3], const sigset_t *saved, pid_t parent) {
@@ -85,17 +101,9 @@ int proc_run_watch(char *const argv[], void (*tick)(void *), void *user) {
   fflush(stdout);
   fflush(stderr);
   static const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
-  struct sigaction sa, old[3];
-  memset(&sa, 0, sizeof sa);
-  sa.sa_handler = pass_on;
-  sigemptyset(&sa.sa_mask);
-  /* block the signals over the fork, so that none falls between the child's
-     creation and 'running' naming it */
-  sigset_t block, saved;
-  sigemptyset(&block);
-  for (int i = 0; i < 3; i++) sigaddset(&block, sigs[i]);
-  sigprocmask(SIG_BLOCK, &block, &saved);
-  for (int i = 0; i < 3; i++) sigaction(sigs[i], &sa, &old[i]);
+  struct sigaction old[3];
+  sigset_t saved, block;
+  catch_signals(old, &saved, &block);
   pid_t parent = getpid();
   pid_t pid = fork();
   if (pid == 0) exec_child(argv, old, &saved, parent);
@@ -135,15 +143,9 @@ int proc_run_many(char **const argvs[], int n, int jobs) {
   if (jobs < 1) jobs = 1;
   if (jobs > MAX_JOBS) jobs = MAX_JOBS;
   static const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
-  struct sigaction sa, old[3];
-  memset(&sa, 0, sizeof sa);
-  sa.sa_handler = pass_on;
-  sigemptyset(&sa.sa_mask);
-  sigset_t block, saved;
-  sigemptyset(&block);
-  for (int i = 0; i < 3; i++) sigaddset(&block, sigs[i]);
-  sigprocmask(SIG_BLOCK, &block, &saved);
-  for (int i = 0; i < 3; i++) sigaction(sigs[i], &sa, &old[i]);
+  struct sigaction old[3];
+  sigset_t saved, block;
+  catch_signals(old, &saved, &block);
   pid_t parent = getpid();
   int next = 0, active = 0, rc = 0;
   while (next < n || active > 0) {
