@@ -344,7 +344,7 @@ static int check_driver_branches(lmodel *L, evalbuf *e) {
       diag_error(L->ir->path, L->row_loc[r],
                  "%s, which starts at %.6g rad; a rotation driver counts from the configuration "
                  "the model gives, and the assembly found the joint half a turn from that, at "
-                 "%.6g rad: start the profile within 90 degrees of 0 and give the bodies the angle "
+                 "%.6g rad: start the profile at (or near) 0 and give the bodies the angle "
                  "instead", L->row_desc[r], th[0], remainder(th[0] - acos(-1.0), 2 * acos(-1.0)));
       return 2;
     }
