@@ -947,16 +947,34 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
   if (eval_split_finish(&sp, out, nm, head, emit_files_eval_hooks(EF)) < 0) cx->failed = 1;
 }
 
-static void emit_init(emit_ctx *cx) {
-  FILE *f = cx->f;
+/* init's statements per function when a large model's init is split: gcc's
+ * dead store elimination grows with the square of the stores of one function
+ * (measured: docs/architecture.md, "The evaluation in parts") */
+#define INIT_PART_LINES 500
+
+/* one element's start in init's body (a body's or a row's statements): a
+ * part of a split init may begin there */
+typedef struct {
+  long at, lines; /* offset in the text, lines before it */
+} init_mark;
+
+static long count_lines(const char *text, long a, long b) {
+  long n = 0;
+  for (long i = a; i < b; i++) n += text[i] == '\n';
+  return n;
+}
+
+/* the body of init (its statements after the zeroing), marks at its elements */
+static void emit_init_body(emit_ctx *cx, FILE *f, init_mark *mark, int *nmark, char **text) {
   const lmodel *L = cx->L;
-  const char *nm = cx->nm;
   const mb_model *m = &L->m;
-  fprintf(f, "\n/* The constant entries of K (mass matrix, constant Jacobian entries); all else 0. */\n"
-             "void %s_init(const mb_model *m, mb_real *Kx) {\n  (void)m;\n"
-             "  for (int i = 0; i < %d; i++) Kx[i] = 0;\n", nm, m->nnz);
   for (int b = 0; b < m->nbody; b++) {
     const mb_body *B = &L->body[b];
+    fflush(f);
+    mark[*nmark].at = ftell(f);
+    mark[*nmark].lines = count_lines(*text, *nmark ? mark[*nmark - 1].at : 0, mark[*nmark].at) +
+                         (*nmark ? mark[*nmark - 1].lines : 0);
+    (*nmark)++;
     if (B->kind == MB_BODY_FLEXIBLE) {
       /* the constant entries of the mass block: computed by the kernel at rest */
       int nbk = 6 + B->nm, any = 0;
@@ -983,13 +1001,73 @@ static void emit_init(emit_ctx *cx) {
   }
   for (int r = 0; r < m->nrow; r++) {
     const mb_rowdef *R = &L->row[r];
+    fflush(f);
+    mark[*nmark].at = ftell(f);
+    mark[*nmark].lines = count_lines(*text, *nmark ? mark[*nmark - 1].at : 0, mark[*nmark].at) +
+                         (*nmark ? mark[*nmark - 1].lines : 0);
+    (*nmark)++;
     for (int s = 0; s < 2; s++)
       for (int j = 0; j < 6; j++)
         if (R->constant[s][j] && R->slot[s][j] >= 0)
           fprintf(f, "  Kx[%d] = Kx[%d] = %d; /* row %d: %s */\n", R->slot[s][j], R->slotT[s][j],
                   s ? 1 : -1, r, L->row_desc[r]);
   }
-  fputs("}\n", f);
+  fflush(f);
+}
+
+static void emit_init(emit_ctx *cx) {
+  FILE *out = cx->f;
+  const char *nm = cx->nm;
+  const mb_model *m = &cx->L->m;
+  char *text = NULL;
+  size_t len = 0;
+  FILE *f = open_memstream(&text, &len);
+  init_mark *mark = malloc(sizeof *mark * (size_t)(m->nbody + m->nrow + 1));
+  if (!f || !mark) {
+    if (f) fclose(f);
+    free(text);
+    free(mark);
+    cx->failed = 1;
+    return;
+  }
+  int nmark = 0;
+  emit_init_body(cx, f, mark, &nmark, &text);
+  if (ferror(f)) cx->failed = 1;
+  fclose(f);
+  long total = count_lines(text, 0, (long)len);
+  /* the parts: elements grouped greedily up to INIT_PART_LINES; a small
+     init stays one function, as before */
+  int nparts = 0;
+  if (total > 2 * INIT_PART_LINES) {
+    long from = 0, from_lines = 0;
+    for (int i = 0; i <= nmark; i++) {
+      long at = i < nmark ? mark[i].at : (long)len, lines = i < nmark ? mark[i].lines : total;
+      if (lines - from_lines < INIT_PART_LINES && i < nmark) continue;
+      if (at == from) continue;
+      if (!nparts)
+        fputs("\n#if defined(__GNUC__)\n#define INIT_NOINLINE __attribute__((noinline))\n#else\n"
+              "#define INIT_NOINLINE\n#endif\n", out);
+      fprintf(out, "\n/* part %d of init: %ld statement lines (init in parts of bounded size, so that the\n"
+                   " * C compiler's cost per function stays bounded) */\n"
+                   "static INIT_NOINLINE void %s_init_part%d(mb_real *Kx) {\n",
+              nparts + 1, lines - from_lines, nm, nparts);
+      fwrite(text + from, 1, (size_t)(at - from), out);
+      fputs("}\n", out);
+      nparts++;
+      from = at;
+      from_lines = lines;
+    }
+  }
+  fprintf(out, "\n/* The constant entries of K (mass matrix, constant Jacobian entries); all else 0. */\n"
+               "void %s_init(const mb_model *m, mb_real *Kx) {\n  (void)m;\n"
+               "  for (int i = 0; i < %d; i++) Kx[i] = 0;\n", nm, m->nnz);
+  if (nparts)
+    for (int p = 0; p < nparts; p++) fprintf(out, "  %s_init_part%d(Kx);\n", nm, p);
+  else
+    fwrite(text, 1, len, out);
+  fputs("}\n", out);
+  free(text);
+  free(mark);
 }
 
 /* the first comment lines of a generated file: its name, mbcc's version, the

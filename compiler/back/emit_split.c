@@ -27,6 +27,15 @@
 #include "emit_split.h"
 
 #define DEFAULT_PART_BYTES 24000L /* measured: docs/benchmarks.md, "Evaluation in parts" */
+/* what one inlined kernel call costs gcc, in bytes of plain emitted text
+ * (measured: docs/architecture.md, "The evaluation in parts") */
+#define DEFAULT_CALL_BYTES 0L
+
+/* from this many parts on, <m>_eval calls them in a loop over a table */
+#define LOOPED_CALLS_FROM 64
+
+static int ident_start(int c) { return isalpha(c) || c == '_'; }
+static int ident_char(int c) { return isalnum(c) || c == '_'; }
 
 long eval_part_bytes(void) {
   const char *e = getenv("MBCC_EVAL_PART_BYTES");
@@ -36,6 +45,37 @@ long eval_part_bytes(void) {
     if (*end == 0 && v >= 0) return v;
   }
   return DEFAULT_PART_BYTES;
+}
+
+long eval_call_bytes(void) {
+  const char *e = getenv("MBCC_EVAL_CALL_BYTES");
+  if (e && *e) {
+    char *end;
+    long v = strtol(e, &end, 10);
+    if (*end == 0 && v >= 0) return v;
+  }
+  return DEFAULT_CALL_BYTES;
+}
+
+/* the calls of runtime kernels in text[a, b) that gcc inlines (an
+ * identifier mb_<name> followed by '('), not counting the small vector
+ * helpers whose inlined body is about the size of their call */
+static long kernel_calls(const char *text, long a, long b) {
+  static const char *const small[] = {"mb_cross3", "mb_dot3", "mb_mul3", "mb_mul3t", "mb_col3"};
+  long n = 0;
+  for (long i = a; i + 3 < b; i++) {
+    if (text[i] != 'm' || text[i + 1] != 'b' || text[i + 2] != '_' || (i > a && ident_char((unsigned char)text[i - 1])))
+      continue;
+    long e = i + 3;
+    while (e < b && ident_char((unsigned char)text[e])) e++;
+    if (e >= b || text[e] != '(') { i = e; continue; }
+    int is_small = 0;
+    for (size_t k = 0; k < sizeof small / sizeof *small; k++)
+      if ((size_t)(e - i) == strlen(small[k]) && !memcmp(text + i, small[k], (size_t)(e - i))) is_small = 1;
+    n += !is_small;
+    i = e;
+  }
+  return n;
 }
 
 int eval_split_begin(eval_split *s) {
@@ -163,9 +203,6 @@ static int add(vars *t, const char *p, size_t n, const char *type, int array, in
 }
 
 /* --- a small reader of the emitted C ---------------------------------------- */
-
-static int ident_start(int c) { return isalpha(c) || c == '_'; }
-static int ident_char(int c) { return isalnum(c) || c == '_'; }
 
 /* a top-level declaration at p (after a statement end): its type (mb_frame,
  * mb_marker, mb_real, or "" when it is not a declaration), its name and
@@ -308,21 +345,29 @@ int eval_split_finish(eval_split *s, FILE *out, const char *nm, const char *head
   if (s->failed || fflush(s->body) || ferror(s->body)) { free_split(s); return -1; }
   fclose(s->body);
   s->body = NULL;
-  long len = (long)s->len, budget = eval_part_bytes();
-  /* the parts: marks grouped greedily up to the budget */
+  long len = (long)s->len, budget = eval_part_bytes(), call = eval_call_bytes();
+  /* the parts: marks grouped greedily up to the budget, each element
+     weighed by its text and its inlined kernel calls (what gcc sees) */
   int *first = malloc(sizeof *first * (size_t)(s->nmark + 2));
-  if (!first) { free_split(s); return -1; }
+  long *cost = malloc(sizeof *cost * (size_t)(s->nmark + 1));
+  if (!first || !cost) { free(first); free(cost); free_split(s); return -1; }
+  cost[0] = 0; /* cost[i]: of the text before mark i; cost[nmark]: of all */
+  for (int i = 0; i < s->nmark; i++) {
+    long a = s->mark[i], b = i + 1 < s->nmark ? s->mark[i + 1] : len;
+    cost[i + 1] = cost[i] + (b - a) + call * kernel_calls(s->text, a, b);
+  }
   int nparts = 0;
   long start = 0;
   if (budget > 0 && len > 2 * budget && s->nmark > 1 && s->mark[0] == 0) {
     first[nparts++] = 0;
     for (int i = 1; i < s->nmark; i++) {
-      if (s->mark[i] - start >= budget) {
+      if (cost[i] - start >= budget) {
         first[nparts++] = i;
-        start = s->mark[i];
+        start = cost[i];
       }
     }
   }
+  free(cost);
   first[nparts] = s->nmark;
   vars t = {0};
   int ok = nparts > 1;
@@ -401,7 +446,15 @@ int eval_split_finish(eval_split *s, FILE *out, const char *nm, const char *head
   if (files) fprintf(out, "\n#include \"%s\"\n", files->header_name);
   fputs(head, out);
   fprintf(out, "  %s_eval_shared W;\n", nm);
-  for (int p = 0; p < nparts; p++) fprintf(out, "  %s_eval_part%d(&W, m, t, q, v, Kx, rhs, phi, phid);\n", nm, p);
+  if (nparts > LOOPED_CALLS_FROM) {
+    /* one call in a loop over a table of the parts: gcc's alias analysis
+       walks, at each call that may write W, the calls before it (measured:
+       the 1000-link chain's 286 calls cost 7 s of gcc CPU written out) */
+    fprintf(out, "  static void (*const part[%d])(%s_eval_shared *, %s) = {\n", nparts, nm, part_args);
+    for (int p = 0; p < nparts; p++) fprintf(out, "    %s_eval_part%d%s\n", nm, p, p + 1 < nparts ? "," : "");
+    fprintf(out, "  };\n  for (int i = 0; i < %d; i++) part[i](&W, m, t, q, v, Kx, rhs, phi, phid);\n", nparts);
+  } else
+    for (int p = 0; p < nparts; p++) fprintf(out, "  %s_eval_part%d(&W, m, t, q, v, Kx, rhs, phi, phid);\n", nm, p);
   fputs("}\n", out);
   if (!ok_files) nparts = -1;
   free_vars(&t);

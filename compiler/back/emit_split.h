@@ -30,6 +30,9 @@ void eval_split_mark_lines(eval_split *s, long from, const char *prefix, const c
 /* about this many bytes of body text per part; the body is split when it is
  * larger than two parts (MBCC_EVAL_PART_BYTES overrides it, for measurement) */
 long eval_part_bytes(void);
+/* what one call of an inlined runtime kernel weighs in that budget, in bytes
+ * (MBCC_EVAL_CALL_BYTES overrides it, for measurement) */
+long eval_call_bytes(void);
 /* Where the parts go when they are compiled as translation units of their
  * own (emit_files.c): the shared struct and the parts' prototypes into
  * 'header' (the private header 'header_name', which 'out' then includes), part
