@@ -29,7 +29,7 @@
 #define DEFAULT_PART_BYTES 24000L /* measured: docs/benchmarks.md, "Evaluation in parts" */
 /* what one inlined kernel call costs gcc, in bytes of plain emitted text
  * (measured: docs/architecture.md, "The evaluation in parts") */
-#define DEFAULT_CALL_BYTES 0L
+#define DEFAULT_CALL_BYTES 300L
 
 /* from this many parts on, <m>_eval calls them in a loop over a table */
 #define LOOPED_CALLS_FROM 64
