@@ -950,7 +950,10 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
 /* init's statements per function when a large model's init is split: gcc's
  * dead store elimination grows with the square of the stores of one function
  * (measured: docs/architecture.md, "The evaluation in parts") */
-#define INIT_PART_LINES 500
+#define INIT_PART_LINES 500L
+
+/* MBCC_INIT_PART_LINES overrides it, for measurement and tests (0: one function) */
+static long init_part_lines(void) { return emit_size_setting("MBCC_INIT_PART_LINES", INIT_PART_LINES); }
 
 /* one element's start in init's body (a body's or a row's statements): a
  * part of a split init may begin there */
@@ -1035,14 +1038,15 @@ static void emit_init(emit_ctx *cx) {
   if (ferror(f)) cx->failed = 1;
   fclose(f);
   long total = count_lines(text, 0, (long)len);
-  /* the parts: elements grouped greedily up to INIT_PART_LINES; a small
+  /* the parts: elements grouped greedily up to part_lines; a small
      init stays one function, as before */
   int nparts = 0;
-  if (total > 2 * INIT_PART_LINES) {
+  long part_lines = init_part_lines();
+  if (part_lines > 0 && total > 2 * part_lines) {
     long from = 0, from_lines = 0;
     for (int i = 0; i <= nmark; i++) {
       long at = i < nmark ? mark[i].at : (long)len, lines = i < nmark ? mark[i].lines : total;
-      if (lines - from_lines < INIT_PART_LINES && i < nmark) continue;
+      if (lines - from_lines < part_lines && i < nmark) continue;
       if (at == from) continue;
       if (!nparts)
         fputs("\n#if defined(__GNUC__)\n#define INIT_NOINLINE __attribute__((noinline))\n#else\n"

@@ -27,15 +27,7 @@
 
 #define DEFAULT_FILE_BYTES 100000L /* measured: docs/architecture.md, "The evaluation in parts" */
 
-long eval_file_bytes(void) {
-  const char *e = getenv("MBCC_EVAL_FILE_BYTES");
-  if (e && *e) {
-    char *end;
-    long v = strtol(e, &end, 10);
-    if (*end == 0 && v >= 0) return v;
-  }
-  return DEFAULT_FILE_BYTES;
-}
+long eval_file_bytes(void) { return emit_size_setting("MBCC_EVAL_FILE_BYTES", DEFAULT_FILE_BYTES); }
 
 static int text_open(gen_text *g) {
   if (g->f) return 0;

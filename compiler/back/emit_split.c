@@ -32,30 +32,24 @@
 #define DEFAULT_CALL_BYTES 300L
 
 /* from this many parts on, <m>_eval calls them in a loop over a table */
-#define LOOPED_CALLS_FROM 64
+#define LOOPED_CALLS_FROM 32
 
 static int ident_start(int c) { return isalpha(c) || c == '_'; }
 static int ident_char(int c) { return isalnum(c) || c == '_'; }
 
-long eval_part_bytes(void) {
-  const char *e = getenv("MBCC_EVAL_PART_BYTES");
+long emit_size_setting(const char *env, long fallback) {
+  const char *e = getenv(env);
   if (e && *e) {
     char *end;
     long v = strtol(e, &end, 10);
     if (*end == 0 && v >= 0) return v;
   }
-  return DEFAULT_PART_BYTES;
+  return fallback;
 }
 
-long eval_call_bytes(void) {
-  const char *e = getenv("MBCC_EVAL_CALL_BYTES");
-  if (e && *e) {
-    char *end;
-    long v = strtol(e, &end, 10);
-    if (*end == 0 && v >= 0) return v;
-  }
-  return DEFAULT_CALL_BYTES;
-}
+long eval_part_bytes(void) { return emit_size_setting("MBCC_EVAL_PART_BYTES", DEFAULT_PART_BYTES); }
+
+long eval_call_bytes(void) { return emit_size_setting("MBCC_EVAL_CALL_BYTES", DEFAULT_CALL_BYTES); }
 
 /* the calls of runtime kernels in text[a, b) that gcc inlines (an
  * identifier mb_<name> followed by '('), not counting the small vector

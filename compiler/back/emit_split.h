@@ -27,6 +27,9 @@ void eval_split_mark(eval_split *s, const char *fmt, ...);
  * with 'prefix' (a block of independent statements, e.g. one per pair of
  * bodies, that may go to different parts) */
 void eval_split_mark_lines(eval_split *s, long from, const char *prefix, const char *label);
+/* a size setting of the emitters: the environment variable 'env' when it is
+ * a whole number >= 0 (for measurement and tests), else 'fallback' */
+long emit_size_setting(const char *env, long fallback);
 /* about this many bytes of body text per part; the body is split when it is
  * larger than two parts (MBCC_EVAL_PART_BYTES overrides it, for measurement) */
 long eval_part_bytes(void);
