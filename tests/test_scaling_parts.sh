@@ -26,7 +26,7 @@ bash "$root/scripts/chain.sh" 200 > chain200.yaml
 nfiles=$(wc -l < g200/chain200.sources)
 # each evaluation part: bytes + 300 per kernel call (not the small vector helpers)
 worst=$(cat g200/chain200_eval*.c | awk '
-  /^EVAL_NOINLINE void .*_eval_part[0-9]+\(/ { inpart = 1; cost = 0; name = $3 }
+  /^EVAL_NOINLINE void .*_eval_part[0-9]+\(/ { inpart = 1; cost = 0; name = $3; sub(/\(.*/, "", name) }
   inpart {
     cost += length($0) + 1
     line = $0
