@@ -949,7 +949,7 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
 
 /* init's statements per function when a large model's init is split: gcc's
  * dead store elimination grows with the square of the stores of one function
- * (measured: docs/architecture.md, "The evaluation in parts") */
+ * (measured: docs/architecture.md, "What a part costs the C compiler") */
 #define INIT_PART_LINES 500L
 
 /* MBCC_INIT_PART_LINES overrides it, for measurement and tests (0: one function) */
@@ -967,17 +967,22 @@ static long count_lines(const char *text, long a, long b) {
   return n;
 }
 
+/* a mark where the text written to f (a memory stream over 'text') ends now */
+static void add_init_mark(FILE *f, char *const *text, init_mark *mark, int *nmark) {
+  fflush(f); /* the stream's text (*text, which fflush may move) is valid up to ftell */
+  long at = ftell(f), from = *nmark ? mark[*nmark - 1].at : 0;
+  mark[*nmark].at = at;
+  mark[*nmark].lines = (*nmark ? mark[*nmark - 1].lines : 0) + count_lines(*text, from, at);
+  (*nmark)++;
+}
+
 /* the body of init (its statements after the zeroing), marks at its elements */
 static void emit_init_body(emit_ctx *cx, FILE *f, init_mark *mark, int *nmark, char **text) {
   const lmodel *L = cx->L;
   const mb_model *m = &L->m;
   for (int b = 0; b < m->nbody; b++) {
     const mb_body *B = &L->body[b];
-    fflush(f);
-    mark[*nmark].at = ftell(f);
-    mark[*nmark].lines = count_lines(*text, *nmark ? mark[*nmark - 1].at : 0, mark[*nmark].at) +
-                         (*nmark ? mark[*nmark - 1].lines : 0);
-    (*nmark)++;
+    add_init_mark(f, text, mark, nmark);
     if (B->kind == MB_BODY_FLEXIBLE) {
       /* the constant entries of the mass block: computed by the kernel at rest */
       int nbk = 6 + B->nm, any = 0;
@@ -1004,11 +1009,7 @@ static void emit_init_body(emit_ctx *cx, FILE *f, init_mark *mark, int *nmark, c
   }
   for (int r = 0; r < m->nrow; r++) {
     const mb_rowdef *R = &L->row[r];
-    fflush(f);
-    mark[*nmark].at = ftell(f);
-    mark[*nmark].lines = count_lines(*text, *nmark ? mark[*nmark - 1].at : 0, mark[*nmark].at) +
-                         (*nmark ? mark[*nmark - 1].lines : 0);
-    (*nmark)++;
+    add_init_mark(f, text, mark, nmark);
     for (int s = 0; s < 2; s++)
       for (int j = 0; j < 6; j++)
         if (R->constant[s][j] && R->slot[s][j] >= 0)

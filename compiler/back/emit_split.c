@@ -28,7 +28,7 @@
 
 #define DEFAULT_PART_BYTES 24000L /* measured: docs/benchmarks.md, "Evaluation in parts" */
 /* what one inlined kernel call costs gcc, in bytes of plain emitted text
- * (measured: docs/architecture.md, "The evaluation in parts") */
+ * (measured: docs/architecture.md, "What a part costs the C compiler") */
 #define DEFAULT_CALL_BYTES 300L
 
 /* from this many parts on, <m>_eval calls them in a loop over a table */
