@@ -21,7 +21,8 @@
  *     residual or refinement, as a library LDL^T would do it; with weighted
  *     rows it still refines.  Returns MB_OK or MB_ERR_NONFINITE.
  *
- * Below the flop budget (LDL_FLOP_BUDGET, order.h) every operation is emitted
+ * Below the flop budget (order.h: the host's compile-time limit, the embedded
+ * target's flash budget) every operation is emitted
  * with constant indices (straight-line, the factorization split into
  * out-of-line parts of about LDL_CHUNK_FLOPS); above it the same operations
  * run as loops over static const index arrays, so that the C compiler's time
