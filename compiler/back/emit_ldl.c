@@ -890,13 +890,12 @@ static void emit_blocks_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *
       }
   }
   cx->ldl.kput_k1 = 1;
-  fputs("/* Kc (the entries of K' the block pivots set) from Kx; returns 0, or 1 + a column\n"
-        " * of a virtual body whose Du is singular.  Entries known at compile time (a\n"
-        " * weld's unit translational rows) are literals where they are read, not stored */\n"
-        "static int ldl_block_pivots(const mb_real *Kx, mb_real *work) {\n"
-        "  mb_real *Kc = work + LDL_KR, *Di, *W, v;\n", f);
-  if (cx->ldl.k1_direct) fputs("  const mb_real *K1 = work + LDL_K1; /* the massless bodies' computed entries */\n  (void)K1;\n", f);
-  fputs("  /* the entries of K' that no block changes (the others: at their first change) */\n", f);
+  /* a function per block (and one for the entries no block changes): one
+     function of all of them took gcc 8 s on the car with 8 virtual bodies */
+  const char *k1_local = cx->ldl.k1_direct ? "  const mb_real *K1 = work + LDL_K1; /* the massless bodies' computed entries */\n  (void)K1;\n" : "";
+  fprintf(f, "/* the entries of K' that no block changes (the others: at their first change) */\n"
+             "static LDL_NOINLINE void ldl_block_fixed(const mb_real *Kx, mb_real *work) {\n"
+             "  mb_real *Kc = work + LDL_KR;\n%s", k1_local);
   for (int k = 0; k < nkc; k++) {
     double c;
     if (updated[k]) continue;
@@ -908,9 +907,13 @@ static void emit_blocks_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *
     kname(cx, src[k]);
     fputs(";\n", f);
   }
+  fputs("  (void)Kx;\n  (void)Kc;\n}\n\n", f);
   for (int e = 0, w0 = 0; e < p->nelim; e++) {
     int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
-    fprintf(f, "  /* block %d: Du^-1, W = Eu Du^-1, K'(s, x) -= (W Dx)(s, x) */\n", e);
+    fprintf(f, "/* block %d: Du^-1, W = Eu Du^-1, K'(s, x) -= (W Dx)(s, x); 0, or 1 + a column of\n"
+               " * the virtual body if its Du is singular */\n"
+               "static LDL_NOINLINE int ldl_block_pivot%d(const mb_real *Kx, mb_real *work) {\n"
+               "  mb_real *Kc = work + LDL_KR, *Di, *W, v;\n%s", e, e, k1_local);
     fprintf(f, "  Di = work + %ld;\n  W = Di + 42;\n", woff[e]);
     {
       char fail[32];
@@ -1016,10 +1019,17 @@ static void emit_blocks_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *
       }
     }
     w0 += 6 * ns;
+    fputs("  (void)v;\n  (void)W;\n  (void)Kc;\n  return 0;\n}\n\n", f);
   }
   free(src);
   free(updated);
-  fputs("  (void)v;\n  (void)W;\n  (void)Kc;\n  return 0;\n}\n\n", f);
+  fputs("/* Kc (the entries of K' the block pivots set) from Kx; returns 0, or 1 + a column\n"
+        " * of a virtual body whose Du is singular.  Entries known at compile time (a\n"
+        " * weld's unit translational rows) are literals where they are read, not stored */\n"
+        "static int ldl_block_pivots(const mb_real *Kx, mb_real *work) {\n"
+        "  int rc = 0;\n  ldl_block_fixed(Kx, work);\n", f);
+  for (int e = 0; e < p->nelim; e++) fprintf(f, "  if ((rc = ldl_block_pivot%d(Kx, work)) != 0) return rc;\n", e);
+  fputs("  return rc;\n}\n\n", f);
 
   fputs(BLOCK_RHS_COMMENT
         "static void ldl_block_rhs(const mb_real *Kx, const mb_real *work, mb_real *r) {\n"
