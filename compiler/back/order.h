@@ -144,7 +144,8 @@ typedef struct {
   int nsets;         /* CAMD constraint sets used */
   int straight;      /* 1: straight-line code, 0: loops over tables */
   double budget;     /* the flop budget per factorization that chose, or < 0: the host's rule */
-  double cc_seconds; /* straight-line code's estimated gcc -O2 CPU (the host's rule) */
+  double cc_seconds; /* straight-line code's estimated gcc -O2 CPU (the host's rule): of the
+                        flops of factor and solve, block pivots and massless bodies */
 } ldl_plan;
 
 /* Build the plan of the lowered, assembled model.  Returns 0, or -1 (out of
