@@ -393,8 +393,8 @@ static const char *factor_part_params(const emit_ctx *cx, const ldl_plan *p) {
       "const mb_real *MB_RESTRICT Kx, mb_real *MB_RESTRICT Lx, mb_real *MB_RESTRICT Dinv",
       "const mb_real *MB_RESTRICT Kx, const mb_real *MB_RESTRICT Kc, mb_real *MB_RESTRICT Lx, mb_real *MB_RESTRICT Dinv",
       "const mb_real *MB_RESTRICT Kx, const mb_real *MB_RESTRICT K1, mb_real *MB_RESTRICT Lx, mb_real *MB_RESTRICT Dinv",
-      "const mb_real *MB_RESTRICT Kx, const mb_real *MB_RESTRICT Kc, const mb_real *MB_RESTRICT K1, mb_real *MB_RESTRICT Lx, "
-      "mb_real *MB_RESTRICT Dinv"};
+      ("const mb_real *MB_RESTRICT Kx, const mb_real *MB_RESTRICT Kc, const mb_real *MB_RESTRICT K1, mb_real *MB_RESTRICT Lx, "
+       "mb_real *MB_RESTRICT Dinv")};
   return v[(p->nelim ? 1 : 0) + (cx->ldl.k1_direct ? 2 : 0)];
 }
 
