@@ -380,6 +380,25 @@ the triplets into a compressed matrix at every factorization (its design:
 no compile-time pattern).  On the flexible car the LDLᵀ factor is over half
 of the generated step: the ratio to generic + KLU is set there.
 
+**The flexible car's LDLᵀ straight-line** (the form chosen by a measured
+compile-time limit instead of a fixed flop budget: docs/architecture.md,
+"The choice"): its 30 862 + 7 680 flops now run as straight-line code
+(before: loops over tables).  Cachegrind, the same 0.5 s bench run (521
+steps): 1506.0 M instructions → 786.3 M, **2.89 M → 1.51 M per step**; on
+the 0.1 s run (121 steps, process start and set-up included) the
+generic + KLU path takes 1563.1 M against 188.8 M, a ratio of **8.3** in
+instructions (4.3 before).  The `rigid` scene keeps straight-line code and
+`flexible_virtual` keeps loops (its 8 block pivots add about 18 000 flops of
+code: 14.8 s of estimated gcc CPU, above the 12 s limit), so their steps do
+not change.  What it costs: the flexible car's build, `/usr/bin/time` of
+`mbcc run --end 0.01` from a clean directory at load average 15–17 (5 other
+engineers building), 10.8 s of CPU before, 25.5 s after (the rigid car 14.5 s,
+flexible_virtual 12.8 s at the same load; CPU time grows with the load: on an idle
+machine the flexible car's straight-line LDLᵀ files take about 10 s of the
+25.5 s).  Timed medians at that load are not a measure (one bench
+repetition: generated + LDLᵀ 5.6 ms a step after, 3.8 ms before, on a
+machine whose cores run 8 processes each); the instruction counts are.
+
 Reproduce: `valgrind --tool=cachegrind --cache-sim=no DIR/sports_car_SCENE_bench
 --end 0.5 --reps 1 --paths generated+ldl --quiet` (DIR: the `generated/`
 directory `mbcc bench models/sports_car.yaml --scene SCENE` leaves), then

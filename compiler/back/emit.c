@@ -1161,19 +1161,15 @@ static int emit_source(emit_ctx *cx, emit_files *EF, char **text, size_t *len) {
   int ldl;
   if (EF->active) {
     if (fflush(f) || emit_files_tables(EF, f, *text, *len)) return 1;
-    /* the LDL^T in a file of its own; its wrappers for the model record stay */
-    char *ltext = NULL;
-    size_t llen = 0;
-    FILE *lf = open_memstream(&ltext, &llen);
+    /* the LDL^T in files of its own; its wrappers for the model record stay */
+    ldl_out out;
+    FILE *lf = emit_files_ldl(EF, f, &out);
     if (!lf) { cx->failed = 1; return 0; }
     cx->f = lf;
-    ldl = emit_ldl(cx);
+    ldl = emit_ldl(cx, &out);
     cx->f = f;
-    if (fflush(lf) || emit_files_ldl(EF, f, ltext, llen, "static int ldl_factor_m(")) cx->failed = 1;
-    fclose(lf);
-    free(ltext);
   } else
-    ldl = emit_ldl(cx);
+    ldl = emit_ldl(cx, NULL);
   fprintf(f, "\nconst mb_model %s_model = {\n", nm);
   fprintf(f, "  .name = \"%s\",\n  .nbody = %d, .nmarker = %d, .nrow = %d, .nforce = %d,\n"
              "  .nprofile = %d, .noutput = %d, .njoint = %d,\n"
@@ -1336,7 +1332,7 @@ static void remove_stale(const char *dir, const char *nm, char **old, const char
     int keep = 0;
     for (int k = 0; k < nnow; k++) keep |= !strcmp(old[i], now[k]);
     size_t n = strlen(nm);
-    int ours = !strncmp(old[i], nm, n) && (!strncmp(old[i] + n, "_eval", 5) || !strcmp(old[i] + n, "_ldl.c"));
+    int ours = !strncmp(old[i], nm, n) && (!strncmp(old[i] + n, "_eval", 5) || !strncmp(old[i] + n, "_ldl", 4));
     if (!keep && ours) {
       snprintf(path, sizeof path, "%s/%s", dir, old[i]);
       remove(path);

@@ -354,24 +354,40 @@ int emit_files_tables(emit_files *F, FILE *src, const char *text, size_t len) {
   return rc ? -1 : text_sync(&F->refs);
 }
 
-int emit_files_ldl(emit_files *F, FILE *src, const char *ldl, size_t len, const char *wrappers_from) {
-  const char *w = NULL;
-  size_t wl = strlen(wrappers_from);
-  for (const char *p = ldl; p + wl <= ldl + len && !w; p++)
-    if ((p == ldl || p[-1] == '\n') && !memcmp(p, wrappers_from, wl)) w = p;
-  if (!w || w == ldl) { /* not found: the LDL^T stays in <m>.c */
-    fwrite(ldl, 1, len, src);
-    return 0;
+/* the stream of the LDL^T's next part: the last file while it holds less
+ * than file_bytes, else a new one */
+static FILE *ldl_part_file(void *ctx, int *fresh) {
+  emit_files *F = ctx;
+  *fresh = 0;
+  if (F->nldl_part) {
+    gen_text *g = F->ldl_part[F->nldl_part - 1];
+    if (text_sync(g)) return NULL;
+    if ((long)g->len < F->file_bytes) return g->f;
   }
-  snprintf(F->ldl.name, sizeof F->ldl.name, "%s_ldl.c", F->nm);
-  if (text_open(&F->ldl)) return -1;
-  fwrite(ldl, 1, (size_t)(w - ldl), F->ldl.f);
-  fwrite(w, 1, (size_t)(ldl + len - w), src);
-  F->has_ldl = 1;
-  return text_sync(&F->ldl);
+  /* each its own allocation: its stream writes through &g->text, &g->len */
+  gen_text **v = realloc(F->ldl_part, sizeof *v * (size_t)(F->nldl_part + 1));
+  if (!v) return NULL;
+  F->ldl_part = v;
+  gen_text *g = calloc(1, sizeof *g);
+  if (!g) return NULL;
+  v[F->nldl_part++] = g;
+  snprintf(g->name, sizeof g->name, "%s_ldl%d.c", F->nm, F->nldl_part - 1);
+  if (text_open(g)) return NULL;
+  *fresh = 1;
+  return g->f;
 }
 
-int emit_files_count(const emit_files *F) { return F->active ? 2 + F->neval + F->has_ldl : 0; }
+FILE *emit_files_ldl(emit_files *F, FILE *src, ldl_out *out) {
+  snprintf(F->ldl.name, sizeof F->ldl.name, "%s_ldl.c", F->nm);
+  if (text_open(&F->ldl)) return NULL;
+  F->has_ldl = 1;
+  out->wrappers = src;
+  out->part_file = ldl_part_file;
+  out->ctx = F;
+  return F->ldl.f;
+}
+
+int emit_files_count(const emit_files *F) { return F->active ? 2 + F->neval + F->has_ldl + F->nldl_part : 0; }
 
 /* a malloc'ed copy of a + b + c */
 static char *join3(const char *a, const char *b, size_t blen, const char *c, size_t *len) {
@@ -417,10 +433,13 @@ char *emit_files_text(emit_files *F, int i, const char **name, size_t *len) {
     free(a);
     return r;
   }
-  if (F->has_ldl && i == F->neval + 1) {
-    *name = F->ldl.name;
+  int k = i - F->neval - 1 - F->has_ldl; /* an LDL^T part file: k >= 0 */
+  if (F->has_ldl && k < F->nldl_part) {
+    gen_text *g = k < 0 ? &F->ldl : F->ldl_part[k];
+    if (text_sync(g)) return NULL;
+    *name = g->name;
     snprintf(head, sizeof head, "\n#include \"%s.h\"\n\n", F->nm);
-    return join3(head, F->ldl.text, F->ldl.len, "", len);
+    return join3(head, g->text, g->len, "", len);
   }
   /* the list of the C files, <m>.c first */
   static char list_name[320];
@@ -431,6 +450,8 @@ char *emit_files_text(emit_files *F, int i, const char **name, size_t *len) {
   for (int k = 0; k < F->neval; k++)
     if (append(&r, "%s\n", F->eval[k].name)) { free(r); return NULL; }
   if (F->has_ldl && append(&r, "%s\n", F->ldl.name)) { free(r); return NULL; }
+  for (int k = 0; k < F->nldl_part; k++)
+    if (append(&r, "%s\n", F->ldl_part[k]->name)) { free(r); return NULL; }
   *len = strlen(r);
   return r;
 }
@@ -445,6 +466,11 @@ void emit_files_free(emit_files *F) {
   free(F->eval);
   free(F->eval_macros);
   text_free(&F->ldl);
+  for (int k = 0; k < F->nldl_part; k++) {
+    text_free(F->ldl_part[k]);
+    free(F->ldl_part[k]);
+  }
+  free(F->ldl_part);
   for (int i = 0; i < F->ncopied; i++) {
     free(F->copied[i].decl_head);
     free(F->copied[i].params);

@@ -14,6 +14,7 @@
 
 #include <stdio.h>
 
+#include "emit_ldl.h"
 #include "emit_split.h"
 
 typedef struct {
@@ -42,6 +43,8 @@ typedef struct {
   char **eval_macros; /* each one's table macros */
   int neval;
   gen_text ldl;       /* <m>_ldl.c body */
+  gen_text **ldl_part; /* <m>_ldl<k>.c: the straight-line LDL^T's parts */
+  int nldl_part;
   keep_decl *copied;
   int ncopied;
   int active;         /* the evaluation went into files */
@@ -65,9 +68,11 @@ int emit_files_tables(emit_files *F, FILE *src, const char *text, size_t len);
 /* at the end of <m>.c (its text so far in 'text'): a pointer to each static
  * copied into the parts that <m>.c itself does not read (no unused static) */
 int emit_files_keep(emit_files *F, FILE *src, const char *text, size_t len);
-/* the LDL^T's text 'ldl' (what emit_ldl wrote): its factor and solve go to
- * <m>_ldl.c, the model record's wrappers (from 'wrappers_from' on) to src */
-int emit_files_ldl(emit_files *F, FILE *src, const char *ldl, size_t len, const char *wrappers_from);
+/* the LDL^T in files of its own: returns the stream of <m>_ldl.c (NULL: out
+ * of memory) and sets *out for emit_ldl: the wrappers the model record
+ * points at to src, the straight-line code's parts to <m>_ldl0.c,
+ * <m>_ldl1.c, ... of about file_bytes of text each */
+FILE *emit_files_ldl(emit_files *F, FILE *src, ldl_out *out);
 /* the extra files, each as its text after the origin comment: n of them */
 int emit_files_count(const emit_files *F);
 /* file i: its name; its text (the caller frees it) after the comment line */

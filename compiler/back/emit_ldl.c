@@ -21,11 +21,14 @@
  *     residual or refinement, as a library LDL^T would do it; with weighted
  *     rows it still refines.  Returns MB_OK or MB_ERR_NONFINITE.
  *
- * Below the flop budget (LDL_FLOP_BUDGET, order.h) every operation is emitted
+ * Below the flop budget (order.h: the host's compile-time limit, the embedded
+ * target's flash budget) every operation is emitted
  * with constant indices (straight-line, the factorization split into
  * out-of-line parts of about LDL_CHUNK_FLOPS); above it the same operations
  * run as loops over static const index arrays, so that the C compiler's time
- * stays bounded (gcc 12 -O2 -g needs about 0.3 ms per straight-line flop).
+ * stays bounded (gcc 12 -O2 needs about 0.26 ms per straight-line flop).
+ * Written into files of their own (ldl_out), the straight-line parts of a
+ * large model compile in parallel.
  *
  * The workspace (<M>_LDL_WORK mb_real) holds Lx (nnz(L)), 1/d (n), then x,
  * r, t and the best x of the refinement (n each). */
@@ -354,6 +357,47 @@ static void emit_sum(emit_ctx *cx, const char *fmt, const int *a, const int *b, 
  * forwarding then work on small functions, and its time stays linear */
 #define LDL_CHUNK_FLOPS 600
 
+/* the macros the out-of-line parts use (also in the LDL^T's own preamble) */
+#define LDL_PIVTOL_DEFINE "#define LDL_PIVTOL 1e-14\n"
+
+/* an out-of-line part's name: ldl_<what><k>, static, in one file; extern
+ * <model>_ldl_<what><k> when the parts go to files of their own */
+static void part_name(const emit_ctx *cx, char *buf, size_t n, const char *what, int k) {
+  if (cx->ldl.part_file) snprintf(buf, n, "%s_ldl_%s%d", cx->nm, what, k);
+  else snprintf(buf, n, "ldl_%s%d", what, k);
+}
+
+/* where the next part is written (cx->f from now on), and its storage class */
+static const char *part_open(emit_ctx *cx) {
+  if (!cx->ldl.part_file) return "static LDL_NOINLINE ";
+  int fresh = 0;
+  FILE *f = cx->ldl.part_file(cx->ldl.part_ctx, &fresh);
+  if (!f) {
+    cx->failed = 1; /* the output is discarded: the text goes on where it was */
+    return "";
+  }
+  if (fresh) fputs(LDL_PIVTOL_DEFINE "\n", f);
+  cx->f = f;
+  return "";
+}
+
+/* back to the LDL^T's own stream after a part */
+static FILE *part_close(emit_ctx *cx) {
+  if (cx->ldl.part_file) cx->f = cx->ldl.body;
+  return cx->f;
+}
+
+/* a factorization part's parameter list */
+static const char *factor_part_params(const emit_ctx *cx, const ldl_plan *p) {
+  static const char *const v[4] = {
+      "const mb_real *MB_RESTRICT Kx, mb_real *MB_RESTRICT Lx, mb_real *MB_RESTRICT Dinv",
+      "const mb_real *MB_RESTRICT Kx, const mb_real *MB_RESTRICT Kc, mb_real *MB_RESTRICT Lx, mb_real *MB_RESTRICT Dinv",
+      "const mb_real *MB_RESTRICT Kx, const mb_real *MB_RESTRICT K1, mb_real *MB_RESTRICT Lx, mb_real *MB_RESTRICT Dinv",
+      ("const mb_real *MB_RESTRICT Kx, const mb_real *MB_RESTRICT Kc, const mb_real *MB_RESTRICT K1, mb_real *MB_RESTRICT Lx, "
+       "mb_real *MB_RESTRICT Dinv")};
+  return v[(p->nelim ? 1 : 0) + (cx->ldl.k1_direct ? 2 : 0)];
+}
+
 static void emit_factor_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *p, const char *nm) {
   FILE *f = cx->f;
   int n = p->n;
@@ -373,9 +417,11 @@ static void emit_factor_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *
   for (int k = 0; k < n; k++) {
     if (k == 0 || chunk_flops > LDL_CHUNK_FLOPS) {
       if (k) fputs("  return 0;\n}\n\n", f);
-      fprintf(f, "static LDL_NOINLINE int ldl_factor_part%d(const mb_real *MB_RESTRICT Kx,%s%s mb_real *MB_RESTRICT Lx, "
-                 "mb_real *MB_RESTRICT Dinv) {\n",
-              nchunk++, p->nelim ? " const mb_real *MB_RESTRICT Kc," : "", cx->ldl.k1_direct ? " const mb_real *MB_RESTRICT K1," : "");
+      part_close(cx);
+      const char *storage = part_open(cx);
+      f = cx->f;
+      part_name(cx, name, sizeof name, "factor_part", nchunk++);
+      fprintf(f, "%sint %s(%s) {\n", storage, name, factor_part_params(cx, p));
       fprintf(f, "  (void)Kx;\n%s%s  (void)Lx;\n", p->nelim ? "  (void)Kc;\n" : "", cx->ldl.k1_direct ? "  (void)K1;\n" : "");
       chunk_flops = 0;
     }
@@ -434,14 +480,22 @@ static void emit_factor_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *
   free(inrow);
   free(kent);
   if (n) fputs("  return 0;\n}\n\n", f);
+  f = part_close(cx);
   (void)nm;
+  if (cx->ldl.part_file)
+    for (int c = 0; c < nchunk; c++) {
+      part_name(cx, name, sizeof name, "factor_part", c);
+      fprintf(f, "int %s(%s);\n", name, factor_part_params(cx, p));
+    }
   fputs("/* L D L^T of K_aug, whose entries come from Kx (K, or K' after the block pivots) */\n", f);
   fprintf(f, "static int ldl_factor_aug(const mb_real *Kx,%s mb_real *work) {\n", p->nelim ? " const mb_real *Kc," : "");
   fputs("  mb_real *Lx = work, *Dinv = work + LDL_DINV;\n  int rc;\n", f);
   fputs("  /* the pivots in order, in parts */\n", f);
-  for (int c = 0; c < nchunk; c++)
-    fprintf(f, "  if ((rc = ldl_factor_part%d(Kx,%s%s Lx, Dinv)) != 0) return rc;\n", c, p->nelim ? " Kc," : "",
+  for (int c = 0; c < nchunk; c++) {
+    part_name(cx, name, sizeof name, "factor_part", c);
+    fprintf(f, "  if ((rc = %s(Kx,%s%s Lx, Dinv)) != 0) return rc;\n", name, p->nelim ? " Kc," : "",
             cx->ldl.k1_direct ? " work + LDL_K1," : "");
+  }
   fputs("  (void)Lx;\n  (void)Dinv;\n  (void)rc;\n  return 0;\n}\n\n", f);
 }
 
@@ -836,13 +890,12 @@ static void emit_blocks_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *
       }
   }
   cx->ldl.kput_k1 = 1;
-  fputs("/* Kc (the entries of K' the block pivots set) from Kx; returns 0, or 1 + a column\n"
-        " * of a virtual body whose Du is singular.  Entries known at compile time (a\n"
-        " * weld's unit translational rows) are literals where they are read, not stored */\n"
-        "static int ldl_block_pivots(const mb_real *Kx, mb_real *work) {\n"
-        "  mb_real *Kc = work + LDL_KR, *Di, *W, v;\n", f);
-  if (cx->ldl.k1_direct) fputs("  const mb_real *K1 = work + LDL_K1; /* the massless bodies' computed entries */\n  (void)K1;\n", f);
-  fputs("  /* the entries of K' that no block changes (the others: at their first change) */\n", f);
+  /* a function per block (and one for the entries no block changes): one
+     function of all of them took gcc 8 s on the car with 8 virtual bodies */
+  const char *k1_local = cx->ldl.k1_direct ? "  const mb_real *K1 = work + LDL_K1; /* the massless bodies' computed entries */\n  (void)K1;\n" : "";
+  fprintf(f, "/* the entries of K' that no block changes (the others: at their first change) */\n"
+             "static LDL_NOINLINE void ldl_block_fixed(const mb_real *Kx, mb_real *work) {\n"
+             "  mb_real *Kc = work + LDL_KR;\n%s", k1_local);
   for (int k = 0; k < nkc; k++) {
     double c;
     if (updated[k]) continue;
@@ -854,9 +907,13 @@ static void emit_blocks_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *
     kname(cx, src[k]);
     fputs(";\n", f);
   }
+  fputs("  (void)Kx;\n  (void)Kc;\n}\n\n", f);
   for (int e = 0, w0 = 0; e < p->nelim; e++) {
     int xs = p->exp_[e], nx = p->exp_[e + 1] - xs, ss = p->esp[e], ns = p->esp[e + 1] - ss;
-    fprintf(f, "  /* block %d: Du^-1, W = Eu Du^-1, K'(s, x) -= (W Dx)(s, x) */\n", e);
+    fprintf(f, "/* block %d: Du^-1, W = Eu Du^-1, K'(s, x) -= (W Dx)(s, x); 0, or 1 + a column of\n"
+               " * the virtual body if its Du is singular */\n"
+               "static LDL_NOINLINE int ldl_block_pivot%d(const mb_real *Kx, mb_real *work) {\n"
+               "  mb_real *Kc = work + LDL_KR, *Di, *W, v;\n%s", e, e, k1_local);
     fprintf(f, "  Di = work + %ld;\n  W = Di + 42;\n", woff[e]);
     {
       char fail[32];
@@ -962,10 +1019,17 @@ static void emit_blocks_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *
       }
     }
     w0 += 6 * ns;
+    fputs("  (void)v;\n  (void)W;\n  (void)Kc;\n  return 0;\n}\n\n", f);
   }
   free(src);
   free(updated);
-  fputs("  (void)v;\n  (void)W;\n  (void)Kc;\n  return 0;\n}\n\n", f);
+  fputs("/* Kc (the entries of K' the block pivots set) from Kx; returns 0, or 1 + a column\n"
+        " * of a virtual body whose Du is singular.  Entries known at compile time (a\n"
+        " * weld's unit translational rows) are literals where they are read, not stored */\n"
+        "static int ldl_block_pivots(const mb_real *Kx, mb_real *work) {\n"
+        "  int rc = 0;\n  ldl_block_fixed(Kx, work);\n", f);
+  for (int e = 0; e < p->nelim; e++) fprintf(f, "  if ((rc = ldl_block_pivot%d(Kx, work)) != 0) return rc;\n", e);
+  fputs("  return rc;\n}\n\n", f);
 
   fputs(BLOCK_RHS_COMMENT
         "static void ldl_block_rhs(const mb_real *Kx, const mb_real *work, mb_real *r) {\n"
@@ -1634,11 +1698,15 @@ static void emit_factor_entry(emit_ctx *cx, const lmodel *L, const ldl_plan *p, 
 /* start part *nparts of the forward or backward solve when there is none yet or
  * the open one has passed LDL_CHUNK_FLOPS (closing it) */
 static void solve_part_open(emit_ctx *cx, const char *dir, const char *what, int *nparts, double *part_flops) {
-  FILE *f = cx->f;
   if (*nparts && *part_flops <= LDL_CHUNK_FLOPS) return;
-  if (*nparts) fputs("}\n\n", f);
+  if (*nparts) fputs("}\n\n", cx->f);
+  part_close(cx);
+  const char *storage = part_open(cx);
+  FILE *f = cx->f;
+  char name[320];
+  part_name(cx, name, sizeof name, dir, *nparts);
   fprintf(f, "/* %s: %s, row by row (part %d) */\n", dir, what, *nparts);
-  fprintf(f, "static LDL_NOINLINE void ldl_%s%d(const mb_real *MB_RESTRICT Lx, mb_real *MB_RESTRICT t) {\n", dir, *nparts);
+  fprintf(f, "%svoid %s(const mb_real *MB_RESTRICT Lx, mb_real *MB_RESTRICT t) {\n", storage, name);
   (*nparts)++;
   *part_flops = 0;
 }
@@ -1680,16 +1748,19 @@ static void emit_solve_helpers_straight(emit_ctx *cx, const lmodel *L, const ldl
     int len = p->Rp[i + 1] - p->Rp[i];
     if (!len) continue;
     solve_part_open(cx, "forward", "L y = t", &nfwd, &part_flops);
+    f = cx->f;
     fprintf(f, "  t[%d] -= ", i);
     emit_sum(cx, "Lx[%d] * t[%d]", p->Rpos + p->Rp[i], p->Rj + p->Rp[i], len);
     fputs(";\n", f);
     part_flops += 2.0 * len;
   }
   if (nfwd) fputs("}\n\n", f);
+  f = part_close(cx);
   for (int j = n - 1; j >= 0; j--) {
     int len = p->Lp[j + 1] - p->Lp[j];
     if (!len) continue;
     solve_part_open(cx, "backward", "L^T x = z", &nbwd, &part_flops);
+    f = cx->f;
     int *lq = malloc(sizeof(int) * (size_t)len);
     if (!lq) { cx->failed = 1; break; }
     for (int k = 0; k < len; k++) lq[k] = p->Lp[j] + k;
@@ -1700,13 +1771,25 @@ static void emit_solve_helpers_straight(emit_ctx *cx, const lmodel *L, const ldl
     part_flops += 2.0 * len;
   }
   if (nbwd) fputs("}\n\n", f);
+  f = part_close(cx);
+  char name[320];
+  for (int c = 0; cx->ldl.part_file && c < nfwd + nbwd; c++) {
+    part_name(cx, name, sizeof name, c < nfwd ? "forward" : "backward", c < nfwd ? c : c - nfwd);
+    fprintf(f, "void %s(const mb_real *MB_RESTRICT Lx, mb_real *MB_RESTRICT t);\n", name);
+  }
   fputs("/* t <- (L D L^T)^-1 t */\n", f);
   fputs("static void ldl_lsolve(const mb_real *MB_RESTRICT Lx, const mb_real *MB_RESTRICT Dinv, mb_real *MB_RESTRICT t) {\n", f);
-  for (int c = 0; c < nfwd; c++) fprintf(f, "  ldl_forward%d(Lx, t);\n", c);
+  for (int c = 0; c < nfwd; c++) {
+    part_name(cx, name, sizeof name, "forward", c);
+    fprintf(f, "  %s(Lx, t);\n", name);
+  }
   fputs("  /* diagonal: z = D^-1 y */\n", f);
   for (int k = 0; k < n; k++)
     if (!ldl_decoupled(cx, p, k)) fprintf(f, "  t[%d] *= Dinv[%d];\n", k, k);
-  for (int c = 0; c < nbwd; c++) fprintf(f, "  ldl_backward%d(Lx, t);\n", c);
+  for (int c = 0; c < nbwd; c++) {
+    part_name(cx, name, sizeof name, "backward", c);
+    fprintf(f, "  %s(Lx, t);\n", name);
+  }
   if (p->nnzL == 0) fputs("  (void)Lx;\n", f);
   fputs("}\n\n", f);
 
@@ -1865,7 +1948,7 @@ static void emit_solve(emit_ctx *cx, const ldl_plan *p, const char *nm) {
         "  return isfinite(best) ? MB_OK : MB_ERR_NONFINITE;\n}\n\n", f);
 }
 
-int emit_ldl(emit_ctx *cx) {
+int emit_ldl(emit_ctx *cx, const ldl_out *out) {
   FILE *f = cx->f;
   const mbc_unit *u = cx->u;
   const lmodel *L = cx->L;
@@ -1899,7 +1982,7 @@ int emit_ldl(emit_ctx *cx) {
   fputs("\n * Workspace: Lx, 1/d, x, r, t, best x. */\n", f);
   fprintf(f, "#define LDL_N %d\n#define LDL_DINV %s_LDL_NNZL\n"
              "#define LDL_X (LDL_DINV + LDL_N)\n#define LDL_R (LDL_X + LDL_N)\n#define LDL_T (LDL_R + LDL_N)\n"
-             "#define LDL_XB (LDL_T + LDL_N)\n#define LDL_PIVTOL 1e-14\n"
+             "#define LDL_XB (LDL_T + LDL_N)\n" LDL_PIVTOL_DEFINE
              "#define LDL_KR (LDL_XB + LDL_N)\n#define LDL_DD (LDL_KR + %d)\n"
              "/* a solve whose relative residual is already this small is not refined */\n"
              "#define LDL_REFINE_TOL 1e-15\n"
@@ -1974,6 +2057,9 @@ int emit_ldl(emit_ctx *cx) {
           cst[R->slot[s][j]] = cst[R->slotT[s][j]] = (signed char)(s ? 1 : -1); /* as init writes them */
         }
   cx->ldl.kx_cst = cst;
+  cx->ldl.part_file = out && p->straight ? out->part_file : NULL;
+  cx->ldl.part_ctx = out ? out->ctx : NULL;
+  cx->ldl.body = f;
   int *kc = NULL;
   cx->ldl.inv6_emitted = 0;
   if (p->nml) emit_massless(cx, L, p);
@@ -2008,6 +2094,10 @@ int emit_ldl(emit_ctx *cx) {
   cx->ldl.kc_sym = NULL;
   sym_free(&cx->ldl.sym);
   free(kc);
+  cx->ldl.part_file = NULL;
+  cx->ldl.part_ctx = NULL;
+  cx->ldl.body = NULL;
+  if (out) f = out->wrappers;
   fputs("static int ldl_factor_m(const mb_model *m, const mb_real *Kx, mb_real *work) {\n", f);
   fprintf(f, "  (void)m;\n  return %s_ldl_factor(Kx, work);\n}\n", nm);
   fputs("static int ldl_solve_m(const mb_model *m, const mb_real *Kx, mb_real *work, mb_real *b,\n"

@@ -41,6 +41,11 @@ typedef struct {
   sym_id *kc_sym;
   sym_graph sym;
   int inv6_emitted; /* ldl_invn and ldl_inv6 are written once per file */
+  /* a model in several files (emit_ldl.h, ldl_out): the stream of the next
+   * out-of-line part of the straight-line code, NULL: they stay in body */
+  FILE *(*part_file)(void *ctx, int *fresh);
+  void *part_ctx;
+  FILE *body; /* the LDL^T's own stream, where the parts are called */
 } emit_ldl_state;
 
 typedef struct {

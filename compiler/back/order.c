@@ -1163,8 +1163,13 @@ done:
   return nsets;
 }
 
-static double default_budget = LDL_FLOP_BUDGET;
+static double default_budget = -1; /* < 0: the host's compile-time rule */
 void ldl_set_default_budget(double flops) { default_budget = flops; }
+
+double ldl_payback_calls(const ldl_plan *p, int jobs) {
+  double gain = (LDL_NS_PER_FLOP_LOOPED - LDL_NS_PER_FLOP_STRAIGHT) * 1e-9 * (p->flops + p->flops_solve);
+  return gain > 0 ? LDL_GCC_SECONDS_PER_FLOP * (p->flops + p->flops_solve) / (jobs > 0 ? jobs : 1) / gain : 0;
+}
 
 int ldl_plan_build(const lmodel *L, ldl_plan *p) {
   const mb_model *m = &L->m;
@@ -1236,7 +1241,6 @@ int ldl_plan_build(const lmodel *L, ldl_plan *p) {
     }
   }
   if (!p->perm) goto fail;
-  p->straight = p->flops <= p->budget;
   /* the block pivots' own work with dense 6 x 6 blocks (the looped code's):
      LU of Du, a transposed solve per S row and the product with Dx; per solve
      the right side (W g_r, Dx^T Du^-T f_u) and the recovery (two 6 x 6
@@ -1256,6 +1260,12 @@ int ldl_plan_build(const lmodel *L, ldl_plan *p) {
     p->flops_block += 150 + nse * (72 + 12 * nxe);
     p->flops_block_solve += 4 * 72 + 24 * (nxe + nse);
   }
+  /* the choice (order.h): the straight-line block pivots and massless
+     bodies are code too (their bounds: the flexible_virtual car's 18096 flops
+     of block pivots took about 6 s of gcc) */
+  p->cc_seconds = LDL_GCC_SECONDS_PER_FLOP * (p->flops + p->flops_solve + p->flops_block + p->flops_block_solve +
+                                              p->flops_ml + p->flops_ml_solve);
+  p->straight = p->budget >= 0 ? p->flops <= p->budget : p->cc_seconds <= LDL_STRAIGHT_SECONDS;
   free(Kx); free(Ap); free(Ai); free(C2); free(Ct);
   return 0;
 fail:
@@ -1286,5 +1296,10 @@ void ldl_plan_report(const ldl_plan *plan, FILE *out) {
                  "(at most %.0f flops per factorization, %.0f per solve)\n", p->nelim, p->flops_block, p->flops_block_solve);
   fprintf(out, "  nnz(L)            %ld (strictly lower; L + D + L^T has %ld)\n", p->nnzL, 2 * p->nnzL + p->n);
   fprintf(out, "  LDL^T flops       %.0f per factorization, %.0f per solve\n", p->flops, p->flops_solve);
-  fprintf(out, "  LDL^T code        %s (flop budget %.0f)\n", p->straight ? "straight-line" : "looped", p->budget);
+  if (p->budget >= 0)
+    fprintf(out, "  LDL^T code        %s (flop budget %.0f)\n", p->straight ? "straight-line" : "looped", p->budget);
+  else
+    fprintf(out, "  LDL^T code        %s (straight-line: about %.1f s of gcc CPU, limit %.0f s; it pays back its build "
+                 "after about %.2g calls on 2 cores)\n",
+            p->straight ? "straight-line" : "looped", p->cc_seconds, LDL_STRAIGHT_SECONDS, ldl_payback_calls(p, 2));
 }

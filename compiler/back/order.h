@@ -27,17 +27,31 @@
 
 #include "lower.h"
 
-/* default flop budget for straight-line code (above it: loops over tables);
- * the environment variable MBCC_LDL_BUDGET overrides it */
-#define LDL_FLOP_BUDGET 20000.0
-/* the embedded target's: straight-line LDL^T costs about 10 bytes of Cortex-M4F
- * flash per flop (the flexible slider-crank's 2118 + 923 flops: 31.6 KB more
- * than its loops), so above 2000 flops per factorization the loops keep a
- * package near a 64 KiB flash */
+/* The host's choice of form is a compile-time limit derived from measured
+ * costs (docs/architecture.md, "The emitted LDL^T: its two forms, measured"):
+ * straight-line code runs LDL_NS_PER_FLOP_STRAIGHT per flop of factor + solve
+ * against the looped form's LDL_NS_PER_FLOP_LOOPED, and costs
+ * LDL_GCC_SECONDS_PER_FLOP of gcc -O2 CPU per such flop (the looped form's
+ * compile time is small and does not grow with the flops).  Both the gain
+ * per call and the compile time grow with the flops, so the calls after
+ * which straight-line code has paid for its build do not depend on the
+ * model's size (ldl_payback_calls); what limits it is the build's time:
+ * straight-line while its estimated gcc CPU stays under LDL_STRAIGHT_SECONDS
+ * (its files compile in parallel with the evaluation's; the limit keeps the
+ * cars' builds near the 10 s aim on 2 cores). */
+#define LDL_GCC_SECONDS_PER_FLOP 2.6e-4
+#define LDL_NS_PER_FLOP_STRAIGHT 0.27
+#define LDL_NS_PER_FLOP_LOOPED 0.38
+#define LDL_STRAIGHT_SECONDS 12.0
+/* the embedded target's flop budget (per factorization): straight-line
+ * LDL^T costs about 10 bytes of Cortex-M4F flash per flop (the flexible
+ * slider-crank's 2118 + 923 flops: 31.6 KB more than its loops), so above
+ * 2000 flops per factorization the loops keep a package near a 64 KiB flash */
 #define LDL_FLOP_BUDGET_EMBEDDED 2000.0
-/* the budget of the plans built from now on when MBCC_LDL_BUDGET is not set */
+/* a flop budget per factorization for the plans built from now on, instead
+ * of the host's compile-time rule (the environment variable MBCC_LDL_BUDGET
+ * overrides both: 0 always loops, 1e12 always straight-line) */
 void ldl_set_default_budget(double flops);
-
 typedef struct {
   int n, nv, nc;
   /* ordering: perm[k] = original unknown of pivot k; iperm its inverse */
@@ -128,14 +142,19 @@ typedef struct {
   double flops_solve; /* one forward/diagonal/backward solve */
   int tree;          /* ordering: 1 spanning-tree constraint sets, 0 bodies first */
   int nsets;         /* CAMD constraint sets used */
-  int straight;      /* 1: flops <= budget (straight-line code), 0: loops */
-  double budget;
+  int straight;      /* 1: straight-line code, 0: loops over tables */
+  double budget;     /* the flop budget per factorization that chose, or < 0: the host's rule */
+  double cc_seconds; /* straight-line code's estimated gcc -O2 CPU (the host's rule): of the
+                        flops of factor and solve, block pivots and massless bodies */
 } ldl_plan;
 
 /* Build the plan of the lowered, assembled model.  Returns 0, or -1 (out of
  * memory or CAMD failure; *p is then freed). */
 int ldl_plan_build(const lmodel *L, ldl_plan *p);
 void ldl_plan_free(ldl_plan *p);
+/* the factor + solve calls after which straight-line code's extra build
+ * time (CPU on 'jobs' cores) is won back by its faster calls */
+double ldl_payback_calls(const ldl_plan *p, int jobs);
 
 /* the diagonal blocks of a 6 x 6 matrix of structure nz[36] (1: can be nonzero):
  * comp[i] the block of row and column i; returns the number of blocks.  Its
