@@ -1,7 +1,8 @@
 /* emit_loops.c: the loop form of the emitted evaluation (emit_loops.h).
  *
- * The groups: rigid bodies of equal mass and inertia (their frame, gravity
- * and gyroscopic terms; the mass blocks are constant, set by init); the
+ * The groups: rigid (or virtual) bodies of equal mass and inertia (their
+ * frame, gravity and gyroscopic terms; the mass blocks are constant, set by
+ * init); the
  * markers (on the ground, on a rigid body); joints, as blocks of consecutive
  * constraint rows between one pair of markers, equal when their rows have the
  * same primitives (kind, axes, length, time function), the same sides on the
@@ -47,6 +48,10 @@ typedef struct {
   int njoint_group;
   int *joint_count;  /* members per joint group */
   int *joint_first;  /* the first member (block index) of each joint group */
+  int *force_group;  /* per force element: its group */
+  int nforce_group;
+  int *force_count;  /* members per force group */
+  int *force_first;  /* the first member of each force group */
   int largest;
 } loop_plan;
 
@@ -56,6 +61,9 @@ static void plan_free(loop_plan *p) {
   free(p->block);
   free(p->joint_count);
   free(p->joint_first);
+  free(p->force_group);
+  free(p->force_count);
+  free(p->force_first);
   memset(p, 0, sizeof *p);
 }
 
@@ -67,7 +75,7 @@ static int side_on_ground(const lmodel *L, const mb_rowdef *R, int s) {
 }
 
 static int same_body(const mb_body *a, const mb_body *b) {
-  if (a->mass != b->mass) return 0;
+  if (a->kind != b->kind || a->mass != b->mass) return 0;
   for (int j = 0; j < 9; j++)
     if (a->J[j] != b->J[j]) return 0;
   return 1;
@@ -91,12 +99,36 @@ static int same_block(const lmodel *L, const row_block *x, const row_block *y) {
   return 1;
 }
 
+/* the force kinds with a loop form: those whose markers are on rigid bodies
+ * and whose kernel reads everything from the pools (the tyre's road and the
+ * superelement's nodes are not) */
+static int force_has_loop(const mb_forcedef *d) {
+  switch (d->kind) {
+  case MB_FORCE_POINT:
+  case MB_FORCE_TORQUE:
+  case MB_FORCE_SPRING:
+  case MB_FORCE_FIELD: return 1;
+  case MB_FORCE_TYRE:
+  case MB_FORCE_SUPERELEMENT: return 0;
+  }
+  return 0;
+}
+
+static int same_force(const lmodel *L, const mb_forcedef *x, const mb_forcedef *y) {
+  if (x->kind != y->kind || x->profile != y->profile || x->local != y->local) return 0;
+  if ((L->marker[x->m0].body < 0) != (L->marker[y->m0].body < 0)) return 0;
+  if (x->m1 >= 0 && (L->marker[x->m1].body < 0) != (L->marker[y->m1].body < 0)) return 0;
+  return 1;
+}
+
 /* every element has a loop form */
 static int loop_form_exists(const lmodel *L) {
   const mb_model *m = &L->m;
-  if (m->nbody < 1 || m->nmarker < 1 || m->nforce) return 0;
+  if (m->nbody < 1 || m->nmarker < 1) return 0;
+  for (int i = 0; i < m->nforce; i++)
+    if (!force_has_loop(&L->force[i])) return 0;
   for (int b = 0; b < m->nbody; b++)
-    if (L->body[b].kind != MB_BODY_RIGID) return 0;
+    if (L->body[b].kind == MB_BODY_FLEXIBLE) return 0;
   for (int k = 0; k < m->nmarker; k++)
     if (L->marker[k].node >= 0) return 0;
   for (int r = 0; r < m->nrow; r++)
@@ -113,7 +145,11 @@ static int plan_groups(const lmodel *L, loop_plan *p) {
   p->block = malloc(sizeof *p->block * (size_t)(m->nrow + 1));
   p->joint_count = calloc((size_t)m->nrow + 1, sizeof *p->joint_count);
   p->joint_first = malloc(sizeof *p->joint_first * (size_t)(m->nrow + 1));
-  if (!p->body_group || !p->body_count || !p->block || !p->joint_count || !p->joint_first) {
+  p->force_group = malloc(sizeof *p->force_group * (size_t)(m->nforce + 1));
+  p->force_count = calloc((size_t)m->nforce + 1, sizeof *p->force_count);
+  p->force_first = malloc(sizeof *p->force_first * (size_t)(m->nforce + 1));
+  if (!p->body_group || !p->body_count || !p->block || !p->joint_count || !p->joint_first || !p->force_group ||
+      !p->force_count || !p->force_first) {
     plan_free(p);
     return -1;
   }
@@ -142,6 +178,15 @@ static int plan_groups(const lmodel *L, loop_plan *p) {
     p->joint_count[g]++;
     r += n;
   }
+  for (int i = 0; i < m->nforce; i++) {
+    int g = 0;
+    while (g < p->nforce_group && !same_force(L, &L->force[i], &L->force[p->force_first[g]])) g++;
+    if (g == p->nforce_group) p->force_first[p->nforce_group++] = i;
+    p->force_group[i] = g;
+    p->force_count[g]++;
+  }
+  for (int g = 0; g < p->nforce_group; g++)
+    if (p->force_count[g] > p->largest) p->largest = p->force_count[g];
   for (int g = 0; g < p->nbody_group; g++)
     if (p->body_count[g] > p->largest) p->largest = p->body_count[g];
   for (int g = 0; g < p->njoint_group; g++)
@@ -168,7 +213,7 @@ static void block_comment(FILE *f, const lmodel *L, const row_block *B) {
 
 static void write_bodies(FILE *t, FILE *f, const lmodel *L, const loop_plan *p) {
   const mb_model *m = &L->m;
-  fputs("\n/* the loop form's rigid bodies: frame, gravity and gyroscopic terms (emit_loops.c) */\n"
+  fputs("\n/* the loop form's bodies: frame, gravity and gyroscopic terms (emit_loops.c) */\n"
         "typedef struct {\n  int body, qadr, vadr;\n} loop_body;\n",
         t);
   for (int g = 0; g < p->nbody_group; g++) {
@@ -188,7 +233,7 @@ static void write_bodies(FILE *t, FILE *f, const lmodel *L, const loop_plan *p) 
       vec(t, B0->J, 9);
       fputs(";\n", t);
     }
-    fprintf(f, "  /* %d rigid bodies of mass ", p->body_count[g]);
+    fprintf(f, "  /* %d %s bodies of mass ", p->body_count[g], B0->kind == MB_BODY_VIRTUAL ? "virtual" : "rigid");
     num(f, B0->mass);
     fprintf(f, " (loop_bodies%d) */\n  for (int e = 0; e < %d; e++) {\n"
                "    const loop_body *B = &loop_bodies%d[e];\n"
@@ -234,6 +279,65 @@ static void write_markers(FILE *t, FILE *f, const lmodel *L) {
                "  for (int e = 0; e < %d; e++) {\n    const loop_marker *M = &loop_markers[e];\n"
                "    mb_marker_rigid(&fr[M->body], markers[M->marker].s, markers[M->marker].C, &mk[M->marker]);\n  }\n",
             nrigid, nrigid);
+  }
+}
+
+/* rhs of side s's body += the body columns of (dV, dW) at point P */
+static void add_wrench(FILE *f, int s, const char *P, const char *dV, const char *dW) {
+  fprintf(f, "    mb_rigid_cols(&fr[E->b%d], %s, %s, %s, c);\n"
+             "    for (int j = 0; j < 6; j++) rhs[E->v%d + j] += c[j];\n", s, P, dV, dW, s);
+}
+
+static void write_forces(FILE *t, FILE *f, const lmodel *L, const loop_plan *p) {
+  const mb_model *m = &L->m;
+  if (!p->nforce_group) return;
+  fputs("/* the loop form's force elements: markers, their bodies and first velocities (-1: the\n"
+        "   ground), the element's reals in force_prm and laws in force_laws */\n"
+        "typedef struct {\n  int m0, m1, b0, b1, v0, v1, padr, ladr;\n} loop_force;\n", t);
+  for (int g = 0; g < p->nforce_group; g++) {
+    const mb_forcedef *d0 = &L->force[p->force_first[g]];
+    fprintf(t, "static const loop_force loop_forces%d[%d] = {\n", g, p->force_count[g]);
+    for (int i = 0; i < m->nforce; i++) {
+      if (p->force_group[i] != g) continue;
+      const mb_forcedef *d = &L->force[i];
+      int b0 = L->marker[d->m0].body, b1 = d->m1 >= 0 ? L->marker[d->m1].body : -1;
+      fprintf(t, "  {.m0 = %d, .m1 = %d, .b0 = %d, .b1 = %d, .v0 = %d, .v1 = %d, .padr = %d, .ladr = %d}, /* '%s' */\n",
+              d->m0, d->m1, b0, b1, b0 >= 0 ? L->body[b0].vadr : -1, b1 >= 0 ? L->body[b1].vadr : -1, d->padr,
+              d->ladr, L->ir->forces[L->force_ir[i]].name);
+    }
+    fputs("};\n", t);
+    int ground0 = L->marker[d0->m0].body < 0, ground1 = d0->m1 < 0 || L->marker[d0->m1].body < 0;
+    fprintf(f, "  /* %d force elements (loop_forces%d) */\n  for (int e = 0; e < %d; e++) {\n"
+               "    const loop_force *E = &loop_forces%d[e];\n",
+            p->force_count[g], g, p->force_count[g], g);
+    switch (d0->kind) {
+    case MB_FORCE_POINT:
+    case MB_FORCE_TORQUE:
+      if (ground0) { fputs("    (void)E; /* on the ground: no effect */\n  }\n", f); continue; }
+      fputs("    mb_real s = 1, val[3];\n", f);
+      if (d0->profile >= 0) fprintf(f, "    mb_profile_eval(&profiles[%d], t, x);\n    s = x[0];\n", d0->profile);
+      fprintf(f, "    mb_point_vector(force_prm + E->padr, s, %s, val);\n", d0->local ? "fr[E->b0].A" : "0");
+      add_wrench(f, 0, "mk[E->m0].P", d0->kind == MB_FORCE_POINT ? "val" : "zero3",
+                 d0->kind == MB_FORCE_POINT ? "zero3" : "val");
+      break;
+    case MB_FORCE_SPRING:
+      fputs("    mb_real F0[3], F1[3];\n"
+            "    mb_spring(&mk[E->m0], &mk[E->m1], force_prm + E->padr, force_laws + E->ladr, F0, F1, 0);\n", f);
+      if (!ground0) add_wrench(f, 0, "mk[E->m0].P", "F0", "zero3");
+      if (!ground1) add_wrench(f, 1, "mk[E->m1].P", "F1", "zero3");
+      break;
+    case MB_FORCE_FIELD:
+      fputs("    mb_real F[3], T[3];\n    mb_field(&mk[E->m0], &mk[E->m1], force_prm + E->padr, F, T, 0);\n", f);
+      if (!ground1) add_wrench(f, 1, "mk[E->m1].P", "F", "T");
+      if (!ground0) {
+        fputs("    mb_real mF[3] = {-F[0], -F[1], -F[2]}, mT[3] = {-T[0], -T[1], -T[2]};\n", f);
+        add_wrench(f, 0, "mk[E->m1].P", "mF", "mT"); /* the reaction at the same point */
+      }
+      break;
+    case MB_FORCE_TYRE:
+    case MB_FORCE_SUPERELEMENT: break; /* no loop form (force_has_loop) */
+    }
+    fputs("  }\n", f);
   }
 }
 
@@ -334,6 +438,7 @@ int emit_loops_eval(FILE *tables, FILE *body, const lmodel *L) {
           m->nbody, m->nmarker);
   write_bodies(tables, body, L, &p);
   write_markers(tables, body, L);
+  write_forces(tables, body, L, &p);
   int failed = write_joints(tables, body, L, &p);
   plan_free(&p);
   return failed;
