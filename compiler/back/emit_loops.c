@@ -21,7 +21,7 @@
 #include "emit_util.h"
 
 /* measured: docs/architecture.md, "The loop form" */
-#define LOOP_MIN_GROUP 64
+#define LOOP_MIN_GROUP 32
 
 int loop_min_group(void) {
   const char *s = getenv("MBCC_LOOP_MIN");
