@@ -986,6 +986,7 @@ static void add_init_mark(FILE *f, char *const *text, init_mark *mark, int *nmar
 static void emit_init_body(emit_ctx *cx, FILE *f, init_mark *mark, int *nmark, char **text) {
   const lmodel *L = cx->L;
   const mb_model *m = &L->m;
+  if (emit_loops_chosen(L)) { emit_loops_init(f, L); return; } /* loops over the tables: no marks */
   for (int b = 0; b < m->nbody; b++) {
     const mb_body *B = &L->body[b];
     add_init_mark(f, text, mark, nmark);

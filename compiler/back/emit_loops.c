@@ -443,3 +443,18 @@ int emit_loops_eval(FILE *tables, FILE *body, const lmodel *L) {
   plan_free(&p);
   return failed;
 }
+
+void emit_loops_init(FILE *f, const lmodel *L) {
+  const mb_model *m = &L->m;
+  fprintf(f, "  /* the loop form (emit_loops.c): the rigid bodies' mass and inertia (bodies[]), the\n"
+             "     constant entries of the rows' D, -1 on marker 0's body and +1 on marker 1's (rows[]) */\n"
+             "  for (int b = 0; b < %d; b++)\n    if (bodies[b].kind == MB_BODY_RIGID)\n"
+             "      for (int j = 0; j < 12; j++)\n"
+             "        if (bodies[b].mslot[j] >= 0) Kx[bodies[b].mslot[j]] = j < 3 ? bodies[b].mass : bodies[b].J[j - 3];\n",
+          m->nbody);
+  if (m->nrow)
+    fprintf(f, "  for (int r = 0; r < %d; r++)\n    for (int s = 0; s < 2; s++)\n      for (int j = 0; j < 6; j++)\n"
+               "        if (rows[r].constant[s][j] && rows[r].slot[s][j] >= 0)\n"
+               "          Kx[rows[r].slot[s][j]] = Kx[rows[r].slotT[s][j]] = s ? 1 : -1;\n",
+            m->nrow);
+}

@@ -30,4 +30,9 @@ int emit_loops_chosen(const lmodel *L);
  * of memory. */
 int emit_loops_eval(FILE *tables, FILE *body, const lmodel *L);
 
+/* init's statements after K is zeroed, when the evaluation is in the loop
+ * form: the mass blocks and the rows' constant entries as loops over the
+ * model's tables (bodies[], rows[]) */
+void emit_loops_init(FILE *f, const lmodel *L);
+
 #endif
