@@ -2,11 +2,13 @@
  *
  * The groups: rigid (or virtual) bodies of equal mass and inertia (their
  * frame, gravity and gyroscopic terms; the mass blocks are constant, set by
- * init); the
- * markers (on the ground, on a rigid body); joints, as blocks of consecutive
- * constraint rows between one pair of markers, equal when their rows have the
- * same primitives (kind, axes, length, time function), the same sides on the
- * ground and the same varying entries of K.  Each group's loop body is
+ * init); the markers (on the ground, on a rigid body); force elements of one
+ * kind, time function and sides on the ground; joints, as blocks of
+ * consecutive constraint rows between one pair of markers, equal when their
+ * rows have the same primitives (kind, axes, length, time function), the
+ * same sides on the ground and the same varying entries of K.  Members join
+ * the first group whose first member equals them (quadratic in the number of
+ * groups, which repeated structure keeps small).  Each group's loop body is
  * written once, with what the members share folded (the group's mass,
  * inertia, primitives, which columns are stored); what differs per member
  * (coordinates, markers, rows, slots) is in its table.  The kernels are the
@@ -43,6 +45,7 @@ typedef struct {
   int *body_group;   /* per body: its group */
   int nbody_group;
   int *body_count;   /* members per body group */
+  int *body_first;   /* the first member of each body group */
   row_block *block;
   int nblock;
   int njoint_group;
@@ -58,6 +61,7 @@ typedef struct {
 static void plan_free(loop_plan *p) {
   free(p->body_group);
   free(p->body_count);
+  free(p->body_first);
   free(p->block);
   free(p->joint_count);
   free(p->joint_first);
@@ -142,28 +146,25 @@ static int plan_groups(const lmodel *L, loop_plan *p) {
   memset(p, 0, sizeof *p);
   p->body_group = malloc(sizeof *p->body_group * (size_t)m->nbody);
   p->body_count = calloc((size_t)m->nbody, sizeof *p->body_count);
+  p->body_first = malloc(sizeof *p->body_first * (size_t)m->nbody);
   p->block = malloc(sizeof *p->block * (size_t)(m->nrow + 1));
   p->joint_count = calloc((size_t)m->nrow + 1, sizeof *p->joint_count);
   p->joint_first = malloc(sizeof *p->joint_first * (size_t)(m->nrow + 1));
   p->force_group = malloc(sizeof *p->force_group * (size_t)(m->nforce + 1));
   p->force_count = calloc((size_t)m->nforce + 1, sizeof *p->force_count);
   p->force_first = malloc(sizeof *p->force_first * (size_t)(m->nforce + 1));
-  if (!p->body_group || !p->body_count || !p->block || !p->joint_count || !p->joint_first || !p->force_group ||
+  if (!p->body_group || !p->body_count || !p->body_first || !p->block || !p->joint_count || !p->joint_first || !p->force_group ||
       !p->force_count || !p->force_first) {
     plan_free(p);
     return -1;
   }
-  /* body groups: each body joins the first group whose first member equals it */
-  int *first_body = malloc(sizeof *first_body * (size_t)m->nbody);
-  if (!first_body) { plan_free(p); return -1; }
   for (int b = 0; b < m->nbody; b++) {
     int g = 0;
-    while (g < p->nbody_group && !same_body(&L->body[b], &L->body[first_body[g]])) g++;
-    if (g == p->nbody_group) first_body[p->nbody_group++] = b;
+    while (g < p->nbody_group && !same_body(&L->body[b], &L->body[p->body_first[g]])) g++;
+    if (g == p->nbody_group) p->body_first[p->nbody_group++] = b;
     p->body_group[b] = g;
     p->body_count[g]++;
   }
-  free(first_body);
   /* row blocks: consecutive rows between the same markers */
   for (int r = 0; r < m->nrow;) {
     int n = 1;
@@ -217,11 +218,10 @@ static void write_bodies(FILE *t, FILE *f, const lmodel *L, const loop_plan *p) 
         "typedef struct {\n  int body, qadr, vadr;\n} loop_body;\n",
         t);
   for (int g = 0; g < p->nbody_group; g++) {
-    const mb_body *B0 = NULL;
+    const mb_body *B0 = &L->body[p->body_first[g]];
     fprintf(t, "static const loop_body loop_bodies%d[%d] = {\n", g, p->body_count[g]);
     for (int b = 0; b < m->nbody; b++) {
       if (p->body_group[b] != g) continue;
-      if (!B0) B0 = &L->body[b];
       fprintf(t, "  {.body = %d, .qadr = %d, .vadr = %d}, /* '%s' */\n", b, L->body[b].qadr, L->body[b].vadr,
               L->body[b].name);
     }
