@@ -20,19 +20,15 @@
 #include <string.h>
 
 #include "emit_loops.h"
+#include "emit_split.h"
 #include "emit_util.h"
 
 /* measured: docs/architecture.md, "The loop form" */
 #define LOOP_MIN_GROUP 32
 
 int loop_min_group(void) {
-  const char *s = getenv("MBCC_LOOP_MIN");
-  if (s && *s) {
-    char *end;
-    long v = strtol(s, &end, 10);
-    if (!*end && v >= 0 && v <= 1000000000) return (int)v;
-  }
-  return LOOP_MIN_GROUP;
+  long v = emit_size_setting("MBCC_LOOP_MIN", LOOP_MIN_GROUP);
+  return v > 1000000000 ? 1000000000 : (int)v;
 }
 
 /* a joint's rows: rows r0 .. r0 + n - 1, all between the same two markers */
