@@ -4,6 +4,7 @@
  *   ldl_harness eval N   N evaluations (eval's share, for comparison)
  *   ldl_harness time     median and fastest per-call time [us] of factor + solve over
  *                        31 rounds (a round: about 2 ms of calls)
+ *   ldl_harness evaltime the same of one evaluation (scripts/loop-profile.sh)
  *   ldl_harness amd      nnz(L) and flops of the model's ordering beside SuiteSparse AMD
  *                        (no constraint sets) on the same pattern of K */
 #define _POSIX_C_SOURCE 200809L
@@ -57,6 +58,18 @@ static void symbolic(const mb_model *m, const int *perm, long *nnzl, double *flo
   free(iperm); free(parent); free(mark); free(cnt);
 }
 
+/* one call of what the time modes measure: the evaluation, or factor + solve */
+static void timed_call(const mb_model *m, int eval_only, const double *q, const double *v, double *Kx,
+                       double *rhs, double *phi, double *phid, void *work, double *lw, double *x) {
+  if (eval_only) {
+    m->eval(m, 0, q, v, Kx, rhs, phi, phid, work);
+    return;
+  }
+  m->ldl_factor(m, Kx, lw);
+  memcpy(x, rhs, sizeof(double) * (size_t)m->n);
+  m->ldl_solve(m, Kx, lw, x, NULL);
+}
+
 int main(int argc, char **argv) {
   const mb_model *m = ldl_model;
   const char *mode = argc > 1 ? argv[1] : "time";
@@ -95,23 +108,19 @@ int main(int argc, char **argv) {
     }
     return 0;
   }
-  /* time: calls per round from a first estimate, 31 rounds */
+  /* time (factor + solve) or evaltime (eval): calls per round from a first
+     estimate, 31 rounds */
+  int eval_only = !strcmp(mode, "evaltime");
   double t0 = now();
   long reps = 0;
   while (now() - t0 < 2e-3) {
-    m->ldl_factor(m, Kx, lw);
-    memcpy(x, rhs, sizeof(double) * (size_t)m->n);
-    m->ldl_solve(m, Kx, lw, x, NULL);
+    timed_call(m, eval_only, q, v, Kx, rhs, phi, phid, work, lw, x);
     reps++;
   }
   double t[31];
   for (int r = 0; r < 31; r++) {
     t0 = now();
-    for (long k = 0; k < reps; k++) {
-      m->ldl_factor(m, Kx, lw);
-      memcpy(x, rhs, sizeof(double) * (size_t)m->n);
-      m->ldl_solve(m, Kx, lw, x, NULL);
-    }
+    for (long k = 0; k < reps; k++) timed_call(m, eval_only, q, v, Kx, rhs, phi, phid, work, lw, x);
     t[r] = (now() - t0) / (double)reps * 1e6;
   }
   qsort(t, 31, sizeof t[0], by_value);

@@ -23,6 +23,7 @@
 #include "emit_force.h"
 #include "emit_rows.h"
 #include "emit_split.h"
+#include "emit_loops.h"
 #include "emit_files.h"
 #include "element.h"
 #include "emit_util.h"
@@ -779,6 +780,11 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
           "  (void)m; (void)work; (void)t; (void)x; (void)c; (void)r; (void)zero3;\n"
           "  (void)Kx; (void)phi; (void)phid;\n",
           nm);
+  if (emit_loops_chosen(L)) { /* identical elements as loops over tables: one function */
+    if (emit_loops_eval(out, f, L)) cx->failed = 1;
+    if (eval_split_finish(&sp, out, nm, head, NULL) < 0) cx->failed = 1;
+    return;
+  }
   eval_split_mark(&sp, "the body frames");
   /* frames and markers are separate variables, not arrays: the C compiler
      then drops the fields no row reads and keeps the rest compact, where an
@@ -980,6 +986,7 @@ static void add_init_mark(FILE *f, char *const *text, init_mark *mark, int *nmar
 static void emit_init_body(emit_ctx *cx, FILE *f, init_mark *mark, int *nmark, char **text) {
   const lmodel *L = cx->L;
   const mb_model *m = &L->m;
+  if (emit_loops_chosen(L)) { emit_loops_init(f, L); return; } /* loops over the tables: no marks */
   for (int b = 0; b < m->nbody; b++) {
     const mb_body *B = &L->body[b];
     add_init_mark(f, text, mark, nmark);
