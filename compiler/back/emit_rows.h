@@ -30,7 +30,8 @@ int emit_row_special(FILE *f, const lmodel *L, int r);
  * constants; 0, or -1 out of memory */
 int emit_marker_node(FILE *f, const lmodel *L, int k);
 /* c = mb_node_cols_mk at marker k (a flexible node) with the node's shapes as
- * constants; dV, dW: names of 3-vectors; 0, or -1 out of memory */
+ * constants; dV, dW: names of 3-vectors (zero3: zero, its half of the modal
+ * columns dropped); 0, or -1 out of memory */
 int emit_node_cols(FILE *f, const lmodel *L, int k, const char *dV, const char *dW, const char *indent);
 
 /* 1 when row r writes entries of D through its marker s (0 or 1): on a body,
