@@ -822,6 +822,11 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
       fprintf(f, "  /* the frame of body '%s' itself: the rows read f%d */\n", L->body[d->body].name, d->body);
       continue;
     }
+    int twin = emit_marker_node_twin(L, k, use);
+    if (twin >= 0) {
+      fprintf(f, "  mb_marker k%d = k%d; /* the same node and axes */\n", k, twin);
+      continue;
+    }
     fprintf(f, "  mb_marker k%d;\n", k);
     if (d->body < 0) {
       fprintf(f, "  mb_marker_ground(markers[%d].s, markers[%d].C, &k%d);\n", k, k, k);

@@ -245,6 +245,16 @@ int emit_marker_special(FILE *f, const lmodel *L, int k) {
   return rows_graph_done(&g) ? -1 : 1;
 }
 
+int emit_marker_node_twin(const lmodel *L, int k, const char *computed) {
+  const mb_markerdef *d = &L->marker[k];
+  if (d->body < 0 || d->node < 0 || emit_node_static(&L->body[d->body], d->node)) return -1;
+  for (int j = 0; j < k; j++) {
+    const mb_markerdef *e = &L->marker[j];
+    if (computed[j] && e->body == d->body && e->node == d->node && !memcmp(e->C, d->C, sizeof d->C)) return j;
+  }
+  return -1;
+}
+
 /* marker k on a flexible node (mb_marker_node): the node's modal sums with
  * its shapes as constants (zeros dropped, the kernel's order kept), then
  * mb_marker_node_sums */
@@ -276,12 +286,19 @@ int emit_marker_node(FILE *f, const lmodel *L, int k) {
       fputs(";\n", f);
     }
   }
-  fprintf(f, "    mb_marker_node_sums(&f%d, b, th, thd, Xwd, (const mb_real[9]){", d->body);
-  for (int i = 0; i < 9; i++) {
-    if (i) fputs(", ", f);
-    put(f, &g, lit(&g, d->C[i]));
+  static const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  fprintf(f, "    mb_marker_node_sums(&f%d, b, th, thd, Xwd, ", d->body);
+  if (!memcmp(d->C, I, sizeof I)) /* the node's own axes: no product with C */
+    fputs("NULL", f);
+  else {
+    fputs("(const mb_real[9]){", f);
+    for (int i = 0; i < 9; i++) {
+      if (i) fputs(", ", f);
+      put(f, &g, lit(&g, d->C[i]));
+    }
+    fputc('}', f);
   }
-  fprintf(f, "}, &k%d);\n  }\n", k);
+  fprintf(f, ", &k%d);\n  }\n", k);
   return rows_graph_done(&g);
 }
 

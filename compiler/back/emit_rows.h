@@ -26,6 +26,10 @@ int emit_row_is_special(const mb_rowdef *R);
 /* write row r if it is a spherical or dot-1 row: 1; 0: not handled; -1 out of memory */
 int emit_row_special(FILE *f, const lmodel *L, int r);
 
+/* an earlier marker j < k on the same flexible node with the same axes C,
+ * one that computed[j] says the evaluation forms (its numbers are marker
+ * k's: a copy replaces the modal sums and the rotation's kernel), or -1 */
+int emit_marker_node_twin(const lmodel *L, int k, const char *computed);
 /* write marker k on a flexible node: the modal sums with the node's shapes as
  * constants; 0, or -1 out of memory */
 int emit_marker_node(FILE *f, const lmodel *L, int k);
