@@ -3,7 +3,7 @@
  * joint type and driver profile; generalized spring forces against finite
  * differences of the potential energy; M and the gyroscopic forces against
  * hand-derived values; the generated evaluation against the generic one. */
-// models: fd_all fd_springs spatial_joints slider_crank slider_crank_flexible slider_crank_flexible@virtual2 free_flexible free_flexible_stiff
+// models: fd_all fd_springs spatial_joints slider_crank slider_crank_flexible slider_crank_flexible@virtual2 free_flexible free_flexible_stiff fd_node_twins
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,6 +17,7 @@
 #include "slider_crank_flexible_virtual2.h"
 #include "free_flexible.h"
 #include "free_flexible_stiff.h"
+#include "fd_node_twins.h"
 
 typedef struct {
   const mb_model *m;
@@ -210,6 +211,7 @@ static void test_constraints_flexible(void **state) {
   (void)state;
   check_constraints(&slider_crank_flexible_model, 3);
   check_constraints(&slider_crank_flexible_virtual2_model, 3);
+  check_constraints(&fd_node_twins_model, 3); /* a revolute on a node: its rows' folded modal columns */
 }
 
 /* The flexible body's quadratic-velocity forces s against Lagrange's equations
@@ -381,8 +383,8 @@ static void test_generated_equals_generic(void **state) {
   (void)state;
   const mb_model *models[] = {&fd_all_model, &fd_springs_model, &spatial_joints_model, &slider_crank_model,
                               &slider_crank_flexible_model, &slider_crank_flexible_virtual2_model,
-                              &free_flexible_model, &free_flexible_stiff_model};
-  for (int k = 0; k < 8; k++) {
+                              &free_flexible_model, &free_flexible_stiff_model, &fd_node_twins_model};
+  for (int k = 0; k < (int)(sizeof models / sizeof models[0]); k++) {
     const mb_model *m = models[k];
     mb_model g = generic_twin(m);
     evaluator a, b;

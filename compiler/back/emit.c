@@ -735,6 +735,10 @@ static void emit_flex_contract(emit_ctx *cx, int b) {
   fputs(" */\n", f);
   for (int i = 0; i < 3; i++)
     for (int l = 0; l < 3; l++) {
+      if (l < i) { /* J is symmetric: its lower triangle is the upper one's */
+        fprintf(f, "  c->J[%d] = c->J[%d];\n", 3 * i + l, 3 * l + i);
+        continue;
+      }
       int nt = 0;
       for (int j = 0; j < nm && lin; j++) {
         const double *E = x->E + 9 * j;
@@ -745,13 +749,29 @@ static void emit_flex_contract(emit_ctx *cx, int b) {
       if (emit_sum(f, lhs, x->J0[3 * i + l], coef, idx, nt, "w", &nterm)) cx->failed = 1;
     }
   if (quad && lin) {
-    fputs("  for (int j = 0; j < ", f);
+    fputs("  mb_real d[3] = {0, 0, 0}, o[3] = {0, 0, 0};\n  for (int j = 0; j < ", f);
     fprintf(f, "%d; j++) {\n", nm);
+    /* the sums of the diagonal (tr(Fw_j) - Fw_j,ii) and of the off-diagonal
+       pairs (Fw_j,il + Fw_j,li) over the modes first, written out: the loop
+       over i and l with its (i == l) cost six times the instructions */
     fputs("    const mb_real *Fw = c->Fw + 9 * j;\n"
           "    mb_real tf = Fw[0] + Fw[4] + Fw[8];\n"
-          "    for (int i = 0; i < 3; i++)\n"
-          "      for (int l = 0; l < 3; l++) c->J[3 * i + l] += w[j] * (tf * (i == l) - 0.5 * (Fw[3 * i + l] + Fw[3 * l + i]));\n"
-          "  }\n", f);
+          "    d[0] += w[j] * (tf - Fw[0]);\n"
+          "    d[1] += w[j] * (tf - Fw[4]);\n"
+          "    d[2] += w[j] * (tf - Fw[8]);\n"
+          "    o[0] += w[j] * (Fw[1] + Fw[3]);\n"
+          "    o[1] += w[j] * (Fw[2] + Fw[6]);\n"
+          "    o[2] += w[j] * (Fw[5] + Fw[7]);\n"
+          "  }\n"
+          "  c->J[0] += d[0];\n"
+          "  c->J[4] += d[1];\n"
+          "  c->J[8] += d[2];\n"
+          "  c->J[1] -= 0.5 * o[0];\n"
+          "  c->J[2] -= 0.5 * o[1];\n"
+          "  c->J[5] -= 0.5 * o[2];\n"
+          "  c->J[3] = c->J[1];\n"
+          "  c->J[6] = c->J[2];\n"
+          "  c->J[7] = c->J[5];\n", f);
   }
   fprintf(f, "  /* %ld multiply-adds with constants (the tables hold %ld entries) */\n}\n", nterm,
           (long)(3 * nm + 3 * nm + 3 * nm + 9 * nm * nm + 6 * nm * nm + 9 * nm));
@@ -826,6 +846,11 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
     }
     if (use[k] == 1 && d->body >= 0 && emit_marker_is_frame(L, k)) {
       fprintf(f, "  /* the frame of body '%s' itself: the rows read f%d */\n", L->body[d->body].name, d->body);
+      continue;
+    }
+    int twin = emit_marker_node_twin(L, k, use);
+    if (twin >= 0) {
+      fprintf(f, "  mb_marker k%d = k%d; /* the same node and axes */\n", k, twin);
       continue;
     }
     fprintf(f, "  mb_marker k%d;\n", k);

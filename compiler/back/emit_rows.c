@@ -245,6 +245,16 @@ int emit_marker_special(FILE *f, const lmodel *L, int k) {
   return rows_graph_done(&g) ? -1 : 1;
 }
 
+int emit_marker_node_twin(const lmodel *L, int k, const char *computed) {
+  const mb_markerdef *d = &L->marker[k];
+  if (d->body < 0 || d->node < 0 || emit_node_static(&L->body[d->body], d->node)) return -1;
+  for (int j = 0; j < k; j++) {
+    const mb_markerdef *e = &L->marker[j];
+    if (computed[j] && e->body == d->body && e->node == d->node && !memcmp(e->C, d->C, sizeof d->C)) return j;
+  }
+  return -1;
+}
+
 /* marker k on a flexible node (mb_marker_node): the node's modal sums with
  * its shapes as constants (zeros dropped, the kernel's order kept), then
  * mb_marker_node_sums */
@@ -276,39 +286,85 @@ int emit_marker_node(FILE *f, const lmodel *L, int k) {
       fputs(";\n", f);
     }
   }
-  fprintf(f, "    mb_marker_node_sums(&f%d, b, th, thd, Xwd, (const mb_real[9]){", d->body);
-  for (int i = 0; i < 9; i++) {
-    if (i) fputs(", ", f);
-    put(f, &g, lit(&g, d->C[i]));
+  static const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  fprintf(f, "    mb_marker_node_sums(&f%d, b, th, thd, Xwd, ", d->body);
+  if (!memcmp(d->C, I, sizeof I)) /* the node's own axes: no product with C */
+    fputs("NULL", f);
+  else {
+    fputs("(const mb_real[9]){", f);
+    for (int i = 0; i < 9; i++) {
+      if (i) fputs(", ", f);
+      put(f, &g, lit(&g, d->C[i]));
+    }
+    fputc('}', f);
   }
-  fprintf(f, "}, &k%d);\n  }\n", k);
+  fprintf(f, ", &k%d);\n  }\n", k);
   return rows_graph_done(&g);
 }
 
-int emit_node_cols(FILE *f, const lmodel *L, int k, const char *dV, const char *dW, const char *indent) {
+/* The modal columns of mb_node_cols_mk at marker k (a flexible node) for the
+ * direction (dV, dW): X_j . lV + Psi_j . JtW, lV = A^T dV, JtW = Jl^T A^T dW,
+ * with the node's shapes as constants.  A zero dV or dW (a coincident-point
+ * row has no dW, an axis row and a force no dV or no dW) drops its half: the
+ * kernel multiplied those zeros at run time.  lV, lW and JtW become locals
+ * (their names end in 'sfx'); modal[j] is column 6 + j. */
+static void node_modal_cols(FILE *f, sym_graph *g, const lmodel *L, int k, const svec *dV, const svec *dW,
+                            const char *sfx, const char *indent, sym_id *modal) {
   const mb_markerdef *d = &L->marker[k];
   const mb_flex *fx = L->body[d->body].flex;
   int nm = fx->nm;
   const double *X = fx->node_X + 3 * d->node * nm, *Psi = fx->node_Psi + 3 * d->node * nm;
-  sym_graph g;
-  rows_graph(&g);
-  fprintf(f, "%s{ /* mb_node_cols_mk, node %d's shapes as constants */\n", indent, d->node);
-  fprintf(f, "%s  mb_real lV[3], JtW[3];\n", indent);
-  fprintf(f, "%s  mb_node_cols_local(&f%d, &k%d, %s, %s, c, lV, JtW);\n", indent, d->body, k, dV, dW);
-  svec lv, jw;
-  for (int i = 0; i < 3; i++) {
-    lv.e[i] = named(&g, "lV[%d]", i);
-    jw.e[i] = named(&g, "JtW[%d]", i);
-  }
+  sym_id A[9], Jl[9];
+  char nv[16];
+  frame_A(g, d->body, A);
+  for (int i = 0; i < 9; i++) Jl[i] = named(g, "k%d.Jl[%d]", k, i);
+  svec lV = s_mul3t(g, A, dV), lW = s_mul3t(g, A, dW);
+  snprintf(nv, sizeof nv, "lV%s", sfx);
+  s_local(f, g, &lV, nv, indent);
+  snprintf(nv, sizeof nv, "lW%s", sfx);
+  s_local(f, g, &lW, nv, indent);
+  svec JtW = s_mul3t(g, Jl, &lW);
+  snprintf(nv, sizeof nv, "JtW%s", sfx);
+  s_local(f, g, &JtW, nv, indent);
   for (int j = 0; j < nm; j++) {
     svec xj, pj;
     for (int i = 0; i < 3; i++) {
-      xj.e[i] = lit(&g, X[3 * j + i]);
-      pj.e[i] = lit(&g, Psi[3 * j + i]);
+      xj.e[i] = lit(g, X[3 * j + i]);
+      pj.e[i] = lit(g, Psi[3 * j + i]);
     }
-    fprintf(f, "%s  c[%d] = ", indent, 6 + j);
-    put(f, &g, sym_add(&g, s_dot(&g, &xj, &lv), s_dot(&g, &pj, &jw)));
-    fputs(";\n", f);
+    modal[j] = sym_add(g, s_dot(g, &xj, &lV), s_dot(g, &pj, &JtW));
+  }
+}
+
+/* the 3-vector named 'name' of the generated code (the force elements pass a
+ * zero force or moment as zero3: constant zeros) */
+static svec arg_vec(sym_graph *g, const char *name) {
+  if (!strcmp(name, "zero3")) return s_zero(g);
+  svec v;
+  for (int i = 0; i < 3; i++) v.e[i] = named(g, "%s[%d]", name, i);
+  return v;
+}
+
+int emit_node_cols(FILE *f, const lmodel *L, int k, const char *dV, const char *dW, const char *indent) {
+  const mb_markerdef *d = &L->marker[k];
+  int nm = L->body[d->body].flex->nm;
+  sym_graph g;
+  rows_graph(&g);
+  char in2[32];
+  snprintf(in2, sizeof in2, "%s  ", indent);
+  fprintf(f, "%s{ /* mb_node_cols_mk, node %d's shapes as constants */\n", indent, d->node);
+  fprintf(f, "%smb_rigid_cols(&f%d, k%d.P, %s, %s, c);\n", in2, d->body, k, dV, dW);
+  svec v = arg_vec(&g, dV), w = arg_vec(&g, dW);
+  sym_id *modal = malloc(sizeof *modal * (size_t)(nm ? nm : 1));
+  if (!modal) g.failed = 1;
+  else {
+    node_modal_cols(f, &g, L, k, &v, &w, "", in2, modal);
+    for (int j = 0; j < nm; j++) {
+      fprintf(f, "%sc[%d] = ", in2, 6 + j);
+      put(f, &g, modal[j]);
+      fputs(";\n", f);
+    }
+    free(modal);
   }
   fprintf(f, "%s}\n", indent);
   return rows_graph_done(&g);
@@ -392,7 +448,7 @@ int emit_row_side_varies(const lmodel *L, int r, int s) {
 
 /* row r's stores through marker s, the body columns c[0..5] nodes of g */
 static void row_stores(FILE *f, const sym_graph *g, const lmodel *L, int r, int s, const sym_id c[6],
-                       const char *indent) {
+                       const sym_id *modal, const char *indent) {
   const mb_rowdef *R = &L->row[r];
   int k = s ? R->m1 : R->m0;
   const mb_body *B = &L->body[L->marker[k].body];
@@ -407,7 +463,12 @@ static void row_stores(FILE *f, const sym_graph *g, const lmodel *L, int r, int 
   const int *ms = L->modal_slot + R->mslot[s];
   for (int j = 0; j < B->nm; j++)
     if (ms[j] >= 0 && stat) fprintf(f, "%sKx[%d] = Kx[%d] = 0;\n", indent, ms[j], ms[B->nm + j]);
-    else if (ms[j] >= 0) fprintf(f, "%sKx[%d] = Kx[%d] = c[%d];\n", indent, ms[j], ms[B->nm + j], 6 + j);
+    else if (ms[j] >= 0 && modal) {
+      fprintf(f, "%sKx[%d] = Kx[%d] = ", indent, ms[j], ms[B->nm + j]);
+      put(f, g, modal[j]);
+      fputs(";\n", f);
+    } else if (ms[j] >= 0)
+      fprintf(f, "%sKx[%d] = Kx[%d] = c[%d];\n", indent, ms[j], ms[B->nm + j], 6 + j);
 }
 
 int emit_row_stores(FILE *f, const lmodel *L, int r, int s, const char *const c[6], const char *indent) {
@@ -415,7 +476,7 @@ int emit_row_stores(FILE *f, const lmodel *L, int r, int s, const char *const c[
   rows_graph(&g);
   sym_id cs[6];
   for (int j = 0; j < 6; j++) cs[j] = sym_symbol(&g, c[j]);
-  row_stores(f, &g, L, r, s, cs, indent);
+  row_stores(f, &g, L, r, s, cs, NULL, indent);
   return rows_graph_done(&g);
 }
 
@@ -438,36 +499,24 @@ static void emit_row_common(FILE *f, sym_graph *g, const lmodel *L, int r, const
   for (int s = 0; s < 2; s++) {
     int k = s ? R->m1 : R->m0, b = L->marker[k].body;
     if (!emit_row_side_varies(L, r, s)) continue;
-    sym_id c[6];
-    if (mk[s].rigid) {
-      /* mb_rigid_cols: [dV; A^T ((P - r) x dV + dW)] */
-      sym_id A[9];
-      frame_A(g, b, A);
-      svec u = s_zero(g);
-      if (!mk[s].at_origin)
-        for (int i = 0; i < 3; i++) u.e[i] = sym_sub(g, mk[s].P.e[i], named(g, "f%d.r[%d]", b, i));
-      svec x = s_cross(g, &u, &dV[s]);
-      for (int i = 0; i < 3; i++) x.e[i] = sym_add(g, x.e[i], dW[s].e[i]);
-      s_local(f, g, &x, s ? "t1" : "t0", "    ");
-      svec a = s_mul3t(g, A, &x);
-      for (int i = 0; i < 3; i++) {
-        c[i] = dV[s].e[i];
-        c[3 + i] = a.e[i];
-      }
-    } else {
-      /* a flexible node: its modal columns too */
-      fprintf(f, "    mb_real dV%d[3] = ", s);
-      init3(f, g, &dV[s]);
-      fprintf(f, ", dW%d[3] = ", s);
-      init3(f, g, &dW[s]);
-      fputs(";\n", f);
-      char nv[16], nw[16];
-      snprintf(nv, sizeof nv, "dV%d", s);
-      snprintf(nw, sizeof nw, "dW%d", s);
-      if (emit_node_cols(f, L, k, nv, nw, "    ")) g->failed = 1;
-      for (int j = 0; j < 6; j++) c[j] = named(g, "c[%d]", j);
+    /* mb_rigid_cols: [dV; A^T ((P - r) x dV + dW)], on a flexible node too
+       (mb_node_cols_mk) with its modal columns after them */
+    sym_id c[6], modal[MB_MAX_MODES];
+    sym_id A[9];
+    frame_A(g, b, A);
+    svec u = s_zero(g);
+    if (!mk[s].at_origin)
+      for (int i = 0; i < 3; i++) u.e[i] = sym_sub(g, mk[s].P.e[i], named(g, "f%d.r[%d]", b, i));
+    svec x = s_cross(g, &u, &dV[s]);
+    for (int i = 0; i < 3; i++) x.e[i] = sym_add(g, x.e[i], dW[s].e[i]);
+    s_local(f, g, &x, s ? "t1" : "t0", "    ");
+    svec a = s_mul3t(g, A, &x);
+    for (int i = 0; i < 3; i++) {
+      c[i] = dV[s].e[i];
+      c[3 + i] = a.e[i];
     }
-    row_stores(f, g, L, r, s, c, "    ");
+    if (!mk[s].rigid) node_modal_cols(f, g, L, k, &dV[s], &dW[s], s ? "1" : "0", "    ", modal);
+    row_stores(f, g, L, r, s, c, mk[s].rigid ? NULL : modal, "    ");
   }
 }
 
@@ -588,7 +637,7 @@ static void emit_dot1_frames(FILE *f, sym_graph *g, const lmodel *L, int r, int 
     if (!emit_row_side_varies(L, r, s)) continue;
     const svec *c = s ? &c1 : &c0;
     sym_id zero = lit(g, 0), cs[6] = {zero, zero, zero, c->e[0], c->e[1], c->e[2]};
-    row_stores(f, g, L, r, s, cs, "    ");
+    row_stores(f, g, L, r, s, cs, NULL, "    ");
   }
   fputs("  }\n", f);
 }

@@ -26,11 +26,16 @@ int emit_row_is_special(const mb_rowdef *R);
 /* write row r if it is a spherical or dot-1 row: 1; 0: not handled; -1 out of memory */
 int emit_row_special(FILE *f, const lmodel *L, int r);
 
+/* an earlier marker j < k on the same flexible node with the same axes C,
+ * one that computed[j] says the evaluation forms (its numbers are marker
+ * k's: a copy replaces the modal sums and the rotation's kernel), or -1 */
+int emit_marker_node_twin(const lmodel *L, int k, const char *computed);
 /* write marker k on a flexible node: the modal sums with the node's shapes as
  * constants; 0, or -1 out of memory */
 int emit_marker_node(FILE *f, const lmodel *L, int k);
 /* c = mb_node_cols_mk at marker k (a flexible node) with the node's shapes as
- * constants; dV, dW: names of 3-vectors; 0, or -1 out of memory */
+ * constants; dV, dW: names of 3-vectors (zero3: zero, its half of the modal
+ * columns dropped); 0, or -1 out of memory */
 int emit_node_cols(FILE *f, const lmodel *L, int k, const char *dV, const char *dW, const char *indent);
 
 /* 1 when row r writes entries of D through its marker s (0 or 1): on a body,

@@ -104,17 +104,40 @@ static inline void mb_modal3(const mb_real *X, int nm, const mb_real *w, mb_real
     for (int i = 0; i < 3; i++) y[i] += X[3 * j + i] * w[j];
 }
 
+/* C = A B (3x3, row-major) written out: mb_matmul3's loop form costs about
+ * twice the instructions, and a node marker forms one or two per evaluation */
+static inline void mb_flex_matmul3(const mb_real A[9], const mb_real B[9], mb_real C[9]) {
+#ifdef __OPTIMIZE_SIZE__ /* -Os (the embedded target): the loop, a third of the code */
+  mb_matmul3(A, B, C);
+#else
+  C[0] = A[0] * B[0] + A[1] * B[3] + A[2] * B[6];
+  C[1] = A[0] * B[1] + A[1] * B[4] + A[2] * B[7];
+  C[2] = A[0] * B[2] + A[1] * B[5] + A[2] * B[8];
+  C[3] = A[3] * B[0] + A[4] * B[3] + A[5] * B[6];
+  C[4] = A[3] * B[1] + A[4] * B[4] + A[5] * B[7];
+  C[5] = A[3] * B[2] + A[4] * B[5] + A[5] * B[8];
+  C[6] = A[6] * B[0] + A[7] * B[3] + A[8] * B[6];
+  C[7] = A[6] * B[1] + A[7] * B[4] + A[8] * B[7];
+  C[8] = A[6] * B[2] + A[7] * B[5] + A[8] * B[8];
+#endif
+}
+
 /* marker on node k of a flexible body from the node's modal sums b = x_k + X_k w
  * (its position in body axes), th = Psi_k w, thd = Psi_k wd and Xwd = X_k wd
- * (the generated code forms them with the node's shapes as constants) */
+ * (the generated code forms them with the node's shapes as constants); C the
+ * marker's axes in the node's, NULL for the identity.  Everything is formed
+ * in locals and stored at the end: m may alias f as far as the compiler
+ * knows, and a store before the last read of f reloads the frame. */
 static inline void mb_marker_node_sums(const mb_frame *f, const mb_real b[3], const mb_real th[3],
                                        const mb_real thd[3], const mb_real Xwd[3], const mb_real C[9],
                                        mb_marker *m) {
-  mb_real Ex[9], AE[9], u[3], t1[3], t2[3], g[3], c[3], e[3], jd[3];
+  const mb_real *A = f->A, *wl = f->wl;
+  mb_real Ex[9], AE[9], Jl[9], t1[3], t2[3], g[3], c[3], e[3], jd[3];
+  mb_real P[3], V[3], aP[3], W[3], aW[3];
   mb_so3_coef k;
   mb_real p2 = mb_dot3(th, th);
   mb_so3_coefs(p2, &k);
-  mb_so3_poly(th, p2, k.a, k.b, m->Jl);
+  mb_so3_poly(th, p2, k.a, k.b, Jl);
   mb_so3_poly(th, p2, k.s1, k.c1, Ex);
   /* g = Jl thd = thd + a c + b th x c and jd = Jl' thd =
      (th . thd) (a1 c + b1 th x c) + b thd x c, with c = th x thd
@@ -127,25 +150,38 @@ static inline void mb_marker_node_sums(const mb_frame *f, const mb_real b[3], co
     g[i] = thd[i] + k.a * c[i] + k.b * e[i];
     jd[i] = tt * (k.a1 * c[i] + k.b1 * e[i]) + k.b * t1[i];
   }
-  mb_matmul3(f->A, Ex, AE);
-  mb_matmul3(AE, C, m->R);
-  mb_mul3(f->A, b, u);
+  mb_flex_matmul3(A, Ex, AE);
+  mb_mul3(A, b, P);
   /* V = rd + A (w' x b + X wd) */
-  mb_cross3(f->wl, b, t1);
+  mb_cross3(wl, b, t1);
   for (int i = 0; i < 3; i++) t1[i] += Xwd[i];
-  mb_mul3(f->A, t1, t2);
-  for (int i = 0; i < 3; i++) { m->P[i] = f->r[i] + u[i]; m->V[i] = f->rd[i] + t2[i]; }
+  mb_mul3(A, t1, V);
   /* aP = A (w' x (w' x b) + 2 w' x X wd) */
-  mb_wwa(f->wl, b, t1);
-  mb_cross3(f->wl, Xwd, t2);
+  mb_wwa(wl, b, t1);
+  mb_cross3(wl, Xwd, t2);
   for (int i = 0; i < 3; i++) t1[i] += 2 * t2[i];
-  mb_mul3(f->A, t1, m->aP);
+  mb_mul3(A, t1, aP);
   /* W = A (w' + Jl thd),  aW = A (w' x Jl thd + Jl' thd) */
-  for (int i = 0; i < 3; i++) t1[i] = f->wl[i] + g[i];
-  mb_mul3(f->A, t1, m->W);
-  mb_cross3(f->wl, g, t1);
+  for (int i = 0; i < 3; i++) t1[i] = wl[i] + g[i];
+  mb_mul3(A, t1, W);
+  mb_cross3(wl, g, t1);
   for (int i = 0; i < 3; i++) t1[i] += jd[i];
-  mb_mul3(f->A, t1, m->aW);
+  mb_mul3(A, t1, aW);
+  for (int i = 0; i < 3; i++) {
+    P[i] += f->r[i];
+    V[i] += f->rd[i];
+  }
+  if (C) mb_flex_matmul3(AE, C, m->R);
+  else
+    for (int i = 0; i < 9; i++) m->R[i] = AE[i];
+  for (int i = 0; i < 9; i++) m->Jl[i] = Jl[i];
+  for (int i = 0; i < 3; i++) {
+    m->P[i] = P[i];
+    m->V[i] = V[i];
+    m->aP[i] = aP[i];
+    m->W[i] = W[i];
+    m->aW[i] = aW[i];
+  }
 }
 
 /* marker on node k of a flexible body (frame f, modal w, wd), axes C in body axes */
