@@ -761,15 +761,18 @@ static void emit_flex_contract(emit_ctx *cx, int b) {
 /* the evaluation's body is written to a memory stream with its elements
  * marked; emit_split.c writes it as one function or, when large, in parts
  * (into files of their own when EF says so: emit_files.c) */
-/* marker k is read by reader (a force i, or row r as nforce + r) with use u */
-static void mark_reader(char *use, int *first, int k, char u, int reader) {
+/* marker k is read by reader (a force i, or row r as nforce + r) with use u;
+   spring: the reader is a spring, which reads only the point and its velocity */
+static void mark_reader(char *use, char *springs_only, int *first, int k, char u, int reader, int spring) {
   if (use[k] < u) use[k] = u;
+  if (!spring) springs_only[k] = 0;
   if (first[k] > reader) first[k] = reader;
 }
 
 /* the markers whose first reader is `reader`, at the top level of the
    evaluation (later readers in other parts of the split find them there) */
-static void emit_markers_of(emit_ctx *cx, FILE *f, const char *use, const int *first, int reader) {
+static void emit_markers_of(emit_ctx *cx, FILE *f, const char *use, const char *springs_only, const int *first,
+                            int reader) {
   const lmodel *L = cx->L;
   for (int k = 0; k < L->m.nmarker; k++) {
     if (first[k] != reader) continue;
@@ -787,6 +790,9 @@ static void emit_markers_of(emit_ctx *cx, FILE *f, const char *use, const int *f
       if (emit_marker_special(f, L, k) < 0) cx->failed = 1;
     } else if (d->node >= 0) {
       if (emit_marker_node(f, L, k)) cx->failed = 1;
+    } else if (springs_only[k]) {
+      fputs("  /* mb_marker_rigid's point and velocity (all a spring reads), its zeros and ones folded */\n", f);
+      if (emit_marker_point_velocity(f, L, k) < 0) cx->failed = 1;
     } else {
       fputs("  /* mb_marker_rigid, its zeros and ones folded */\n", f);
       if (emit_marker_special(f, L, k) < 0) cx->failed = 1;
@@ -834,25 +840,27 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
      rigid car that copying was about a third of the evaluation. */
   int nreader = m->nforce + m->nrow;
   char *use = calloc(m->nmarker ? (size_t)m->nmarker : 1, 1);
+  char *springs_only = malloc(m->nmarker ? (size_t)m->nmarker : 1);
   int *first = malloc(sizeof *first * (size_t)(m->nmarker ? m->nmarker : 1));
-  if (!use || !first) {
-    free(use), free(first);
+  if (!use || !springs_only || !first) {
+    free(use), free(springs_only), free(first);
     cx->failed = 1;
     eval_split_finish(&sp, NULL, nm, head, NULL);
     return;
   }
-  for (int k = 0; k < m->nmarker; k++) first[k] = nreader;
+  for (int k = 0; k < m->nmarker; k++) first[k] = nreader, springs_only[k] = 1;
   for (int i = 0; i < m->nforce; i++) {
-    mark_reader(use, first, L->force[i].m0, 2, i);
-    if (L->force[i].m1 >= 0) mark_reader(use, first, L->force[i].m1, 2, i);
+    int spring = L->force[i].kind == MB_FORCE_SPRING;
+    mark_reader(use, springs_only, first, L->force[i].m0, 2, i, spring);
+    if (L->force[i].m1 >= 0) mark_reader(use, springs_only, first, L->force[i].m1, 2, i, spring);
     if (L->force[i].kind == MB_FORCE_SUPERELEMENT) /* its nodes 2.. follow marker m1 */
       for (int j = 1; j < (int)L->force_prm[L->force[i].padr + MB_SUPER_N]; j++)
-        mark_reader(use, first, L->force[i].m1 + j, 2, i);
+        mark_reader(use, springs_only, first, L->force[i].m1 + j, 2, i, 0);
   }
   for (int r = 0; r < m->nrow; r++) {
     char u = emit_row_is_special(&L->row[r]) ? 1 : 2;
-    mark_reader(use, first, L->row[r].m0, u, m->nforce + r);
-    mark_reader(use, first, L->row[r].m1, u, m->nforce + r);
+    mark_reader(use, springs_only, first, L->row[r].m0, u, m->nforce + r, 0);
+    mark_reader(use, springs_only, first, L->row[r].m1, u, m->nforce + r, 0);
   }
   eval_split_mark(&sp, "the body forces");
   fprintf(f, "\n  /* body forces: gravity and the quadratic-velocity (gyroscopic) terms */\n");
@@ -908,7 +916,7 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
   for (int k = 0; k < m->nforce; k++) {
     const ir_force *F = &L->ir->forces[L->force_ir[k]];
     if (k) eval_split_mark(&sp, "force '%s'", F->name);
-    emit_markers_of(cx, f, use, first, k);
+    emit_markers_of(cx, f, use, springs_only, first, k);
     fprintf(f, "  { /* force '%s' (", F->name);
     loc_comment(f, L, F->loc);
     fputs(") */\n", f);
@@ -926,7 +934,7 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
   for (int r = 0; r < m->nrow; r++) {
     const mb_rowdef *R = &L->row[r];
     eval_split_mark(&sp, "row %d (%s)", r, L->row_desc[r]);
-    emit_markers_of(cx, f, use, first, m->nforce + r);
+    emit_markers_of(cx, f, use, springs_only, first, m->nforce + r);
     fprintf(f, "  /* row %d: %s (", r, L->row_desc[r]);
     loc_comment(f, L, L->row_loc[r]);
     fputs(") */\n", f);
@@ -965,6 +973,7 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
     }
   }
   free(use);
+  free(springs_only);
   free(first);
   if (eval_split_finish(&sp, out, nm, head, emit_files_eval_hooks(EF)) < 0) cx->failed = 1;
 }
