@@ -71,9 +71,12 @@ for model in $MODELS; do
     { cat "$W/$name.compile.log" >&2; die "mbcc compile $model failed"; }
   python3 scripts/mjcf_from_yaml.py "$model" "$W/$name.xml"
   printf '#include "%s.h"\nconst mb_model *const peer_model = &%s_model;\n' "$name" "$name" >"$W/$name/peer_model.c"
+  # every file of the model (a large one is split: <name>.sources lists them)
+  srcs=$W/$name/$name.c
+  [ ! -e "$W/$name/$name.sources" ] || srcs=$(sed "s|^|$W/$name/|" "$W/$name/$name.sources" | tr '\n' ' ')
   # shellcheck disable=SC2086
   "$CC" -std=c11 $CFLAGS_GEN -Iruntime/core -Iruntime/hosted -I"$W/$name" bench/peers/mujoco_peer.c \
-    "$W/$name/$name.c" "$W/$name/peer_model.c" "$RTLIB" $LIBS -o "$W/${name}_peer" 2>"$W/$name.cc.log" ||
+    $srcs "$W/$name/peer_model.c" "$RTLIB" $LIBS -o "$W/${name}_peer" 2>"$W/$name.cc.log" ||
     { cat "$W/$name.cc.log" >&2; die "building the peer of $name failed"; }
   # calls per round: about 2 ms of mj_forward each
   reps=200

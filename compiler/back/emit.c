@@ -782,6 +782,52 @@ static void emit_flex_contract(emit_ctx *cx, int b) {
 /* the evaluation's body is written to a memory stream with its elements
  * marked; emit_split.c writes it as one function or, when large, in parts
  * (into files of their own when EF says so: emit_files.c) */
+/* marker k is read by reader (a force i, or row r as nforce + r) with use u;
+   spring: the reader is a spring, which reads only the point and its velocity */
+static void mark_reader(char *use, char *springs_only, int *first, int k, char u, int reader, int spring) {
+  if (use[k] < u) use[k] = u;
+  if (!spring) springs_only[k] = 0;
+  if (first[k] > reader) first[k] = reader;
+}
+
+/* the markers whose first reader is `reader`, at the top level of the
+   evaluation (later readers in other parts of the split find them there) */
+static void emit_markers_of(emit_ctx *cx, FILE *f, const char *use, const char *springs_only, const int *first,
+                            char *computed, int reader) {
+  const lmodel *L = cx->L;
+  for (int k = 0; k < L->m.nmarker; k++) {
+    if (first[k] != reader) continue;
+    const mb_markerdef *d = &L->marker[k];
+    fprintf(f, "  /* %s */\n", L->marker_desc[k]);
+    if (use[k] == 1 && d->body >= 0 && emit_marker_is_frame(L, k)) {
+      fprintf(f, "  /* the frame of body '%s' itself: the rows read f%d */\n", L->body[d->body].name, d->body);
+      continue;
+    }
+    int twin = emit_marker_node_twin(L, k, computed);
+    if (twin >= 0) {
+      fprintf(f, "  mb_marker k%d = k%d; /* the same node and axes */\n", k, twin);
+      computed[k] = 1;
+      continue;
+    }
+    fprintf(f, "  mb_marker k%d;\n", k);
+    if (d->body < 0) {
+      fprintf(f, "  mb_marker_ground(markers[%d].s, markers[%d].C, &k%d);\n", k, k, k);
+    } else if (d->node >= 0 && emit_node_static(&L->body[d->body], d->node)) {
+      fprintf(f, "  /* node %d: its mode shapes vanish: a rigid marker (mb_marker_rigid) */\n", d->node);
+      if (emit_marker_special(f, L, k) < 0) cx->failed = 1;
+    } else if (d->node >= 0) {
+      if (emit_marker_node(f, L, k)) cx->failed = 1;
+      computed[k] = 1; /* whole: a later marker on the same node and axes copies it */
+    } else if (springs_only[k]) {
+      fputs("  /* mb_marker_rigid's point and velocity (all a spring reads), its zeros and ones folded */\n", f);
+      if (emit_marker_point_velocity(f, L, k) < 0) cx->failed = 1;
+    } else {
+      fputs("  /* mb_marker_rigid, its zeros and ones folded */\n", f);
+      if (emit_marker_special(f, L, k) < 0) cx->failed = 1;
+    }
+  }
+}
+
 static void emit_eval(emit_ctx *cx, emit_files *EF) {
   FILE *out = cx->f;
   eval_split sp;
@@ -816,57 +862,40 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
     fprintf(f, "  mb_frame f%d;\n  mb_frame_rigid(q + %d, v + %d, &f%d); /* body '%s' */\n", b,
             L->body[b].qadr, L->body[b].vadr, b, L->body[b].name);
   }
-  eval_split_mark(&sp, "the markers");
-  fprintf(f, "\n  /* markers */\n");
   /* use[k]: 0 no row or force element reads marker k (a joint whose rows were
      all removed as redundant): not computed; 1 only the spherical and dot-1
      rows of emit_row_special read it (they read the frame when the marker is
      its body's frame: then it is not stored); 2 forces or other rows pass it
-     to kernels by address */
+     to kernels by address.  first[k]: its first reader, force i as i, row r
+     as nforce + r; the marker is computed just before it.  Computed up front,
+     all markers went through the eval split's shared struct whole (36 reals
+     each, every field stored and copied back into each reading part): on the
+     rigid car that copying was about a third of the evaluation. */
+  int nreader = m->nforce + m->nrow;
   char *use = calloc(m->nmarker ? (size_t)m->nmarker : 1, 1);
-  if (!use) { cx->failed = 1; eval_split_finish(&sp, NULL, nm, head, NULL); return; }
+  char *computed = calloc(m->nmarker ? (size_t)m->nmarker : 1, 1); /* node markers formed whole so far */
+  char *springs_only = malloc(m->nmarker ? (size_t)m->nmarker : 1);
+  int *first = malloc(sizeof *first * (size_t)(m->nmarker ? m->nmarker : 1));
+  if (!use || !computed || !springs_only || !first) {
+    free(use), free(computed), free(springs_only), free(first);
+    cx->failed = 1;
+    eval_split_finish(&sp, NULL, nm, head, NULL);
+    return;
+  }
+  for (int k = 0; k < m->nmarker; k++) first[k] = nreader, springs_only[k] = 1;
   for (int i = 0; i < m->nforce; i++) {
-    use[L->force[i].m0] = 2;
-    if (L->force[i].m1 >= 0) use[L->force[i].m1] = 2;
+    int spring = L->force[i].kind == MB_FORCE_SPRING;
+    mark_reader(use, springs_only, first, L->force[i].m0, 2, i, spring);
+    if (L->force[i].m1 >= 0) mark_reader(use, springs_only, first, L->force[i].m1, 2, i, spring);
     if (L->force[i].kind == MB_FORCE_SUPERELEMENT) /* its nodes 2.. follow marker m1 */
-      for (int j = 1; j < (int)L->force_prm[L->force[i].padr + MB_SUPER_N]; j++) use[L->force[i].m1 + j] = 2;
+      for (int j = 1; j < (int)L->force_prm[L->force[i].padr + MB_SUPER_N]; j++)
+        mark_reader(use, springs_only, first, L->force[i].m1 + j, 2, i, 0);
   }
   for (int r = 0; r < m->nrow; r++) {
     char u = emit_row_is_special(&L->row[r]) ? 1 : 2;
-    if (use[L->row[r].m0] < u) use[L->row[r].m0] = u;
-    if (use[L->row[r].m1] < u) use[L->row[r].m1] = u;
+    mark_reader(use, springs_only, first, L->row[r].m0, u, m->nforce + r, 0);
+    mark_reader(use, springs_only, first, L->row[r].m1, u, m->nforce + r, 0);
   }
-  for (int k = 0; k < m->nmarker; k++) {
-    const mb_markerdef *d = &L->marker[k];
-    if (k) eval_split_mark(&sp, "marker %d (%s)", k, L->marker_desc[k]);
-    fprintf(f, "  /* %s */\n", L->marker_desc[k]);
-    if (!use[k]) {
-      fputs("  /* read by no row or force element: not computed */\n", f);
-      continue;
-    }
-    if (use[k] == 1 && d->body >= 0 && emit_marker_is_frame(L, k)) {
-      fprintf(f, "  /* the frame of body '%s' itself: the rows read f%d */\n", L->body[d->body].name, d->body);
-      continue;
-    }
-    int twin = emit_marker_node_twin(L, k, use);
-    if (twin >= 0) {
-      fprintf(f, "  mb_marker k%d = k%d; /* the same node and axes */\n", k, twin);
-      continue;
-    }
-    fprintf(f, "  mb_marker k%d;\n", k);
-    if (d->body < 0) {
-      fprintf(f, "  mb_marker_ground(markers[%d].s, markers[%d].C, &k%d);\n", k, k, k);
-    } else if (d->node >= 0 && emit_node_static(&L->body[d->body], d->node)) {
-      fprintf(f, "  /* node %d: its mode shapes vanish: a rigid marker (mb_marker_rigid) */\n", d->node);
-      if (emit_marker_special(f, L, k) < 0) cx->failed = 1;
-    } else if (d->node >= 0) {
-      if (emit_marker_node(f, L, k)) cx->failed = 1;
-    } else {
-      fputs("  /* mb_marker_rigid, its zeros and ones folded */\n", f);
-      if (emit_marker_special(f, L, k) < 0) cx->failed = 1;
-    }
-  }
-  free(use);
   eval_split_mark(&sp, "the body forces");
   fprintf(f, "\n  /* body forces: gravity and the quadratic-velocity (gyroscopic) terms */\n");
   for (int b = 0; b < m->nbody; b++) {
@@ -921,6 +950,7 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
   for (int k = 0; k < m->nforce; k++) {
     const ir_force *F = &L->ir->forces[L->force_ir[k]];
     if (k) eval_split_mark(&sp, "force '%s'", F->name);
+    emit_markers_of(cx, f, use, springs_only, first, computed, k);
     fprintf(f, "  { /* force '%s' (", F->name);
     loc_comment(f, L, F->loc);
     fputs(") */\n", f);
@@ -938,6 +968,7 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
   for (int r = 0; r < m->nrow; r++) {
     const mb_rowdef *R = &L->row[r];
     eval_split_mark(&sp, "row %d (%s)", r, L->row_desc[r]);
+    emit_markers_of(cx, f, use, springs_only, first, computed, m->nforce + r);
     fprintf(f, "  /* row %d: %s (", r, L->row_desc[r]);
     loc_comment(f, L, L->row_loc[r]);
     fputs(") */\n", f);
@@ -975,6 +1006,10 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
       if (emit_cols(f, L, mk, P, dV, dW, "  ") < 0 || emit_row_stores(f, L, r, s, cs, "  ")) cx->failed = 1;
     }
   }
+  free(use);
+  free(computed);
+  free(springs_only);
+  free(first);
   if (eval_split_finish(&sp, out, nm, head, emit_files_eval_hooks(EF)) < 0) cx->failed = 1;
 }
 

@@ -205,7 +205,9 @@ static int svec_is_zero(const sym_graph *g, const svec *v) {
   return is_zero(g, v->e[0]) && is_zero(g, v->e[1]) && is_zero(g, v->e[2]);
 }
 
-int emit_marker_special(FILE *f, const lmodel *L, int k) {
+/* mb_marker_rigid's fields, or with point_only only P and V (all a spring
+   reads: the axes and the accelerations it never reads are left unset) */
+static int marker_rigid_fields(FILE *f, const lmodel *L, int k, int point_only) {
   if (!marker_rigid(L, k, NULL)) return 0;
   const mb_markerdef *d = &L->marker[k];
   int b = d->body;
@@ -218,7 +220,7 @@ int emit_marker_special(FILE *f, const lmodel *L, int k) {
   svec Ai[3];
   for (int i = 0; i < 3; i++)
     for (int l = 0; l < 3; l++) Ai[i].e[l] = A[3 * i + l];
-  for (int i = 0; i < 3; i++)
+  for (int i = 0; i < 3 && !point_only; i++)
     for (int j = 0; j < 3; j++) {
       svec Cj = {{lit(&g, d->C[j]), lit(&g, d->C[3 + j]), lit(&g, d->C[6 + j])}};
       fprintf(f, "  k%d.R[%d] = ", k, 3 * i + j);
@@ -231,17 +233,20 @@ int emit_marker_special(FILE *f, const lmodel *L, int k) {
     fputs("  {\n    mb_real u[3] = ", f);
     init3(f, &g, &u);
     fputs(", wu[3];\n", f);
-    fprintf(f, "    mb_cross3(f%d.w, u, wu);\n    mb_cross3(f%d.w, wu, k%d.aP);\n", b, b, k);
+    fprintf(f, "    mb_cross3(f%d.w, u, wu);\n", b);
+    if (!point_only) fprintf(f, "    mb_cross3(f%d.w, wu, k%d.aP);\n", b, k);
     for (int i = 0; i < 3; i++)
       fprintf(f, "    k%d.P[%d] = f%d.r[%d] + u[%d];\n    k%d.V[%d] = f%d.rd[%d] + wu[%d];\n", k, i, b,
               i, i, k, i, b, i, i);
     fputs("  }\n", f);
   } else {
-    for (int i = 0; i < 3; i++)
-      fprintf(f, "  k%d.P[%d] = f%d.r[%d];\n  k%d.V[%d] = f%d.rd[%d];\n  k%d.aP[%d] = 0;\n", k, i, b,
-              i, k, i, b, i, k, i);
+    for (int i = 0; i < 3; i++) {
+      fprintf(f, "  k%d.P[%d] = f%d.r[%d];\n  k%d.V[%d] = f%d.rd[%d];\n", k, i, b, i, k, i, b, i);
+      if (!point_only) fprintf(f, "  k%d.aP[%d] = 0;\n", k, i);
+    }
   }
-  for (int i = 0; i < 3; i++) fprintf(f, "  k%d.W[%d] = f%d.w[%d];\n  k%d.aW[%d] = 0;\n", k, i, b, i, k, i);
+  for (int i = 0; i < 3 && !point_only; i++)
+    fprintf(f, "  k%d.W[%d] = f%d.w[%d];\n  k%d.aW[%d] = 0;\n", k, i, b, i, k, i);
   return rows_graph_done(&g) ? -1 : 1;
 }
 
@@ -254,6 +259,10 @@ int emit_marker_node_twin(const lmodel *L, int k, const char *computed) {
   }
   return -1;
 }
+
+int emit_marker_special(FILE *f, const lmodel *L, int k) { return marker_rigid_fields(f, L, k, 0); }
+
+int emit_marker_point_velocity(FILE *f, const lmodel *L, int k) { return marker_rigid_fields(f, L, k, 1); }
 
 /* marker k on a flexible node (mb_marker_node): the node's modal sums with
  * its shapes as constants (zeros dropped, the kernel's order kept), then

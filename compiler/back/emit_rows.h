@@ -13,6 +13,9 @@ int emit_node_static(const mb_body *B, int node);
 /* write marker k if it sits on a rigid body (or a static node): 1; 0: not
  * handled; -1 out of memory */
 int emit_marker_special(FILE *f, const lmodel *L, int k);
+/* the same with only the point P and its velocity V set (a marker that only
+ * springs read) */
+int emit_marker_point_velocity(FILE *f, const lmodel *L, int k);
 /* 1 if marker k coincides with its body's frame (rigid body or static node,
  * s = 0, C = I): the rows of emit_row_special read the frame, not the marker */
 int emit_marker_is_frame(const lmodel *L, int k);

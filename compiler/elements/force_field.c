@@ -371,13 +371,55 @@ static int emit_superelement(FILE *f, const lmodel *L, int k) {
 }
 
 /* the wrench on marker 1 at its point; the reaction on body 0 at the same point */
+/* a parameter that is zero whatever the run: not a run-time parameter */
+static int prm_always_zero(const lmodel *L, int slot) {
+  return !(L->prm_runtime && L->prm_runtime[slot]) && L->force_prm[slot] == 0;
+}
+
+/* mb_field's F and T with the zeros of K and C (a bushing's off-diagonal
+   terms, a tyre stand-in's five unused directions) left out: the kernel's
+   6x6 products, its energy and, when no rotation is stiff or damped, the
+   relative rotation (an atan2) cost about 700 instructions a call.  The
+   terms that remain keep the kernel's order, so the sums are the same. */
+static void emit_field_wrench(FILE *f, const lmodel *L, int k) {
+  const mb_forcedef *d = &L->force[k];
+  const int K = d->padr + MB_FIELD_K, C = d->padr + MB_FIELD_C, pre = d->padr + MB_FIELD_PRE;
+  int rotation = 0, torque = 0;
+  for (int i = 0; i < 6; i++)
+    for (int j = 0; j < 6; j++) {
+      int stiff = !prm_always_zero(L, K + 6 * i + j) || !prm_always_zero(L, C + 6 * i + j);
+      if (j >= 3) rotation |= stiff;
+      if (i >= 3) torque |= stiff || !prm_always_zero(L, pre + i);
+    }
+  fprintf(f, "    mb_real u[6], ud[6], fl[6], F[3], T[3];\n"
+             "    mb_field_relative_translation(&k%d, &k%d, force_prm + %d, u, ud);\n",
+          d->m0, d->m1, d->padr + MB_FIELD_D0);
+  if (rotation) fprintf(f, "    mb_field_relative_rotation(&k%d, &k%d, u + 3, ud + 3);\n", d->m0, d->m1);
+  for (int i = 0; i < (torque ? 6 : 3); i++) {
+    fprintf(f, "    fl[%d] = force_prm[%d]", i, pre + i);
+    for (int j = 0; j < 6; j++) {
+      int kz = prm_always_zero(L, K + 6 * i + j), cz = prm_always_zero(L, C + 6 * i + j);
+      if (kz && cz) continue;
+      fputs(" - (", f);
+      if (!kz) fprintf(f, "force_prm[%d] * u[%d]", K + 6 * i + j, j);
+      if (!kz && !cz) fputs(" + ", f);
+      if (!cz) fprintf(f, "force_prm[%d] * ud[%d]", C + 6 * i + j, j);
+      fputc(')', f);
+    }
+    fputs(";\n", f);
+  }
+  fprintf(f, "    mb_mul3(k%d.R, fl, F);\n", d->m0);
+  if (torque)
+    fprintf(f, "    mb_mul3(k%d.R, fl + 3, T);\n", d->m0);
+  else
+    fputs("    T[0] = T[1] = T[2] = 0;\n", f);
+}
+
 static int emit_field(FILE *f, const lmodel *L, int k) {
   const mb_forcedef *d = &L->force[k];
   if (d->kind == MB_FORCE_SUPERELEMENT) return emit_superelement(f, L, k);
   int b0 = L->marker[d->m0].body, b1 = L->marker[d->m1].body;
-  fprintf(f, "    mb_real F[3], T[3];\n"
-             "    mb_field(&k%d, &k%d, force_prm + %d, F, T, 0);\n",
-          d->m0, d->m1, d->padr);
+  emit_field_wrench(f, L, k);
   if (b0 >= 0)
     fputs("    mb_real mF[3] = {-F[0], -F[1], -F[2]}, mT[3] = {-T[0], -T[1], -T[2]};\n", f);
   if (b1 >= 0) {

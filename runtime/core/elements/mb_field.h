@@ -31,28 +31,38 @@ enum {
  * derivatives (row-major) of marker 1's wrench [F; T] with respect to its
  * displacement [dP1; dphi1] (global; dphi1 a small rotation, R1 -> (I + dphi1~) R1),
  * then the 6x6 with respect to its velocities [V1; W1]. */
-/* the relative displacement u and rate ud of marker 1 from marker 0 (mb_field's) */
-static inline void mb_field_relative(const mb_marker *m0, const mb_marker *m1, const mb_real d0[3], mb_real u[6],
-                                     mb_real ud[6]) {
-  mb_real d[3], dd[3], wd[3], Rr[9], wxd[3];
-  for (int j = 0; j < 3; j++) {
-    d[j] = m1->P[j] - m0->P[j];
-    wd[j] = m1->W[j] - m0->W[j];
-  }
+/* mb_field's relative displacement and rate, translations: u[0..2], ud[0..2] */
+static inline void mb_field_relative_translation(const mb_marker *m0, const mb_marker *m1, const mb_real d0[3],
+                                                 mb_real u[3], mb_real ud[3]) {
+  mb_real d[3], dd[3], wxd[3];
+  for (int j = 0; j < 3; j++) d[j] = m1->P[j] - m0->P[j];
   mb_cross3(m0->W, d, wxd);
   for (int j = 0; j < 3; j++) dd[j] = m1->V[j] - m0->V[j] - wxd[j];
   mb_mul3t(m0->R, d, u);
   for (int j = 0; j < 3; j++) u[j] -= d0[j];
   mb_mul3t(m0->R, dd, ud);
-  /* relative rotation R0^T R1 and its rotation vector */
+}
+
+/* ... and rotations: th = the rotation vector of R0^T R1 and R0^T (W1 - W0) */
+static inline void mb_field_relative_rotation(const mb_marker *m0, const mb_marker *m1, mb_real th[3],
+                                              mb_real thd[3]) {
+  mb_real Rr[9], wd[3];
+  for (int j = 0; j < 3; j++) wd[j] = m1->W[j] - m0->W[j];
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++)
       Rr[3 * i + j] = m0->R[i] * m1->R[j] + m0->R[3 + i] * m1->R[3 + j] + m0->R[6 + i] * m1->R[6 + j];
   mb_real v[3] = {MB_R(0.5) * (Rr[7] - Rr[5]), MB_R(0.5) * (Rr[2] - Rr[6]), MB_R(0.5) * (Rr[3] - Rr[1])};
   mb_real sn = MB_SQRT(mb_dot3(v, v)), cs = MB_R(0.5) * (Rr[0] + Rr[4] + Rr[8] - 1);
   mb_real ang = MB_ATAN2(sn, cs), fac = (sn > MB_R(1e-12)) ? ang / sn : 1;
-  for (int j = 0; j < 3; j++) u[3 + j] = fac * v[j];
-  mb_mul3t(m0->R, wd, ud + 3);
+  for (int j = 0; j < 3; j++) th[j] = fac * v[j];
+  mb_mul3t(m0->R, wd, thd);
+}
+
+/* the relative displacement u and rate ud of marker 1 from marker 0 (mb_field's) */
+static inline void mb_field_relative(const mb_marker *m0, const mb_marker *m1, const mb_real d0[3], mb_real u[6],
+                                     mb_real ud[6]) {
+  mb_field_relative_translation(m0, m1, d0, u, ud);
+  mb_field_relative_rotation(m0, m1, u + 3, ud + 3);
 }
 
 static inline mb_real mb_field(const mb_marker *m0, const mb_marker *m1, const mb_real *prm,
