@@ -2,11 +2,17 @@
 # check_bad_models.sh: the reader alone (tests/check_reader.c) on
 # tests/bad_models/*.yaml.  A model it rejects must get exactly one error,
 # containing its "# expect:" line and, if given, at its "# expect-loc:
-# LINE:COL".  Models it accepts hold errors for later stages (assembly...):
-# they are listed, not failed; tests/test_bad_models.c checks them via mbcc.
+# LINE:COL" (or FILE:LINE:COL in a file the model names).  Models it
+# accepts hold errors for later stages (assembly...): they are listed, not
+# failed; tests/test_bad_models.c checks them via mbcc.
 # Usage: tests/check_bad_models.sh CHECK_READER_BINARY
 reader=${1:?usage: $0 path/to/check_reader}
 dir=$(dirname "$0")/bad_models
+# where an error is expected: LINE:COL of the model, or FILE:LINE:COL of a
+# file it names (FILE relative to the model's folder)
+where() {
+  case $2 in *:*:*) echo "$(dirname "$1")/$2" ;; *) echo "$1:$2" ;; esac
+}
 failed=0
 total=0
 later=0
@@ -29,7 +35,7 @@ for model in "$dir"/*.yaml; do
     problem="$errors errors, expected 1"
   elif ! printf '%s\n' "$line" | grep -qF -- "$expect"; then
     problem="message does not contain: $expect"
-  elif [ -n "$loc" ] && ! printf '%s\n' "$line" | grep -qF -- "$model:$loc: error: "; then
+  elif [ -n "$loc" ] && ! printf '%s\n' "$line" | grep -qF -- "$(where "$model" "$loc"): error: "; then
     problem="error not at $loc"
   fi
   if [ -n "$problem" ]; then

@@ -3,7 +3,9 @@
  * `mbcc check`, and `mbcc compile` writes nothing for it.  Each file states
  * what it expects in its first lines:
  *   # expect: <substring of the message>
- *   # expect-loc: LINE:COL          (optional)
+ *   # expect-loc: LINE:COL          (optional; FILE:LINE:COL: in FILE, a file
+ *                                    the model names, relative to its folder)
+ *   # expect-note-loc: LINE:COL     (optional: a note at this place of the model)
  * Also: a redundant model compiles with a warning naming the joints. */
 #define _POSIX_C_SOURCE 200809L
 #include <dirent.h>
@@ -26,23 +28,24 @@ static void copy(char *d, size_t n, const char *s) {
   d[i] = 0;
 }
 
-static void expectations(const char *path, char *msg, size_t n, char *loc, size_t nl) {
+static void expectations(const char *path, char *msg, size_t n, char *loc, char *note_loc, size_t nl) {
   FILE *f = fopen(path, "r");
   char line[1024];
-  msg[0] = loc[0] = 0;
+  msg[0] = loc[0] = note_loc[0] = 0;
   if (!f) return;
   while (fgets(line, sizeof line, f)) {
     line[strcspn(line, "\r\n")] = 0;
     if (!strncmp(line, "# expect: ", 10)) copy(msg, n, line + 10);
     else if (!strncmp(line, "# expect-loc: ", 14)) copy(loc, nl, line + 14);
+    else if (!strncmp(line, "# expect-note-loc: ", 19)) copy(note_loc, nl, line + 19);
   }
   fclose(f);
 }
 
 static void check_bad_model(void **state) {
   const char *path = *state;
-  char msg[512], loc[64], cmd[2048], out[16384];
-  expectations(path, msg, sizeof msg, loc, sizeof loc);
+  char msg[512], loc[64], note_loc[64], cmd[2048], out[16384];
+  expectations(path, msg, sizeof msg, loc, note_loc, sizeof loc);
   if (!msg[0]) {
     print_error("%s has no '# expect:' line\n", path);
     fail();
@@ -54,9 +57,18 @@ static void check_bad_model(void **state) {
     fail();
   }
   char where[1200];
-  snprintf(where, sizeof where, "%s:%s: error: ", path, loc[0] ? loc : "");
+  const char *slash = strrchr(path, '/');
+  if (strchr(loc, ':') != strrchr(loc, ':')) /* FILE:LINE:COL, FILE in the model's folder */
+    snprintf(where, sizeof where, "%.*s%s: error: ", slash ? (int)(slash - path + 1) : 0, path, loc);
+  else
+    snprintf(where, sizeof where, "%s:%s: error: ", path, loc);
   if (loc[0] && !strstr(out, where)) {
     print_error("%s: expected an error at %s, got:\n%s\n", path, loc, out);
+    fail();
+  }
+  snprintf(where, sizeof where, "%s:%s: note: ", path, note_loc);
+  if (note_loc[0] && !strstr(out, where)) {
+    print_error("%s: expected a note at %s, got:\n%s\n", path, note_loc, out);
     fail();
   }
   if (!strstr(out, ": error: ")) {

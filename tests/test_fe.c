@@ -3,13 +3,12 @@
  * consistent mass, h^2 lumped), Timoshenko against Euler-Bernoulli and against
  * the simply supported Timoshenko closed form, Craig-Bampton against the full
  * FE model, mass normalization, lumped masses, axial modes, invariance under a
- * rotation of the model, the modal data file round trip and its diagnostics,
+ * rotation of the model, the mode selection among a modal data file's modes,
  * static condensation (superelement, two and more nodes), residual attachment modes (static correction, free-interface + residual
  * against the full FE model, inertia relief on a free-free body), and the
  * errors for bad FE data. */
 #include "../compiler/flex/fe.c"
 #include "../compiler/flex/fe_sparse.c"
-#include "../compiler/front/bounds.c" /* fe.c bounds the modal data file */
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -588,51 +587,21 @@ static void test_normalization_and_masses(void **state) {
 
 /* --- 5. modal data file ------------------------------------------------------------------------ */
 
-static void tmp_path(char *buf, size_t n, const char *name) {
-  const char *b = getenv("B");
-  snprintf(buf, n, "%s/tests/%s_%ld.yaml", b && *b ? b : "build", name, (long)getpid());
-}
-
-static void write_text(const char *path, const char *text) {
-  FILE *f = fopen(path, "w");
-  assert_non_null(f);
-  fputs(text, f);
-  fclose(f);
-}
-
-static void expect_file_error(const char *path, const char *text, int line, int col, const char *msg) {
-  write_text(path, text);
-  ir_flex fx;
-  memset(&fx, 0, sizeof fx);
-  fx.modal_file = (char *)path;
-  fx.select = MODES_ALL;
-  fe_modes m;
-  char err[1024], want[1024];
-  ir_loc where = {7, 7};
-  int rc = fe_compute_modes_at(&fx, &m, err, sizeof err, &where);
-  snprintf(want, sizeof want, "%s:%d:%d: error: ", path, line, col);
-  if (rc == 0 || strncmp(err, want, strlen(want)) || !strstr(err, msg)) {
-    print_error("rc %d, message: %s\n(expected it to start %s and contain '%s')\n", rc, rc ? err : "-", want, msg);
-    fail();
-  }
-  assert_int_equal(where.line, 0);
-  assert_null(m.shapes);
-  remove(path);
-}
-
+/* The front end reads and checks the file (compiler/front/modal_file.c;
+ * its errors: tests/bad_models/1NN_modal_NAME.yaml; the written file read back:
+ * tests/test_modal_file.sh); fe.c takes its modes as given and selects among
+ * them. */
 static void test_modal_file(void **state) {
   (void)state;
   ir_flex fx;
   frame3d(&fx, 3, MASS_LUMPED, BEAM_TIMOSHENKO);
   fe_modes m;
   assert_int_equal(compute(&fx, &m), 0);
-  char path[512], err[1024];
-  tmp_path(path, sizeof path, "fe_modal");
-  assert_int_equal(fe_modes_write(&m, path, "frame \"3d\", lumped", err, sizeof err), 0);
-
+  ir_modal_data md = {m.nnodes, m.nmodes, m.x, m.node_mass, m.node_inertia, m.freq_hz, m.shapes};
   ir_flex rf;
   memset(&rf, 0, sizeof rf);
-  rf.modal_file = path;
+  rf.modal_file = "frame.modal";
+  rf.modal = &md;
   rf.select = MODES_ALL;
   fe_modes r;
   assert_int_equal(compute(&rf, &r), 0);
@@ -645,7 +614,7 @@ static void test_modal_file(void **state) {
     for (int i = 0; i < 9; i++) assert_true(r.node_inertia[9 * k + i] == m.node_inertia[9 * k + i]);
   }
   for (int j = 0; j < m.nmodes; j++) {
-    assert_true(r.freq_hz[j] == m.freq_hz[j]);
+    assert_true(r.freq_hz[j] == m.freq_hz[j] && r.all_freq_hz[j] == m.freq_hz[j]);
     for (int i = 0; i < 6 * m.nnodes; i++)
       assert_true(r.shapes[(size_t)j * 6 * m.nnodes + i] == m.shapes[(size_t)j * 6 * m.nnodes + i]);
   }
@@ -659,6 +628,7 @@ static void test_modal_file(void **state) {
   assert_int_equal(r.nmodes, 3);
   assert_true(r.freq_hz[0] == m.freq_hz[1] && r.freq_hz[1] == m.freq_hz[4] && r.freq_hz[2] == m.freq_hz[8]);
   assert_true(r.shapes[6 * m.nnodes - 1] == m.shapes[(size_t)1 * 6 * m.nnodes + 6 * m.nnodes - 1]);
+  assert_true(r.shapes[(size_t)3 * 6 * m.nnodes - 1] == m.shapes[(size_t)9 * 6 * m.nnodes - 1]);
   assert_int_equal(r.nall, m.nmodes);
   fe_modes_free(&r);
   rf.select = MODES_MAX_FREQUENCY;
@@ -666,61 +636,19 @@ static void test_modal_file(void **state) {
   assert_int_equal(compute(&rf, &r), 0);
   assert_int_equal(r.nmodes, 4);
   fe_modes_free(&r);
+  char err[1024];
   rf.select = MODES_COUNT;
   rf.count = m.nmodes + 1;
   assert_int_not_equal(fe_compute_modes(&rf, &r, err, sizeof err), 0);
   assert_non_null(strstr(err, "exceeds"));
-  /* nodal masses that do not normalize the shapes */
-  for (int k = 0; k < m.nnodes; k++) m.node_mass[k] *= 1.01;
-  assert_int_equal(fe_modes_write(&m, path, NULL, err, sizeof err), 0);
+  assert_null(r.shapes);
+  /* a file named but not read (the front end reports why): no modes */
+  rf.modal = NULL;
   rf.select = MODES_ALL;
   assert_int_not_equal(fe_compute_modes(&rf, &r, err, sizeof err), 0);
-  assert_non_null(strstr(err, "is not mass-normalized with respect to the nodal masses"));
-  assert_true(!strncmp(err, path, strlen(path)));
-  remove(path);
+  assert_non_null(strstr(err, "was not read"));
   fe_modes_free(&m);
   free_flex(&fx);
-
-  /* malformed files: file:line:col */
-  tmp_path(path, sizeof path, "fe_bad");
-  const char *head = "format: mbcc-modal-1\n"
-                     "nodes:\n"
-                     "  - {position: [0, 0, 0], mass: 1}\n"
-                     "  - {position: [1, 0, 0], mass: 4, inertia: [1, 2, 3]}\n";
-  char text[2048];
-  snprintf(text, sizeof text, "%smodes:\n  - frequency: 3\n    shape:\n      - [1, 0, 0, 0, 0, 0]\n"
-                              "      - [0, 0.5, 0, 0, 0]\n", head);
-  expect_file_error(path, text, 9, 9, "a shape row (ux uy uz rx ry rz) must have 6 numbers (got 5)");
-  snprintf(text, sizeof text, "%smodes:\n  - frequency: 3\n    shape: [[1, 0, 0, 0, 0, 0]\n", head);
-  expect_file_error(path, text, 8, 1, "did not find expected ',' or ']'");
-  snprintf(text, sizeof text, "%smodes:\n  - frequency: 3\n    shapes: []\n", head);
-  expect_file_error(path, text, 7, 5, "unknown key 'shapes' in mode 1 (expected frequency or shape)");
-  snprintf(text, sizeof text, "%smodes:\n  - frequency: fast\n    shape: []\n", head);
-  expect_file_error(path, text, 6, 16, "frequency must be a finite number (got 'fast')");
-  expect_file_error(path, "format: mbcc-modal-2\nnodes: []\nmodes: []\n", 1, 9, "unsupported format");
-  snprintf(text, sizeof text, "%smodes:\n  - frequency: 3\n    shape: [[1, 0, 0, 0, 0, 0], [0, 0, 0, 0, 0, 0]]\n"
-                              "  - frequency: 5\n    shape: [[0, 0, 0, 0, 0, 0], [0, 0.5, 0, 0, 0, 0]]\n"
-                              "  - frequency: 6\n    shape: [[0, 0, 0, 0, 0, 0], [0, 0, 0, 1, 0, 0]]\n"
-                              "  - frequency: 7\n    shape: [[0, 0, 0.6, 0, 0, 0], [0, 0.4, 0, 0, 0, 0]]\n",
-           head);
-  expect_file_error(path, text, 12, 5, "modes 2 and 4 are not orthogonal");
-  {
-    /* the same without the last mode is valid: masses 1, 4, inertia diag(1, 2, 3) */
-    char *cut = strstr(text, "  - frequency: 7");
-    *cut = 0;
-    write_text(path, text);
-    memset(&rf, 0, sizeof rf);
-    rf.modal_file = path;
-    rf.select = MODES_ALL;
-    assert_int_equal(compute(&rf, &r), 0);
-    assert_int_equal(r.nmodes, 3);
-    assert_true(r.node_inertia[9 + 8] == 3 && r.node_inertia[9 + 1] == 0);
-    fe_modes_free(&r);
-    remove(path);
-  }
-  rf.modal_file = "/nonexistent/modes.yaml";
-  assert_int_not_equal(fe_compute_modes(&rf, &r, err, sizeof err), 0);
-  assert_non_null(strstr(err, "/nonexistent/modes.yaml: error: cannot open"));
 }
 
 /* --- 6. errors in the FE data ----------------------------------------------------------------------- */

@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # test_modal_file.sh: a flexible body read from a modal data file (written by
-# `mbcc modes --write-modal` from the FE model) moves exactly as the FE body.
+# `mbcc modes --write-modal` from the FE model) moves exactly as the FE body;
+# the file read and written again is the same file (numbers bit for bit); a
+# file over MBCC_MAX_INPUT is refused at the model's 'modal_file'.  (The
+# errors in a modal data file: tests/bad_models/1NN_modal_NAME.yaml.)
 set -eu
 MBCC=${MBCC:-build/mbcc}
 MBCC=$(cd "$(dirname "$MBCC")" && pwd)/$(basename "$MBCC")
@@ -19,6 +22,16 @@ sed -e 's|    line: {from: \[0.1524, 0, 0\], to: \[0.4572, 0, 0\], elements: 8}|
 cd "$tmp"
 "$MBCC" check scf_modal.yaml > check.txt
 grep -q "frequencies (Hz): 48.7275 48.7275 298.777" check.txt
+"$MBCC" modes scf_modal.yaml --body rod --write-modal back.modal.yaml > /dev/null
+grep -v '^description:' rod.modal.yaml > written.txt
+grep -v '^description:' back.modal.yaml > read_back.txt
+[ "$(grep -c '^  - frequency:' written.txt)" -ge 4 ]
+cmp written.txt read_back.txt
+limit=$(wc -c < scf_modal.yaml)
+[ "$(wc -c < rod.modal.yaml)" -gt "$limit" ]
+if MBCC_MAX_INPUT=$limit "$MBCC" check scf_modal.yaml > big.txt 2>&1; then cat big.txt; exit 1; fi
+grep -q "^scf_modal.yaml:[0-9]*:[0-9]*: error: the modal data file 'rod.modal.yaml' is larger than the limit of $limit bytes" big.txt ||
+  { cat big.txt; exit 1; }
 "$MBCC" run scf_modal.yaml -o modal.csv --plot none --quiet --end 0.02
 "$MBCC" run "$root/models/slider_crank_flexible.yaml" -o fe.csv --plot none --quiet --end 0.02
 # same midspan deflection history (column 4)

@@ -2,8 +2,8 @@
  * consistent and HRZ-lumped mass), dense assembly, and the modal reduction of
  * a flexible body: constrained normal modes or Craig-Bampton (LAPACK: the
  * generalized symmetric-definite eigenproblem, see gen_eig), mode selection,
- * and the modal data file (docs/modal-file.md), read with libyaml and
- * written back.
+ * and the modal data file (docs/modal-file.md): the selection among its
+ * modes (the front end reads it: compiler/front/modal_file.c), and writing one.
  *
  * Conventions.  6 DOFs per node: ux uy uz rx ry rz in body axes.  An
  * element's local frame: x from node 0 to node 1, y = the section's yaxis
@@ -36,7 +36,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <yaml.h>
 
 #include "bounds.h"
 #include "fe.h"
@@ -71,8 +70,6 @@ static const char *const dof_names[6] = {"ux", "uy", "uz", "rx", "ry", "rz"};
 #define FE_PI 3.14159265358979323846
 /* a pivot of K this small relative to its diagonal term means a mechanism */
 #define FE_PIVOT_TOL 1e-11
-/* modal data file: tolerance of X^T M X = I */
-#define FE_NORM_TOL 1e-6
 /* above this many free DOFs the sparse eigensolver is used (eigensolver: auto) */
 #define FE_SPARSE_MIN_DOFS 3000
 
@@ -1747,277 +1744,28 @@ done:
 /* ------------------------------------------------------------------------- */
 /* modal data file                                                            */
 
-typedef struct {
-  const char *path;
-  yaml_document_t *doc;
-  fe_ctx *c;
-} mf_ctx;
-
-#if defined(__GNUC__) || defined(__clang__)
-__attribute__((format(printf, 3, 4)))
-#endif
-static int mf_fail(mf_ctx *m, const yaml_node_t *node, const char *fmt, ...) {
-  char msg[768];
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(msg, sizeof msg, fmt, ap);
-  va_end(ap);
-  if (node)
-    return fail_at(m->c, no_loc, "%s:%lu:%lu: error: %s", m->path,
-                   (unsigned long)node->start_mark.line + 1, (unsigned long)node->start_mark.column + 1,
-                   msg);
-  return fail_at(m->c, no_loc, "%s: error: %s", m->path, msg);
-}
-
-static const char *node_kind(const yaml_node_t *n) {
-  switch (n->type) {
-  case YAML_SCALAR_NODE: return "a scalar";
-  case YAML_SEQUENCE_NODE: return "a sequence";
-  case YAML_MAPPING_NODE: return "a mapping";
-  default: return "nothing";
-  }
-}
-
-static int mf_number(mf_ctx *m, const yaml_node_t *n, const char *what, double *v) {
-  if (n->type != YAML_SCALAR_NODE)
-    return mf_fail(m, n, "%s must be a number (got %s)", what, node_kind(n));
-  const char *s = (const char *)n->data.scalar.value;
-  char *end = NULL;
-  errno = 0;
-  double d = strtod(s, &end);
-  if (end == s || (size_t)(end - s) != n->data.scalar.length || !isfinite(d))
-    return mf_fail(m, n, "%s must be a finite number (got '%s')", what, s);
-  *v = d;
-  return 0;
-}
-
-/* a flow or block sequence of numbers; its length must be one of len1, len2 */
-static int mf_numbers(mf_ctx *m, const yaml_node_t *n, const char *what, int len1, int len2,
-                      double *v, int *len) {
-  if (n->type != YAML_SEQUENCE_NODE)
-    return mf_fail(m, n, "%s must be a sequence of %d numbers (got %s)", what, len1, node_kind(n));
-  int k = (int)(n->data.sequence.items.top - n->data.sequence.items.start);
-  if (k != len1 && k != len2) {
-    if (len2 != len1)
-      return mf_fail(m, n, "%s must have %d or %d numbers (got %d)", what, len1, len2, k);
-    return mf_fail(m, n, "%s must have %d numbers (got %d)", what, len1, k);
-  }
-  for (int i = 0; i < k; i++)
-    if (mf_number(m, yaml_document_get_node(m->doc, n->data.sequence.items.start[i]), what, v + i))
-      return -1;
-  if (len) *len = k;
-  return 0;
-}
-
-static int mf_seq_len(const yaml_node_t *n) {
-  return (int)(n->data.sequence.items.top - n->data.sequence.items.start);
-}
-
-static yaml_node_t *mf_item(mf_ctx *m, const yaml_node_t *seq, int i) {
-  return yaml_document_get_node(m->doc, seq->data.sequence.items.start[i]);
-}
-
-/* the values of a mapping's keys (from 'keys', NULL-terminated); unknown and
- * repeated keys are errors */
-static int mf_mapping(mf_ctx *m, const yaml_node_t *n, const char *what, const char *const *keys,
-                      yaml_node_t **vals) {
-  if (n->type != YAML_MAPPING_NODE) return mf_fail(m, n, "%s must be a mapping (got %s)", what, node_kind(n));
-  int nk = 0;
-  while (keys[nk]) vals[nk++] = NULL;
-  for (yaml_node_pair_t *p = n->data.mapping.pairs.start; p < n->data.mapping.pairs.top; p++) {
-    yaml_node_t *k = yaml_document_get_node(m->doc, p->key);
-    if (k->type != YAML_SCALAR_NODE) return mf_fail(m, k, "%s: keys must be scalars", what);
-    const char *s = (const char *)k->data.scalar.value;
-    int i = 0;
-    while (i < nk && strcmp(keys[i], s)) i++;
-    if (i == nk) {
-      char exp[256] = "";
-      for (int j = 0; j < nk; j++) {
-        size_t l = strlen(exp);
-        snprintf(exp + l, sizeof exp - l, "%s%s", j ? (j == nk - 1 ? " or " : ", ") : "", keys[j]);
-      }
-      return mf_fail(m, k, "unknown key '%s' in %s (expected %s)", s, what, exp);
-    }
-    if (vals[i]) return mf_fail(m, k, "key '%s' given twice in %s", s, what);
-    vals[i] = yaml_document_get_node(m->doc, p->value);
-  }
-  return 0;
-}
-
-#define MODAL_FORMAT "mbcc-modal-1"
-
-static int modes_from_file(const ir_flex *fx, fe_modes *out, fe_ctx *c) {
-  const char *path = fx->modal_file;
-  FILE *f = fopen(path, "rb");
-  if (!f) return fail_at(c, no_loc, "%s: error: cannot open the modal data file: %s", path, strerror(errno));
-  yaml_parser_t parser;
-  yaml_document_t doc;
-  if (!yaml_parser_initialize(&parser)) {
-    fclose(f);
-    return fail_at(c, no_loc, "%s: error: out of memory", path);
-  }
-  /* bounded like a model file: the size, then the bracket depth (bounds.h) */
-  double max_input = limit_value("MBCC_MAX_INPUT", LIMIT_INPUT_BYTES);
-  size_t cap = (size_t)fmin(max_input, 1e12) + 1, len = 0;
-  char *text = malloc(cap);
-  if (text) len = fread(text, 1, cap, f);
-  size_t deep_at = 0;
-  const char *why = !text ? "out of memory" : ferror(f) ? "cannot read it"
-                    : (double)len > max_input ? "larger than the limit of MBCC_MAX_INPUT bytes"
-                    : yaml_flow_depth(text, len, LIMIT_YAML_DEPTH, &deep_at) > LIMIT_YAML_DEPTH
-                        ? "brackets nested too deep" : NULL;
-  if (why) {
-    free(text);
-    yaml_parser_delete(&parser);
-    fclose(f);
-    return fail_at(c, no_loc, "%s: error: the modal data file: %s", path, why);
-  }
-  yaml_parser_set_input_string(&parser, (const unsigned char *)text, len);
-  if (!yaml_parser_load(&parser, &doc)) {
-    const yaml_mark_t *mk = &parser.problem_mark;
-    fail_at(c, no_loc, "%s:%lu:%lu: error: %s%s%s", path, (unsigned long)mk->line + 1,
-            (unsigned long)mk->column + 1, parser.problem ? parser.problem : "invalid YAML",
-            parser.context ? " " : "", parser.context ? parser.context : "");
-    yaml_parser_delete(&parser);
-    free(text);
-    fclose(f);
-    return -1;
-  }
-  yaml_parser_delete(&parser);
-  free(text);
-  fclose(f);
-  mf_ctx m = {path, &doc, c};
-  int rc = -1, nn = 0, nm = 0, *sel = NULL;
-  double *pos = NULL, *mass = NULL, *inertia = NULL, *freq = NULL, *shapes = NULL;
-  yaml_node_t *root = yaml_document_get_root_node(&doc);
-  if (!root) { mf_fail(&m, NULL, "the modal data file is empty"); goto done; }
-  static const char *const top_keys[] = {"format", "description", "nodes", "modes", NULL};
-  yaml_node_t *top[4];
-  if (mf_mapping(&m, root, "the modal data file", top_keys, top)) goto done;
-  if (!top[0]) { mf_fail(&m, root, "missing 'format: " MODAL_FORMAT "'"); goto done; }
-  if (top[0]->type != YAML_SCALAR_NODE || strcmp((const char *)top[0]->data.scalar.value, MODAL_FORMAT)) {
-    mf_fail(&m, top[0], "unsupported format (expected '" MODAL_FORMAT "')");
-    goto done;
-  }
-  if (top[1] && top[1]->type != YAML_SCALAR_NODE) { mf_fail(&m, top[1], "description must be a string"); goto done; }
-  if (!top[2]) { mf_fail(&m, root, "missing 'nodes'"); goto done; }
-  if (!top[3]) { mf_fail(&m, root, "missing 'modes'"); goto done; }
-  if (top[2]->type != YAML_SEQUENCE_NODE || mf_seq_len(top[2]) == 0) {
-    mf_fail(&m, top[2], "nodes must be a nonempty sequence (got %s)", node_kind(top[2]));
-    goto done;
-  }
-  if (top[3]->type != YAML_SEQUENCE_NODE) {
-    mf_fail(&m, top[3], "modes must be a sequence (got %s)", node_kind(top[3]));
-    goto done;
-  }
-  nn = mf_seq_len(top[2]);
-  nm = mf_seq_len(top[3]);
-  pos = xcalloc(3 * (size_t)nn, sizeof(double));
-  mass = xcalloc((size_t)nn, sizeof(double));
-  inertia = xcalloc(9 * (size_t)nn, sizeof(double));
-  freq = xcalloc((size_t)nm, sizeof(double));
-  shapes = xcalloc(6 * (size_t)nn * (size_t)nm, sizeof(double));
-  sel = xcalloc((size_t)nm, sizeof(int));
-  if (!pos || !mass || !inertia || !freq || !shapes || !sel) { mf_fail(&m, NULL, "out of memory"); goto done; }
-  static const char *const node_keys[] = {"position", "mass", "inertia", NULL};
-  for (int k = 0; k < nn; k++) {
-    yaml_node_t *nd = mf_item(&m, top[2], k), *v[3];
-    char what[64];
-    snprintf(what, sizeof what, "node %d", k);
-    if (mf_mapping(&m, nd, what, node_keys, v)) goto done;
-    if (!v[0]) { mf_fail(&m, nd, "node %d: missing 'position'", k); goto done; }
-    if (!v[1]) { mf_fail(&m, nd, "node %d: missing 'mass'", k); goto done; }
-    if (mf_numbers(&m, v[0], "position", 3, 3, pos + 3 * k, NULL)) goto done;
-    if (mf_number(&m, v[1], "mass", mass + k)) goto done;
-    if (mass[k] < 0) { mf_fail(&m, v[1], "node %d: mass must be nonnegative (got %g)", k, mass[k]); goto done; }
-    if (v[2]) {
-      double I[9];
-      int len = 0;
-      if (mf_numbers(&m, v[2], "inertia", 3, 9, I, &len)) goto done;
-      double *J = inertia + 9 * k;
-      if (len == 3) {
-        J[0] = I[0]; J[4] = I[1]; J[8] = I[2];
-      } else
-        memcpy(J, I, sizeof I);
-      double big = 0;
-      for (int i = 0; i < 9; i++) big = fmax(big, fabs(J[i]));
-      for (int i = 0; i < 3; i++)
-        for (int j = 0; j < i; j++)
-          if (fabs(J[3 * i + j] - J[3 * j + i]) > 1e-9 * big) {
-            mf_fail(&m, v[2], "node %d: inertia is not symmetric", k);
-            goto done;
-          }
-      if (J[0] < 0 || J[4] < 0 || J[8] < 0) {
-        mf_fail(&m, v[2], "node %d: inertia has a negative diagonal term", k);
-        goto done;
-      }
+/* the modes of a modal data file, read and checked by the front end
+   (compiler/front/modal_file.c): the selection applies to them */
+static int modes_from_data(const ir_flex *fx, fe_modes *out, fe_ctx *c) {
+  const ir_modal_data *md = fx->modal;
+  if (!md) return fail_at(c, fx->loc, "its modal data file %s was not read", fx->modal_file);
+  int nn = md->nnodes, nm = md->nmodes, ns = 0;
+  int *sel = xcalloc((size_t)nm, sizeof(int));
+  if (!sel) return fail_at(c, fx->loc, "out of memory");
+  int rc = select_modes(fx, md->freq_hz, nm, sel, &ns, "modes in the modal data file", c);
+  if (!rc && alloc_modes(out, nn, ns, nm)) rc = fail_at(c, fx->loc, "out of memory");
+  if (!rc) {
+    memcpy(out->x, md->position, 3 * (size_t)nn * sizeof(double));
+    memcpy(out->node_mass, md->mass, (size_t)nn * sizeof(double));
+    memcpy(out->node_inertia, md->inertia, 9 * (size_t)nn * sizeof(double));
+    memcpy(out->all_freq_hz, md->freq_hz, (size_t)nm * sizeof(double));
+    for (int j = 0; j < ns; j++) {
+      out->freq_hz[j] = md->freq_hz[sel[j]];
+      memcpy(out->shapes + (size_t)j * 6 * nn, md->shapes + (size_t)sel[j] * 6 * nn,
+             6 * (size_t)nn * sizeof(double));
     }
   }
-  static const char *const mode_keys[] = {"frequency", "shape", NULL};
-  for (int j = 0; j < nm; j++) {
-    yaml_node_t *md = mf_item(&m, top[3], j), *v[2];
-    char what[64];
-    snprintf(what, sizeof what, "mode %d", j + 1);
-    if (mf_mapping(&m, md, what, mode_keys, v)) goto done;
-    if (!v[0]) { mf_fail(&m, md, "mode %d: missing 'frequency'", j + 1); goto done; }
-    if (!v[1]) { mf_fail(&m, md, "mode %d: missing 'shape'", j + 1); goto done; }
-    if (mf_number(&m, v[0], "frequency", freq + j)) goto done;
-    if (freq[j] < 0) { mf_fail(&m, v[0], "mode %d: frequency must be nonnegative (got %g Hz)", j + 1, freq[j]); goto done; }
-    if (j > 0 && freq[j] < freq[j - 1]) {
-      mf_fail(&m, v[0], "mode %d: frequencies must be ascending (%.17g Hz after %.17g Hz)", j + 1,
-              freq[j], freq[j - 1]);
-      goto done;
-    }
-    if (v[1]->type != YAML_SEQUENCE_NODE || mf_seq_len(v[1]) != nn) {
-      mf_fail(&m, v[1], "mode %d: shape must be a sequence of one row per node (%d), got %s%s", j + 1,
-              nn, node_kind(v[1]), v[1]->type == YAML_SEQUENCE_NODE ? " of another length" : "");
-      goto done;
-    }
-    for (int k = 0; k < nn; k++)
-      if (mf_numbers(&m, mf_item(&m, v[1], k), "a shape row (ux uy uz rx ry rz)", 6, 6,
-                     shapes + (size_t)j * 6 * nn + 6 * k, NULL))
-        goto done;
-  }
-  /* X^T M X = I with the lumped nodal masses and inertias */
-  for (int a = 0; a < nm; a++)
-    for (int b = 0; b <= a; b++) {
-      const double *xa = shapes + (size_t)a * 6 * nn, *xb = shapes + (size_t)b * 6 * nn;
-      double g = 0;
-      for (int k = 0; k < nn; k++) {
-        const double *u = xa + 6 * k, *v = xb + 6 * k, *J = inertia + 9 * k;
-        g += mass[k] * (u[0] * v[0] + u[1] * v[1] + u[2] * v[2]);
-        for (int i = 0; i < 3; i++)
-          for (int l = 0; l < 3; l++) g += u[3 + i] * J[3 * i + l] * v[3 + l];
-      }
-      yaml_node_t *md = mf_item(&m, top[3], a);
-      if (a == b && fabs(g - 1) > FE_NORM_TOL) {
-        mf_fail(&m, md,
-                "mode %d is not mass-normalized with respect to the nodal masses and inertias: "
-                "x^T M x = %.10g (expected 1 to %g)", a + 1, g, FE_NORM_TOL);
-        goto done;
-      }
-      if (a != b && fabs(g) > FE_NORM_TOL) {
-        mf_fail(&m, md,
-                "modes %d and %d are not orthogonal with respect to the nodal masses and inertias: "
-                "x%d^T M x%d = %.10g (expected 0 to %g)", b + 1, a + 1, b + 1, a + 1, g, FE_NORM_TOL);
-        goto done;
-      }
-    }
-  int ns = 0;
-  if (select_modes(fx, freq, nm, sel, &ns, "modes in the modal data file", c)) goto done;
-  if (alloc_modes(out, nn, ns, nm)) { mf_fail(&m, NULL, "out of memory"); goto done; }
-  memcpy(out->x, pos, 3 * (size_t)nn * sizeof(double));
-  memcpy(out->node_mass, mass, (size_t)nn * sizeof(double));
-  memcpy(out->node_inertia, inertia, 9 * (size_t)nn * sizeof(double));
-  memcpy(out->all_freq_hz, freq, (size_t)nm * sizeof(double));
-  for (int j = 0; j < ns; j++) {
-    out->freq_hz[j] = freq[sel[j]];
-    memcpy(out->shapes + (size_t)j * 6 * nn, shapes + (size_t)sel[j] * 6 * nn, 6 * (size_t)nn * sizeof(double));
-  }
-  rc = 0;
-done:
-  yaml_document_delete(&doc);
-  free(pos); free(mass); free(inertia); free(freq); free(shapes); free(sel);
+  free(sel);
   return rc;
 }
 
@@ -2040,7 +1788,7 @@ int fe_modes_write(const fe_modes *m, const char *path, const char *description,
   if (!f) return fail_at(&c, no_loc, "%s: error: cannot write the modal data file: %s", path, strerror(errno));
   fprintf(f, "# modal data file of a flexible body (format: docs/modal-file.md); SI units.\n");
   fprintf(f, "# Shapes are mass-normalized with respect to the nodal masses and inertias.\n");
-  fprintf(f, "format: " MODAL_FORMAT "\n");
+  fprintf(f, "format: " IR_MODAL_FORMAT "\n");
   if (description) {
     fprintf(f, "description: ");
     write_string(f, description);
@@ -2073,7 +1821,7 @@ int fe_compute_modes_at(const ir_flex *fx, fe_modes *out, char *err, size_t nerr
   fe_ctx c = {err, nerr, where};
   memset(out, 0, sizeof *out);
   if (where) *where = no_loc;
-  int rc = fx->modal_file ? modes_from_file(fx, out, &c) : modes_from_fe(fx, out, &c);
+  int rc = fx->modal_file ? modes_from_data(fx, out, &c) : modes_from_fe(fx, out, &c);
   if (rc) fe_modes_free(out);
   return rc ? -1 : 0;
 }

@@ -60,8 +60,8 @@ void fe_modes_free(fe_modes *m);
 
 /* As fe_assemble and fe_compute_modes, and also report in *where the source
  * location of the item at fault (a beam, a point mass, a node, or the body);
- * line 0 when there is none.  Errors in a modal data file already carry
- * their place: err then reads "file:line:col: error: ..." and where->line is 0.
+ * line 0 when there is none.  A modal data file's modes come from the IR
+ * (fx->modal, read and checked by the front end): only the selection applies.
  * Node numbers in messages are the IR's (0-based) indices.
  * Craig-Bampton: the selection applies to the fixed-interface normal modes,
  * and all_freq_hz lists those; the result is the 6 x (interface nodes) +

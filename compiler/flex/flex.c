@@ -185,8 +185,6 @@ int flex_compute_modes(const char *path, const ir_body *B, fe_modes *fm) {
   }
   if (where.line > 0) /* at a node, beam or point mass: of the YAML FE file if it has one */
     diag_error(B->flex->fe_source ? B->flex->fe_source : path, where, "flexible body '%s': %s", B->name, err);
-  else if (strstr(err, ": error: ")) /* a modal data file's own diagnostic */
-    fprintf(stderr, "%s\n", err), diag_error(path, B->loc, "flexible body '%s': its modal data file is invalid", B->name);
   else
     diag_error(path, B->loc, "flexible body '%s': %s", B->name, err);
   return 2;

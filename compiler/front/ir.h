@@ -86,8 +86,22 @@ typedef struct {
  * (chord) frame; free-free modes in mean axes (frame at the centre of mass) */
 typedef enum { REFERENCE_CLAMPED, REFERENCE_CHORD, REFERENCE_FREE } ir_reference_kind;
 
+/* The content of a modal data file (docs/modal-file.md), as the reader read
+ * and checked it (compiler/front/modal_file.c): every mode, before the
+ * body's mode selection (compiler/flex/fe.c applies that). */
+#define IR_MODAL_FORMAT "mbcc-modal-1"
+typedef struct {
+  int nnodes, nmodes;
+  double *position;  /* 3 nnodes: undeformed, body axes, relative to the body frame origin */
+  double *mass;      /* nnodes: lumped translational masses */
+  double *inertia;   /* 9 nnodes: rotary inertias about the nodes, body axes, row-major */
+  double *freq_hz;   /* nmodes, ascending */
+  double *shapes;    /* 6 nnodes per mode, mode after mode; orthonormal with respect to
+                        the nodal masses and inertias */
+} ir_modal_data;
+
 typedef struct ir_flex {
-  /* FE description (nmodal_file == NULL) */
+  /* FE description (modal_file == NULL) */
   int nnodes;
   double *nodes;           /* 3 * nnodes: positions in body axes relative to the body frame origin */
   ir_loc *node_loc;        /* where each node (or the generator) was given */
@@ -124,7 +138,8 @@ typedef struct ir_flex {
   int nw0, nwd0;
   ir_loc w0_loc, wd0_loc;
   /* modal data file instead of FE (documented neutral format) */
-  char *modal_file;
+  char *modal_file;        /* its path */
+  ir_modal_data *modal;    /* its content */
   /* mode selection */
   ir_mode_select select;
   int count;               /* MODES_COUNT */

@@ -34,6 +34,7 @@
 #include "yaml_map.h"
 #include "fe_import.h"
 #include "fe.h"
+#include "modal_file.h"
 
 
 static bool is_null_scalar(const yaml_node_t *n) {
@@ -557,52 +558,42 @@ static bool is_yaml_name(const char *path) {
  * keys of an inline one; errors are located in that file.  Returns the node
  * positions (global), or NULL after an error. */
 static double *parse_fe_yaml(reader *r, ir_body *b, ir_flex *fx, char *path) {
-  size_t size = 0;
-  double max_input = limit_value("MBCC_MAX_INPUT", LIMIT_INPUT_BYTES);
-  char *data = read_file(path, &size, max_input);
-  ir_loc nowhere = {0, 0};
-  if (data == NULL) {
-    diag_error(path, nowhere, "cannot read the FE file: %s", errno == EFBIG ? "larger than MBCC_MAX_INPUT" : strerror(errno));
+  yaml_document_t doc;
+  bool unreadable = false;
+  if (!load_named_yaml(path, &doc, &unreadable)) {
+    if (unreadable)
+      diag_error(path, (ir_loc){0, 0}, "cannot read the FE file: %s",
+                 errno == EFBIG ? "larger than MBCC_MAX_INPUT" : strerror(errno));
     free(path);
     return NULL;
   }
   double *global = NULL;
-  yaml_parser_t parser;
-  if (!yaml_parser_initialize(&parser)) out_of_memory();
-  yaml_parser_set_input_string(&parser, (const unsigned char *)data, size);
-  yaml_document_t doc;
-  if (!yaml_parser_load(&parser, &doc)) {
-    report_yaml_error(path, &parser, data, size);
-  } else {
-    yaml_node_t *root = yaml_document_get_root_node(&doc);
-    reader fr; /* the FE file's own reader: its diagnostics name that file */
-    memset(&fr, 0, sizeof fr);
-    fr.path = path;
-    fr.doc = &doc;
-    fr.model = r->model;
-    mapping fm;
-    if (root == NULL) {
-      diag_error(path, file_start, "empty FE file (expected a mapping with 'nodes' and 'beams')");
-    } else if (map_open(&fm, &fr, root, loc_of(root), "the FE model of flexible body '%s'", b->name)) {
-      static const char *const keys[] = {"description", "line", "nodes", "beams", "section", "material",
-                                         "sections", "materials", "theory", "mass", "nonstructural_mass",
-                                         "point_masses", "node_names", NULL};
-      map_check_keys(&fm, keys);
-      map_get(&fm, "description");
-      int errors = diag_errors();
-      global = parse_fe_model(&fm, fx);
-      map_close(&fm);
-      if (diag_errors() > errors) {
-        free(global);
-        global = NULL;
-      }
-    } else {
-      map_close(&fm);
+  yaml_node_t *root = yaml_document_get_root_node(&doc);
+  reader fr; /* the FE file's own reader: its diagnostics name that file */
+  memset(&fr, 0, sizeof fr);
+  fr.path = path;
+  fr.doc = &doc;
+  fr.model = r->model;
+  mapping fm;
+  if (root == NULL) {
+    diag_error(path, file_start, "empty FE file (expected a mapping with 'nodes' and 'beams')");
+  } else if (map_open(&fm, &fr, root, loc_of(root), "the FE model of flexible body '%s'", b->name)) {
+    static const char *const keys[] = {"description", "line", "nodes", "beams", "section", "material",
+                                       "sections", "materials", "theory", "mass", "nonstructural_mass",
+                                       "point_masses", "node_names", NULL};
+    map_check_keys(&fm, keys);
+    map_get(&fm, "description");
+    int errors = diag_errors();
+    global = parse_fe_model(&fm, fx);
+    map_close(&fm);
+    if (diag_errors() > errors) {
+      free(global);
+      global = NULL;
     }
-    yaml_document_delete(&doc);
+  } else {
+    map_close(&fm);
   }
-  yaml_parser_delete(&parser);
-  free(data);
+  yaml_document_delete(&doc);
   if (global) fx->fe_source = path;
   else free(path);
   return global;
@@ -1214,17 +1205,10 @@ static void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc) {
                                           "materials", "nonstructural_mass", "node_names", "residual_modes", NULL};
     for (int i = 0; fe_only[i]; i++)
       map_reject(m, fe_only[i], "flexible body '%s': '%s' does not go with 'modal_file'", b->name, fe_only[i]);
-    if (modal_file->type != YAML_SCALAR_NODE) {
+    if (modal_file->type != YAML_SCALAR_NODE)
       error_at(r, loc_of(modal_file), "'modal_file' must be a file name (got %s)", show_node(r, modal_file));
-    } else {
-      /* relative to the model file's directory */
-      const char *slash = strrchr(r->path, '/');
-      const char *fname = scalar_text(modal_file);
-      size_t dl = (slash && fname[0] != '/') ? (size_t)(slash - r->path + 1) : 0;
-      fx->modal_file = xcalloc(dl + scalar_length(modal_file) + 1, 1);
-      memcpy(fx->modal_file, r->path, dl);
-      memcpy(fx->modal_file + dl, fname, scalar_length(modal_file));
-    }
+    else
+      read_modal_file(r, modal_file, b, fx);
   } else if (map_get(m, "fe_file") != NULL) {
     global = parse_fe_file(m, b, fx);
   } else if (line != NULL && nodes != NULL) {
@@ -1808,6 +1792,28 @@ static void report_yaml_error(const char *path, const yaml_parser_t *parser, con
   }
 }
 
+bool load_named_yaml(const char *path, yaml_document_t *doc, bool *unreadable) {
+  size_t size = 0;
+  char *data = read_file(path, &size, limit_value("MBCC_MAX_INPUT", LIMIT_INPUT_BYTES));
+  *unreadable = data == NULL;
+  if (data == NULL) return false;
+  bool loaded = false;
+  size_t deep_at = 0;
+  if (yaml_flow_depth(data, size, LIMIT_YAML_DEPTH, &deep_at) > LIMIT_YAML_DEPTH) {
+    diag_error(path, loc_of_offset(data, size, deep_at),
+               "brackets nested more than %d deep (the limit of the model reader)", LIMIT_YAML_DEPTH);
+  } else {
+    yaml_parser_t parser;
+    if (!yaml_parser_initialize(&parser)) out_of_memory();
+    yaml_parser_set_input_string(&parser, (const unsigned char *)data, size);
+    loaded = yaml_parser_load(&parser, doc) != 0;
+    if (!loaded) report_yaml_error(path, &parser, data, size);
+    yaml_parser_delete(&parser);
+  }
+  free(data);
+  return loaded;
+}
+
 static ir_model *read_model(const char *path, const char *scene) {
   int errors_before = diag_errors();
   size_t size = 0;
@@ -1914,6 +1920,7 @@ void free_flex(ir_flex *fx) {
   free(fx->interface);
   free(fx->residual);
   free(fx->modal_file);
+  free_modal_data(fx->modal);
   free(fx->fe_source);
   for (int i = 0; i < fx->nnode_names; i++) free(fx->node_names[i]);
   free(fx->node_names);

@@ -18,6 +18,12 @@ void parse_profile(reader *r, yaml_node_t *n, const char *label, ir_profile *p);
 void parse_beam_properties(reader *r, mapping *body, ir_beam *proto);
 extern const char *const theory_names[]; /* 'theory' of a beam */
 
+/* A YAML file that the model names (fe_file: X.fe.yaml, modal_file): read
+ * within the limits of a model file (its size, the bracket depth) and parsed
+ * into *doc.  False after an error: reported at its place in the file, or,
+ * with *unreadable set and errno saying why (EFBIG: too large), left to the
+ * caller to report. */
+bool load_named_yaml(const char *path, yaml_document_t *doc, bool *unreadable);
 /* a file name given in the model, relative to the model file's directory */
 char *model_relative_path(reader *r, const yaml_node_t *n);
 /* a superelement's FE model from 'fe_file' and its 'interface' nodes (2 or
