@@ -6,7 +6,8 @@
 #     enough (--max-step) that the projected rows are exact to round-off; the default still
 #     prints at most 12 significant digits; --precision 0 and 18 are errors;
 #   - the units file CSV.units has a row per CSV column, in order, with the
-#     unit of the output's kind (s, rad, m, rad/s, J, N, N m), and a scaled
+#     unit of the output's kind (s, rad, m, rad/s, J, N, N m; a beam
+#     section's forces N, moments N m, a fiber's stress Pa), and a scaled
 #     output (scale 1000 on a position) in 0.001 m;
 #   - --results DIR puts the CSV, its units and the plot in DIR;
 #   - each warning and note is printed once (the four-bar's redundant rows).
@@ -44,6 +45,11 @@ if [ -s p12.csv.units ]; then
 else
   err "no units file p12.csv.units"
 fi
+"$MBCC" run "$root/tests/models/fe/cantilever_section.yaml" --end 0.001 -o cs.csv --plot none --quiet > cs.log 2>&1 ||
+  err "cantilever_section run failed: $(tail -3 cs.log)"
+for want in root.N,N root.Vz,N "root.T,N m" "root.Mz,N m" "mid_Mz,N m" root_top,Pa; do
+  grep -qx "$want" cs.csv.units || err "cs.csv.units lacks '$want'"
+done
 sed 's/{name: bob_position, type: position, body: bob}/{name: bob_position, type: position, body: bob, scale: 1000}/' \
   "$root/models/pendulum.yaml" > mm.yaml
 "$MBCC" run mm.yaml --end 0.1 -o mm.csv --plot none --quiet > mm.log 2>&1 || err "scaled run failed: $(tail -3 mm.log)"

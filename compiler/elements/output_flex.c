@@ -144,7 +144,9 @@ static int section_coefficients(lmodel *L, const ir_output *o, mb_outputdef *d) 
     memcpy(dst, rows, sizeof(double) * 6 * (size_t)nm);
     L->noutput_coef += 6 * nm;
   }
-  d->component = -1; /* the rows are the columns */
+  /* the rows are the columns; the component says what they are (their unit
+     in CSV.units): -1 all six resultants, 0..5 one of them, 6 the stress */
+  d->component = o->has_fiber ? 6 : o->component;
   return 0;
 }
 

@@ -105,7 +105,8 @@ typedef struct {
   mb_real u[3];      /* ANGLE: reference direction perpendicular to axis, body axes */
   mb_real axis_g[3]; /* ANGLE: the axis, global */
   mb_real u_g[3];    /* ANGLE: the reference direction, global */
-  int component;     /* -1: all; else 0..2 */
+  int component;     /* -1: all; else 0..2 (SECTION: 0..5 one of N Vy Vz T My Mz, 6 the
+                        fiber's normal stress; TYRE, FORCE: below) */
   int joint;         /* REACTION: joint index; its marker 1 is reaction_marker; TYRE: the
                         force element's index */
   int reaction_marker;

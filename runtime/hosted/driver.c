@@ -156,8 +156,11 @@ static const char *base_unit(const mb_outputdef *o, int k) {
   case MB_OUT_RELATIVE: case MB_OUT_CENTER_OF_MASS:
     return o->quantity == MB_QUANTITY_POSITION ? "m" : o->quantity == MB_QUANTITY_VELOCITY ? "m/s" : "m/s^2";
   case MB_OUT_JOINT: return o->joint_dofs == 2 || k > o->col ? "m" : "rad";
-  default: return "";
+  case MB_OUT_SECTION: /* N Vy Vz T My Mz, one of them, or a fiber's stress */
+    if (o->component == 6) return "Pa";
+    return (o->component >= 0 ? o->component < 3 : first3) ? "N" : "N m";
   }
+  return "?"; /* not a kind: a corrupt table */
 }
 
 static mode_t current_umask(void) {
