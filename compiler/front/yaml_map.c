@@ -1,8 +1,8 @@
 /* yaml_map.c: the typed YAML access layer of the reader: memory, the reader's
  * diagnostics (file:line:col), quoting user text, sequences, mappings that
  * catch duplicate and unknown keys, and typed look-ups (numbers, vectors,
- * tables, choices, unit axes).  Used by reader.c, names.c, the element
- * parsers of compiler/elements/ and fe.c. */
+ * tables, choices, unit axes).  Used by every reader of YAML in the
+ * compiler (yaml_map.h lists them). */
 #include "yaml_map.h"
 #include "bounds.h"
 #include "compose.h"

@@ -1,7 +1,12 @@
 /* yaml_map.h: the typed YAML access layer of the reader (yaml_map.c): the
  * reader state, diagnostics at file:line:col, sequences, mappings that catch
  * duplicate and unknown keys, and typed look-ups.  Every reader of YAML in
- * the compiler (reader.c, names.c, compiler/elements/, fe.c) goes through it. */
+ * the compiler goes through it: the model's document walk (reader.c, scene.c,
+ * sim.c, params.c, quantities.c, names.c, compiler/elements/), the YAML FE
+ * files (fe_file) and the modal data files (modal_file.c).  compose.c comes
+ * before it: it builds the document that the walk reads (merge keys
+ * expanded, included files loaded and spliced in, checking only which
+ * sections they supply). */
 #ifndef MBCC_YAML_MAP_H
 #define MBCC_YAML_MAP_H
 
