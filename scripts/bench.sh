@@ -10,12 +10,8 @@
 # about the machine for the document, e.g. that it was shared).  Work files
 # (generated code, CSV, logs) go to build/bench/.
 # shellcheck disable=SC2016  # awk programs in single quotes
-set -eu
-export LC_ALL=C
-cd "$(dirname "$0")/.."
-ROOT=$(pwd)
-MBCC=${MBCC:-build/mbcc}
-case $MBCC in /*) ;; *) MBCC=$ROOT/$MBCC ;; esac
+TOOL=bench
+. "$(dirname "$0")/lib.sh"
 REPS=${REPS:-5}
 # the chain's run is 42 steps (a few ms on the emitted path): more repetitions,
 # so that one slow run (a cold cache, the machine's other work) cannot move its median
@@ -23,14 +19,8 @@ CHAIN_REPS=${CHAIN_REPS:-$((REPS * 5))}
 W=$ROOT/build/bench
 OUT=docs/benchmarks.md
 
-die() { echo "bench: error: $*" >&2; exit 1; }
-say() { echo "bench: $*" >&2; }
-[ -x "$MBCC" ] || die "$MBCC not found: run 'make all' first"
-rm -rf "$W"
-mkdir -p "$W"
-
-# a command as seen from the repository root
-show() { echo "$*" | sed "s|$ROOT/||g"; }
+need_mbcc
+fresh_dir "$W"
 
 # bench NAME MODEL [ARGS...]: `mbcc bench` in $W; table to $W/NAME.txt, CSV to $W/NAME.csv
 bench() {
@@ -266,7 +256,7 @@ tmp=$OUT.part
   echo "- \`nproc\`: $(nproc 2>/dev/null || echo unknown), \`uname -m\`: $(uname -m)"
   echo "- compiler: $(${CC:-cc} --version 2>/dev/null | head -1)"
   [ -z "${BENCH_NOTE:-}" ] || echo "- note: $BENCH_NOTE"
-  echo "- load average when the page was written: $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null || echo unknown)"
+  echo "- load average when the page was written: $(load_average)"
   echo
   echo "## Flexible slider-crank (seed 000 Table 3)"
   echo

@@ -13,10 +13,10 @@ set -u
 cd "$(dirname "$0")/.." || exit 2
 
 # document | make target | the code it describes (paths for git)
-table='docs/results.md|results|scripts/results.sh compiler runtime templates models/pendulum.yaml models/slider_crank.yaml models/slider_crank_flexible.yaml
-docs/benchmarks.md|bench|scripts/bench.sh scripts/peers.sh scripts/mjcf_from_yaml.py bench compiler runtime templates models
-docs/peers.md|peers|scripts/peers.sh scripts/mjcf_from_yaml.py bench/peers compiler runtime templates
-docs/trade.md|trade|scripts/trade.sh compiler runtime templates models/slider_crank_flexible.yaml
+table='docs/results.md|results|scripts/results.sh scripts/lib.sh compiler runtime templates models/pendulum.yaml models/slider_crank.yaml models/slider_crank_flexible.yaml
+docs/benchmarks.md|bench|scripts/bench.sh scripts/peers.sh scripts/lib.sh scripts/mjcf_from_yaml.py bench compiler runtime templates models
+docs/peers.md|peers|scripts/peers.sh scripts/lib.sh scripts/mjcf_from_yaml.py bench/peers compiler runtime templates
+docs/trade.md|trade|scripts/trade.sh scripts/lib.sh compiler runtime templates models/slider_crank_flexible.yaml
 docs/stability.md|extremes|tests/extremes compiler runtime templates
 docs/vehicle.md|vehicle|scripts/vehicle.sh compiler runtime templates models/sports_car.yaml models/sports_car models/subsystems models/sports_car_chassis.fe.yaml
 docs/sweeps.md|sweeps|scripts/sweeps.sh compiler/tools/sweep.c runtime models/quarter_car.yaml'

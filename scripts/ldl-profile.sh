@@ -12,12 +12,8 @@
 # Environment: MBCC (build/mbcc), CC (cc), LDL_PROFILE_MODELS ("MODEL.yaml[:SCENE] ..."),
 # LDL_PROFILE_FORMS ("straight looped"), LDL_PROFILE_ROUNDS (3), LDL_PROFILE_DIR
 # (build/ldl-profile), LDL_PROFILE_CACHEGRIND (1).
-set -eu
-export LC_ALL=C
-cd "$(dirname "$0")/.."
-ROOT=$(pwd)
-MBCC=${MBCC:-build/mbcc}
-case $MBCC in /*) ;; *) MBCC=$ROOT/$MBCC ;; esac
+TOOL=ldl-profile
+. "$(dirname "$0")/lib.sh"
 RTLIB=$(dirname "$MBCC")/libmbrt.a
 CC=${CC:-cc}
 MODELS=${LDL_PROFILE_MODELS:-"models/sports_car.yaml:rigid models/sports_car.yaml:flexible models/sports_car.yaml:flexible_virtual models/slider_crank.yaml tests/models/hinged_chain20_rigid.yaml"}
@@ -25,11 +21,9 @@ FORMS=${LDL_PROFILE_FORMS:-"straight looped"}
 ROUNDS=${LDL_PROFILE_ROUNDS:-3}
 W=${LDL_PROFILE_DIR:-$ROOT/build/ldl-profile}
 CG=${LDL_PROFILE_CACHEGRIND:-1}
-die() { echo "ldl-profile: error: $*" >&2; exit 1; }
-[ -x "$MBCC" ] || die "$MBCC not found: run 'make all' first"
+need_mbcc
 if [ "$CG" = 1 ] && ! command -v valgrind >/dev/null; then echo "ldl-profile: no valgrind: no instruction counts" >&2; CG=0; fi
-rm -rf "$W"
-mkdir -p "$W"
+fresh_dir "$W"
 LIBS="-lamd -lklu -lcolamd -lbtf -lsuitesparseconfig -llapack -lblas -lm"
 
 budget() { case $1 in straight) echo 1e12 ;; looped) echo 0 ;; *) echo "" ;; esac; }
@@ -118,4 +112,4 @@ for spec in $MODELS; do
   echo "- $("$W/$tag.$first/harness" amd)"
 done
 echo
-echo "load average: $(cut -d' ' -f1-3 /proc/loadavg)"
+echo "load average: $(load_average)"

@@ -15,22 +15,15 @@
 # Environment: MBCC (build/mbcc), CC, PEER_ROUNDS (31), PEER_MODELS (both),
 # PEER_DIR (build/peers), PEER_CACHEGRIND (1; 0 skips it), PEER_DOC.
 # shellcheck disable=SC2016
-set -eu
-export LC_ALL=C
-cd "$(dirname "$0")/.."
-ROOT=$(pwd)
-MBCC=${MBCC:-build/mbcc}
-case $MBCC in /*) ;; *) MBCC=$ROOT/$MBCC ;; esac
+TOOL=peers
+. "$(dirname "$0")/lib.sh"
 RTLIB=$(dirname "$MBCC")/libmbrt.a
 CC=${CC:-cc}
 ROUNDS=${PEER_ROUNDS:-31}
 MODELS=${PEER_MODELS:-"bench/peers/four_bar_4r.yaml bench/peers/sports_car_rigid.yaml"}
 W=${PEER_DIR:-$ROOT/build/peers}
 CG=${PEER_CACHEGRIND:-1}
-say() { echo "peers: $*" >&2; }
-die() { echo "peers: error: $*" >&2; exit 1; }
-rm -rf "$W"
-mkdir -p "$W"
+fresh_dir "$W"
 OUT=$W/peers.md
 
 if [ ! -e /usr/include/mujoco/mujoco.h ]; then
@@ -38,7 +31,7 @@ if [ ! -e /usr/include/mujoco/mujoco.h ]; then
   printf '## MuJoCo\n\nSkipped: MuJoCo (libmujoco-dev) was not installed when this page was made.\n' >"$OUT"
   exit 0
 fi
-[ -x "$MBCC" ] || die "$MBCC not found: run 'make all' first"
+need_mbcc
 command -v python3 >/dev/null || die "python3 is needed (scripts/mjcf_from_yaml.py)"
 if [ "$CG" = 1 ] && ! command -v valgrind >/dev/null; then
   say "valgrind is not installed: no instruction counts"
@@ -155,7 +148,7 @@ if [ -n "${PEER_DOC:-}" ]; then
     echo
     echo "- CPU: $(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo 2>/dev/null | head -1), \`nproc\`: $(nproc)"
     echo "- compiler: $($CC --version 2>/dev/null | head -1), the generated code and the peer at $CFLAGS_GEN"
-    echo "- load average when written: $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null)"
+    echo "- load average when written: $(load_average)"
     [ -z "${BENCH_NOTE:-}" ] || echo "- note: $BENCH_NOTE"
     echo
     sed '1s/^## MuJoCo$/## Results/' "$OUT"

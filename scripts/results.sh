@@ -6,29 +6,20 @@
 # Environment: MBCC (default build/mbcc).  Work files go to build/results/.
 # shellcheck disable=SC2046,SC2086  # `set -- $(awk ...)`, $sc: split on purpose
 # shellcheck disable=SC2016,SC2154  # awk programs in single quotes; pe_* are set by eval
-set -eu
-export LC_ALL=C
-cd "$(dirname "$0")/.."
-ROOT=$(pwd)
-MBCC=${MBCC:-build/mbcc}
-case $MBCC in /*) ;; *) MBCC=$ROOT/$MBCC ;; esac
+TOOL=results
+. "$(dirname "$0")/lib.sh"
 W=$ROOT/build/results
 IMG=docs/img
 OUT=docs/results.md
 FIGS="pendulum_energy.png slider_crank_error.png slider_crank_flexible.png free_flexible.png"
 
-die() { echo "results: error: $*" >&2; exit 1; }
-say() { echo "results: $*" >&2; }
-[ -x "$MBCC" ] || die "$MBCC not found: run 'make all' first"
+need_mbcc
 command -v gnuplot >/dev/null 2>&1 || die "gnuplot not found (Debian: apt-get install gnuplot-nox)"
 
 rm -rf "$W"
 mkdir -p "$W" "$IMG"
 for f in $FIGS; do rm -f "$IMG/$f"; done
 rm -f "$OUT"
-
-# a command as seen from the repository root
-show() { echo "$*" | sed "s|$ROOT/||g"; }
 
 # run NAME MODEL [ARGS...]: `mbcc run` in $W (so generated code goes to
 # $W/generated/), CSV to $W/NAME.csv, stderr/stdout to $W/NAME.log; sets

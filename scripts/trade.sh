@@ -9,26 +9,17 @@
 # time, default 0.05 s: one crank revolution), TARGETS (default
 # 1e-2,1e-3,1e-4).  Work files (generated code, CSV, logs) go to build/trade/.
 # shellcheck disable=SC2016  # awk programs in single quotes
-set -eu
-export LC_ALL=C
-cd "$(dirname "$0")/.."
-ROOT=$(pwd)
-MBCC=${MBCC:-build/mbcc}
-case $MBCC in /*) ;; *) MBCC=$ROOT/$MBCC ;; esac
+TOOL=trade
+. "$(dirname "$0")/lib.sh"
 REPS=${REPS:-3}
 END=${END:-0.05}
 TARGETS=${TARGETS:-1e-2,1e-3,1e-4}
 W=$ROOT/build/trade
 OUT=docs/trade.md
 
-die() { echo "trade: error: $*" >&2; exit 1; }
-say() { echo "trade: $*" >&2; }
-[ -x "$MBCC" ] || die "$MBCC not found: run 'make all' first"
-rm -rf "$W"
-mkdir -p "$W" docs/img
-
-# a command as seen from the repository root
-show() { echo "$*" | sed "s|$ROOT/||g"; }
+need_mbcc
+fresh_dir "$W"
+mkdir -p docs/img
 
 # study NAME MODEL [ARGS...]: `mbcc trade` into $W/NAME.{txt,csv,cmd,log}, docs/img/trade_NAME.png
 study() {
