@@ -1374,23 +1374,6 @@ static int source_text(const mbc_unit *u, emit_files *EF, char **text, size_t *l
   return -1;
 }
 
-/* the names DIR/<nm>.sources lists (a split model's files of an earlier
- * emission), NULL-terminated, or NULL */
-static char **old_sources(const char *dir, const char *nm) {
-  char path[4400], line[400];
-  snprintf(path, sizeof path, "%s/%s.sources", dir, nm);
-  FILE *f = fopen(path, "r");
-  if (!f) return NULL;
-  char **v = calloc(1025, sizeof *v);
-  int n = 0;
-  while (v && n < 1024 && fgets(line, sizeof line, f)) {
-    line[strcspn(line, "\n")] = 0;
-    if (line[0] && !strchr(line, '/')) v[n++] = strdup(line);
-  }
-  fclose(f);
-  return v;
-}
-
 /* after a successful emission: the files of an earlier split emission that
  * this one did not write (only names of the split's own pattern) */
 static void remove_stale(const char *dir, const char *nm, char **old, const char *const *now, int nnow) {
@@ -1430,7 +1413,7 @@ int emit_model(const mbc_unit *u, const char *dir) {
   /* every file is written as .part; renamed only when all of them are complete */
   out_file *out = calloc((size_t)nout, sizeof *out);
   const char **names = calloc((size_t)nextra + 1, sizeof *names);
-  char **old = old_sources(dir, nm);
+  char **old = emit_files_read_list(dir, nm); /* of an earlier emission */
   int st = out && names ? 0 : 2;
   if (st) diag_error(NULL, (ir_loc){0, 0}, "out of memory while writing '%s'", dir);
   for (int i = 0; i < nout && !st; i++) {
@@ -1488,8 +1471,7 @@ int emit_model(const mbc_unit *u, const char *dir) {
     else st = out_file_commit(&out[i]);
   }
   if (!st) remove_stale(dir, nm, old, names, nextra);
-  for (int i = 0; old && old[i]; i++) free(old[i]);
-  free(old);
+  emit_files_list_free(old);
   free(names);
   free(out);
   free(src);

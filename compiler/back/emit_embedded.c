@@ -16,6 +16,7 @@
 
 #include "diag.h"
 #include "emit.h"
+#include "emit_files.h"
 #include "lower.h"
 #include "params.h"
 
@@ -252,37 +253,28 @@ static int join(char *out, size_t n, const char *a, const char *b) {
  * several translation units (emit_files.h): what <m>.sources lists but
  * <m>.c, the list itself and <m>_parts.h; NULL-terminated, or NULL */
 static char **split_files(const char *dir, const char *nm) {
-  char path[4400], line[400];
-  snprintf(path, sizeof path, "%s/%s.sources", dir, nm);
-  FILE *f = fopen(path, "r");
-  if (!f) return NULL;
-  char **v = calloc(1027, sizeof *v);
+  char **listed = emit_files_read_list(dir, nm);
   int n = 0;
-  if (v) {
-    snprintf(line, sizeof line, "%s.sources", nm);
-    v[n++] = strdup(line);
-    snprintf(line, sizeof line, "%s_parts.h", nm);
-    v[n++] = strdup(line);
+  while (listed && listed[n]) n++;
+  char **v = listed ? calloc((size_t)n + 3, sizeof *v) : NULL;
+  int k = 0, ok = v != NULL;
+  char name[300];
+  snprintf(name, sizeof name, "%s.sources", nm);
+  if (ok) ok = (v[k++] = strdup(name)) != NULL;
+  snprintf(name, sizeof name, "%s_parts.h", nm);
+  if (ok) ok = (v[k++] = strdup(name)) != NULL;
+  snprintf(name, sizeof name, "%s.c", nm);
+  for (int i = 0; ok && i < n; i++) {
+    if (!strcmp(listed[i], name)) free(listed[i]);
+    else v[k++] = listed[i];
+    listed[i] = NULL;
   }
-  char self[300];
-  snprintf(self, sizeof self, "%s.c", nm);
-  while (v && n < 1026 && fgets(line, sizeof line, f)) {
-    line[strcspn(line, "\n")] = 0;
-    if (line[0] && !strchr(line, '/') && strcmp(line, self)) v[n++] = strdup(line);
+  emit_files_list_free(listed);
+  if (!ok) { /* out of memory: the package cannot be complete */
+    emit_files_list_free(v);
+    return NULL;
   }
-  fclose(f);
-  for (int i = 0; v && i < n; i++)
-    if (!v[i]) { /* out of memory: the package cannot be complete */
-      for (int k = 0; k < n; k++) free(v[k]);
-      free(v);
-      return NULL;
-    }
   return v;
-}
-
-static void free_split(char **v) {
-  for (int i = 0; v && v[i]; i++) free(v[i]);
-  free(v);
 }
 
 /* remove what a failed write_package left in tmp (only names it writes) */
@@ -291,7 +283,7 @@ static void remove_partial(const char *tmp, const char *nm) {
   char **split = split_files(tmp, nm);
   for (int i = 0; split && split[i]; i++)
     if (!join(path, sizeof path, tmp, split[i])) remove(path);
-  free_split(split);
+  emit_files_list_free(split);
   static const char *const suffixes[] = {".c", ".h", "_api.c", "_api.h"};
   for (size_t i = 0; i < 4; i++) {
     snprintf(fn, sizeof fn, "%s%s", nm, suffixes[i]);
@@ -382,11 +374,11 @@ static int write_package(const mbc_unit *u, const char *dir, const char *tmp, in
     if (join(path, sizeof path, tmp, fn) || join(to, sizeof to, dir, fn)) return 2;
     if (rename(path, to)) {
       diag_error(NULL, (ir_loc){0, 0}, "cannot move '%s' to '%s': %s", path, to, strerror(errno));
-      free_split(split);
+      emit_files_list_free(split);
       return 2;
     }
   }
-  free_split(split);
+  emit_files_list_free(split);
   for (size_t i = 0; i < sizeof subdirs / sizeof subdirs[0]; i++)
     if (!join(path, sizeof path, tmp, subdirs[i])) rmdir(path);
   rmdir(tmp);

@@ -478,3 +478,31 @@ void emit_files_free(emit_files *F) {
   free(F->copied);
   memset(F, 0, sizeof *F);
 }
+
+char **emit_files_read_list(const char *dir, const char *nm) {
+  char path[4400], line[400];
+  snprintf(path, sizeof path, "%s/%s.sources", dir, nm);
+  FILE *f = fopen(path, "r");
+  if (!f) return NULL;
+  char **v = calloc(1, sizeof *v);
+  int n = 0, ok = v != NULL;
+  while (ok && fgets(line, sizeof line, f)) {
+    line[strcspn(line, "\n")] = 0;
+    if (!line[0] || strchr(line, '/')) continue;
+    char **bigger = realloc(v, (size_t)(n + 2) * sizeof *v);
+    if (bigger) v = bigger;
+    ok = bigger && (v[n] = strdup(line)) != NULL;
+    if (ok) v[++n] = NULL;
+  }
+  fclose(f);
+  if (!ok) {
+    emit_files_list_free(v);
+    return NULL;
+  }
+  return v;
+}
+
+void emit_files_list_free(char **names) {
+  for (int i = 0; names && names[i]; i++) free(names[i]);
+  free(names);
+}

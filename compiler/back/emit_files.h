@@ -79,6 +79,12 @@ int emit_files_count(const emit_files *F);
 char *emit_files_text(emit_files *F, int i, const char **name, size_t *len);
 void emit_files_free(emit_files *F);
 
+/* the file names that DIR/<nm>.sources lists (written by an earlier
+ * emission; names with a '/' are skipped), NULL-terminated, each allocated
+ * (emit_files_list_free); NULL when there is no list or memory ran out */
+char **emit_files_read_list(const char *dir, const char *nm);
+void emit_files_list_free(char **names);
+
 /* 1 if the identifier 'name' occurs in text (not in a comment, a string, or
  * as a member after '.' or '->') */
 int c_text_names(const char *text, size_t len, const char *name);
