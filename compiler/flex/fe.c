@@ -756,6 +756,8 @@ static int cmp_int(const void *a, const void *b) {
 static int select_modes(const ir_flex *fx, const double *freq, int n, int *idx, int *nsel,
                         const char *what, fe_ctx *c) {
   int k = 0;
+  if ((unsigned)fx->select > MODES_ALL)
+    return fail_at(c, fx->loc, "unknown mode selection %d", (int)fx->select);
   switch (fx->select) {
   case MODES_ALL:
     for (int i = 0; i < n; i++) idx[k++] = i;
@@ -796,8 +798,6 @@ static int select_modes(const ir_flex *fx, const double *freq, int n, int *idx, 
     free(l);
     break;
   }
-  default:
-    return fail_at(c, fx->loc, "unknown mode selection %d", (int)fx->select);
   }
   *nsel = k;
   return 0;

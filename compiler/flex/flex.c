@@ -24,8 +24,9 @@ static double damping_ratio(const ir_flex *fx, int j, double f) {
   case DAMPING_LIST: return j < fx->nratios ? fx->ratios[j] : 0;
   case DAMPING_BANDS: /* seed 001 section 2.6: 1 % below 100 Hz, 10 % to 1 kHz, 100 % above */
     return f < 100 ? 0.01 : f <= 1000 ? 0.10 : 1.0;
-  default: return 0;
+  case DAMPING_NONE: return 0;
   }
+  return 0;
 }
 
 int flex_build(const ir_flex *fx, const fe_modes *fm, flex_data *out, char *err, size_t nerr) {

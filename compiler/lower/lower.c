@@ -533,7 +533,8 @@ static void row_structure(const lmodel *L, const mb_rowdef *R, int s, int nz[6],
   case MB_PRIM_ROT:
     nz[3] = nz[4] = nz[5] = 1;
     break;
-  default: /* DOT2, TRANS */
+  case MB_PRIM_DOT2:
+  case MB_PRIM_TRANS:
     for (int j = 0; j < 6; j++) nz[j] = 1;
     break;
   }

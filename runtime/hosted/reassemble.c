@@ -183,6 +183,7 @@ static double removed_row(const mb_model *m, const mb_rowdef *R, const mb_real *
   mb_real x[3];
   marker_at(m, R->m0, q, v, &f[0], &mk[0]);
   marker_at(m, R->m1, q, v, &f[1], &mk[1]);
+  mb_row_zero(&r); /* a kind not below (a corrupt table): a zero row */
   switch (R->kind) {
   case MB_PRIM_SPH: mb_prim_sph(&mk[0], &mk[1], R->a, &r); break;
   case MB_PRIM_DOT1: mb_prim_dot1(&mk[0], &mk[1], R->a, R->b, &r); break;
@@ -196,7 +197,6 @@ static double removed_row(const mb_model *m, const mb_rowdef *R, const mb_real *
     mb_profile_eval(&m->profile[R->profile], 0, x);
     mb_prim_dot2(&mk[0], &mk[1], 2, x, &r);
     break;
-  default: mb_row_zero(&r); break;
   }
   memset(d, 0, sizeof(double) * (size_t)m->nv);
   for (int s = 0; s < 2; s++) {
