@@ -18,8 +18,8 @@ docs/benchmarks.md|bench|scripts/bench.sh scripts/peers.sh scripts/lib.sh script
 docs/peers.md|peers|scripts/peers.sh scripts/lib.sh scripts/mjcf_from_yaml.py bench/peers compiler runtime templates
 docs/trade.md|trade|scripts/trade.sh scripts/lib.sh compiler runtime templates models/slider_crank_flexible.yaml
 docs/stability.md|extremes|tests/extremes compiler runtime templates
-docs/vehicle.md|vehicle|scripts/vehicle.sh compiler runtime templates models/sports_car.yaml models/sports_car models/subsystems models/sports_car_chassis.fe.yaml
-docs/sweeps.md|sweeps|scripts/sweeps.sh compiler/tools/sweep.c runtime models/quarter_car.yaml'
+docs/vehicle.md|vehicle|scripts/vehicle.sh scripts/lib.sh compiler runtime templates models/sports_car.yaml models/sports_car models/subsystems models/sports_car_chassis.fe.yaml
+docs/sweeps.md|sweeps|scripts/sweeps.sh scripts/lib.sh compiler/tools/sweep.c runtime models/quarter_car.yaml'
 
 stale=0
 while IFS='|' read -r doc target sources; do

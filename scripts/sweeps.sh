@@ -7,17 +7,13 @@
 # the least tyre load (road holding).  Called by `make sweeps` after
 # `make all`.  Environment: MBCC (default build/mbcc), JOBS (default: one per
 # core), OUT (default docs/sweeps.md).
-set -euo pipefail
-export LC_ALL=C
-cd "$(dirname "$0")/.."
-ROOT=$(pwd)
-MBCC=${MBCC:-build/mbcc}
-case $MBCC in /*) ;; *) MBCC=$ROOT/$MBCC ;; esac
+TOOL=sweeps
+. "$(dirname "$0")/lib.sh"
+set -o pipefail
 OUT=${OUT:-docs/sweeps.md}
 W=$ROOT/build/sweeps
 mkdir -p "$W" docs/img
-die() { echo "sweeps: error: $*" >&2; exit 1; }
-[ -x "$MBCC" ] || die "$MBCC not found: run 'make all' first"
+need_mbcc
 jobs=()
 [ -n "${JOBS:-}" ] && jobs=(--jobs "$JOBS")
 

@@ -11,27 +11,21 @@
 # repetitions, default 3), BENCH_END (simulated time of the bench, default
 # the model's 2 s).  Work files go to build/vehicle/.
 # shellcheck disable=SC2016  # awk programs in single quotes
-set -euo pipefail
-export LC_ALL=C
-cd "$(dirname "$0")/.."
-ROOT=$(pwd)
-MBCC=${MBCC:-build/mbcc}
-case $MBCC in /*) ;; *) MBCC=$ROOT/$MBCC ;; esac
+TOOL=vehicle
+. "$(dirname "$0")/lib.sh"
+set -o pipefail
 REPS=${REPS:-3}
 MODEL=$ROOT/models/sports_car.yaml
 W=$ROOT/build/vehicle
 IMG=docs/img
 OUT=docs/vehicle.md
 
-die() { echo "vehicle: error: $*" >&2; exit 1; }
-say() { echo "vehicle: $*" >&2; }
-[ -x "$MBCC" ] || die "$MBCC not found: run 'make all' first"
+need_mbcc
 command -v gnuplot >/dev/null 2>&1 || die "gnuplot not found (Debian: apt-get install gnuplot-nox)"
-rm -rf "$W"
-mkdir -p "$W" "$IMG"
+fresh_dir "$W"
+mkdir -p "$IMG"
 rm -f "$IMG"/vehicle_*.png "$OUT"
 
-show() { echo "$*" | sed "s|$ROOT/||g"; }
 now() { date +%s.%N; }
 fmt() { awk -v x="$1" -v f="$2" 'BEGIN { printf f, x }'; }
 
