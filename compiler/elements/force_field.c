@@ -278,6 +278,7 @@ static double *lower_field_common(lmodel *L, const ir_force *F, mb_forcedef *d) 
 static void lower_bushing(lmodel *L, const ir_force *F, int index, mb_forcedef *d) {
   (void)index;
   double *prm = lower_field_common(L, F, d);
+  if (!prm) return; /* out of memory (lower_force_prm) */
   for (int i = 0; i < 6; i++) {
     prm[MB_FIELD_K + 7 * i] = F->k6[i];
     prm[MB_FIELD_C + 7 * i] = F->c6[i];
@@ -288,6 +289,7 @@ static void lower_bushing(lmodel *L, const ir_force *F, int index, mb_forcedef *
 static void lower_field(lmodel *L, const ir_force *F, int index, mb_forcedef *d) {
   (void)index;
   double *prm = lower_field_common(L, F, d);
+  if (!prm) return; /* out of memory (lower_force_prm) */
   memcpy(prm + MB_FIELD_K, F->K, 36 * sizeof *prm);
   memcpy(prm + MB_FIELD_C, F->C, 36 * sizeof *prm);
   memcpy(prm + MB_FIELD_PRE, F->preload6, 6 * sizeof *prm);
@@ -297,6 +299,7 @@ static void lower_field(lmodel *L, const ir_force *F, int index, mb_forcedef *d)
 static void lower_beam(lmodel *L, const ir_force *F, int index, mb_forcedef *d) {
   (void)index;
   double *prm = lower_field_common(L, F, d);
+  if (!prm) return; /* out of memory (lower_force_prm) */
   double *K = prm + MB_FIELD_K;
   const ir_beam *bm = &F->beam;
   double len = 0;
@@ -326,6 +329,7 @@ static void lower_superelement(lmodel *L, const ir_force *F, int index, mb_force
       if (k == 0) d->m1 = mk;
     }
     double *prm = lower_force_prm(L, d, mb_superelement_nprm(n));
+    if (!prm) return; /* out of memory (lower_force_prm) */
     prm[MB_SUPER_N] = n;
     for (int k = 0; k < n; k++)
       for (int i = 0; i < 3; i++) prm[MB_SUPER_D0 + 3 * k + i] = F->super_point[3 * (k + 1) + i] - F->super_point[i];
@@ -334,6 +338,7 @@ static void lower_superelement(lmodel *L, const ir_force *F, int index, mb_force
     return;
   }
   double *prm = lower_field_common(L, F, d);
+  if (!prm) return; /* out of memory (lower_force_prm) */
   for (int i = 0; i < 3; i++) prm[MB_FIELD_D0 + i] = F->point[1][i] - F->point[0][i];
   memcpy(prm + MB_FIELD_K, F->K, 36 * sizeof *prm);
   memcpy(prm + MB_FIELD_C, F->C, 36 * sizeof *prm);

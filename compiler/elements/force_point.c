@@ -36,6 +36,7 @@ static void lower_point_load(lmodel *L, const ir_force *F, int index, mb_forcede
   static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   d->m0 = lower_force_marker(L, F, 0, I3);
   double *prm = lower_force_prm(L, d, MB_POINT_NPRM);
+  if (!prm) return; /* out of memory (lower_force_prm) */
   memcpy(prm + MB_POINT_VEC, F->vector, 3 * sizeof *prm);
   d->local = F->frame == FRAME_BODY;
   if (F->scale.kind != PROFILE_NONE) d->profile = lower_add_profile(L, &F->scale, -1, index);

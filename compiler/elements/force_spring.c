@@ -94,6 +94,7 @@ static void lower_spring_damper(lmodel *L, const ir_force *F, int index, mb_forc
   d->m0 = lower_force_marker(L, F, 0, I3);
   d->m1 = lower_force_marker(L, F, 1, I3);
   double *prm = lower_force_prm(L, d, MB_SPRING_NPRM);
+  if (!prm) return; /* out of memory (lower_force_prm) */
   mb_law *law = lower_force_laws(L, d, MB_SPRING_NLAW);
   const ir_law *laws[MB_SPRING_NLAW] = {[MB_SPRING_STIFFNESS] = &F->stiffness,
                                         [MB_SPRING_DAMPING] = &F->damping};

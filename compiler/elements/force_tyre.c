@@ -99,9 +99,12 @@ static bool read_road_csv(reader *r, yaml_node_t *n, ir_road *rd) {
     }
     if (rd->nx == cap) {
       cap = cap ? 2 * cap : 64;
-      xs = realloc(xs, sizeof *xs * (size_t)cap);
-      zs = realloc(zs, sizeof *zs * (size_t)cap * (size_t)rd->ny);
-      if (!xs || !zs) { fprintf(stderr, "mbcc: out of memory\n"); exit(2); }
+      double *more_x = realloc(xs, sizeof *xs * (size_t)cap);
+      if (!more_x) out_of_memory(); /* unwinds to ir_read, which reports it */
+      xs = more_x;
+      double *more_z = realloc(zs, sizeof *zs * (size_t)cap * (size_t)rd->ny);
+      if (!more_z) out_of_memory();
+      zs = more_z;
     }
     xs[rd->nx] = vals[0];
     memcpy(zs + (size_t)rd->nx * (size_t)rd->ny, vals + 1, sizeof(double) * (size_t)rd->ny);
@@ -288,6 +291,7 @@ static void lower_tyre(lmodel *L, const ir_force *F, int index, mb_forcedef *d) 
   for (int i = 0; i < 3; i++) { C[3 * i] = x[i]; C[3 * i + 1] = y[i]; C[3 * i + 2] = z[i]; }
   d->m0 = lower_force_marker(L, F, 0, C);
   double *prm = lower_force_prm(L, d, MB_TYRE_NPRM + road_size(rd));
+  if (!prm) return; /* out of memory (lower_force_prm) */
   prm[MB_TYRE_R0] = ty->radius;
   prm[MB_TYRE_WIDTH] = ty->width;
   prm[MB_TYRE_KZ] = ty->kz;

@@ -68,7 +68,10 @@ double *lower_force_prm(lmodel *L, mb_forcedef *d, int n) {
   if (need > L->force_prm_cap) {
     size_t cap = 2 * need;
     double *p = realloc(L->force_prm, cap * sizeof *p);
-    if (!p) { fprintf(stderr, "mbcc: out of memory\n"); exit(2); }
+    if (!p) { /* reported by lower_model after the element's hook */
+      L->out_of_memory = 1;
+      return NULL;
+    }
     memset(p + L->force_prm_cap, 0, (cap - L->force_prm_cap) * sizeof *p);
     L->force_prm = p;
     L->force_prm_cap = cap;
@@ -398,6 +401,7 @@ lmodel *lower_model(const ir_model *ir, const flex_product *flex) {
     d->kind = desc->runtime_kind;
     desc->lower(L, F, e, d);
   }
+  if (L->out_of_memory) { free(jm0); free(jm1); lower_free(L); return NULL; }
 
   /* outputs */
   int col = 0;

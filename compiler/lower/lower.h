@@ -18,6 +18,7 @@ typedef struct {
   mb_forcedef *force;
   double *force_prm;         /* m.nforce_prm reals (mb_forcedef.padr) */
   size_t force_prm_cap;      /* reals allocated for force_prm (grows: a tyre carries its road) */
+  int out_of_memory;         /* lower_force_prm failed (lower_model returns NULL) */
   mb_law *force_law;         /* m.nforce_law laws (mb_forcedef.ladr) */
   mb_profile *profile;
   mb_outputdef *output;
@@ -75,8 +76,9 @@ typedef struct {
 
 /* For the lowering hooks of the elements (compiler/elements/): the marker
  * of a force's side (0 or 1) with axes C (columns, global); the force record
- * d's n reals of the parameter pool (zeroed) and n laws of the law pool; a
- * time function (force: the IR force index, for provenance). */
+ * d's n reals of the parameter pool (zeroed; NULL when memory ran out: the
+ * hook returns, lower_model reports it) and n laws of the law pool; a time
+ * function (force: the IR force index, for provenance). */
 int lower_force_marker(lmodel *L, const ir_force *F, int side, const double C[9]);
 double *lower_force_prm(lmodel *L, mb_forcedef *d, int n);
 mb_law *lower_force_laws(lmodel *L, mb_forcedef *d, int n);
