@@ -214,8 +214,9 @@ static int prec_of(const sym_graph *g, sym_id x) {
   case SYM_MUL: case SYM_DIV: return 2;
   case SYM_NEG: return 3;
   case SYM_CONST: return g->node[x].value < 0 ? 3 : 4; /* "-0.5" reads as a negation */
-  default: return 4;
+  case SYM_SYMBOL: case SYM_SQRT: case SYM_SIN: case SYM_COS: return 4; /* a name, a call */
   }
+  return 4;
 }
 
 static void print_node(FILE *f, const sym_graph *g, sym_id x, const char *const *local);
