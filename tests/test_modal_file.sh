@@ -27,6 +27,25 @@ grep -v '^description:' rod.modal.yaml > written.txt
 grep -v '^description:' back.modal.yaml > read_back.txt
 [ "$(grep -c '^  - frequency:' written.txt)" -ge 4 ]
 cmp written.txt read_back.txt
+# a hand-written file: diagonal inertias [Jxx, Jyy, Jzz] (node 1: 1, 2, 3)
+# are the tensor's diagonal: the modes rotating node 1 about x, y, z are
+# mass-normalized only so (rx^2 Jxx = 1, ry^2 Jyy = 1, rz^2 Jzz = 1)
+cat > diag.modal <<'EOF2'
+format: mbcc-modal-1
+nodes:
+  - {position: [0, 0, 0], mass: 1}
+  - {position: [1, 0, 0], mass: 4, inertia: [1, 2, 3]}
+modes:
+  - {frequency: 3, shape: [[1, 0, 0, 0, 0, 0], [0, 0, 0, 0, 0, 0]]}
+  - {frequency: 5, shape: [[0, 0, 0, 0, 0, 0], [0, 0.5, 0, 0, 0, 0]]}
+  - {frequency: 6, shape: [[0, 0, 0, 0, 0, 0], [0, 0, 0, 1, 0, 0]]}
+  - {frequency: 7, shape: [[0, 0, 0, 0, 0, 0], [0, 0, 0, 0, 0.70710678118654757, 0]]}
+  - {frequency: 8, shape: [[0, 0, 0, 0, 0, 0], [0, 0, 0, 0, 0, 0.57735026918962573]]}
+EOF2
+printf 'name: diag\nbodies:\n  plate:\n    type: flexible\n    modal_file: diag.modal\n' > diag.yaml
+"$MBCC" modes diag.yaml --body plate --write-modal diag_back.modal > diag.txt
+grep -q 'inertia: \[1, 0, 0, 0, 2, 0, 0, 0, 3\]' diag_back.modal || { cat diag_back.modal; exit 1; }
+[ "$(grep -c '^  - frequency:' diag_back.modal)" = 5 ]
 limit=$(wc -c < scf_modal.yaml)
 [ "$(wc -c < rod.modal.yaml)" -gt "$limit" ]
 if MBCC_MAX_INPUT=$limit "$MBCC" check scf_modal.yaml > big.txt 2>&1; then cat big.txt; exit 1; fi
