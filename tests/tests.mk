@@ -23,7 +23,8 @@ sanitize:
 # (tests/fuzz/fuzz_front.c: YAML -> IR -> checks -> lowering and pattern ->
 # assembly analysis) built with clang's AddressSanitizer, UBSan with
 # float-cast-overflow, and LeakSanitizer; seeded with models/, tests/models/
-# and tests/bad_models/, with tests/fuzz/yaml.dict.  tests/fuzz/run.sh prints
+# and tests/bad_models/ (its modal/ files fuzzed as a flexible body's modal
+# data file), with tests/fuzz/yaml.dict.  tests/fuzz/run.sh prints
 # the executions and findings; a finding is copied to tests/fuzz_regressions/
 # (replayed by tests/test_fuzz_regressions.sh).
 .PHONY: fuzz
