@@ -31,12 +31,6 @@ static const char *const subdirs[] = {"board", "elements"};
 static const char *const template_files[] = {"Makefile", "README.md", "example_main.c", "verify_main.c", "timing_main.c",
                                              "board/startup.c", "board/mps2_an386.ld"};
 
-static void upper(char *dst, const char *src, size_t n) {
-  size_t i = 0;
-  for (; src[i] && i + 1 < n; i++) dst[i] = (char)toupper((unsigned char)src[i]);
-  dst[i] = 0;
-}
-
 /* copy src to dst, replacing @MODEL@, @UMODEL@ and @DEFS@ (templates) or nothing */
 static int copy_file(const char *src, const char *dst, const char *nm, const char *U, const char *defs) {
   FILE *in = fopen(src, "r");
