@@ -45,4 +45,13 @@ void parse_outputs(reader *r, yaml_node_t *n, name_table *scene_outputs,
 void free_outputs(ir_output *outputs, int count);
 void free_flex(ir_flex *fx);
 
+/* shared by reader.c and flexible_body.c: the flexible body's keys (a body of
+   type 'flexible'), the global position of node k of flexible body b, a file
+   read whole within a size limit (NULL, errno set, after a failure), and a
+   libyaml parser error reported at its place in data */
+void parse_flexible_body(mapping *m, ir_body *b, ir_loc type_loc);
+void fe_node_global(const ir_body *b, int k, double out[3]);
+char *read_text_file(const char *path, size_t *size, double limit);
+void report_yaml_error(const char *path, const yaml_parser_t *parser, const char *data, size_t size);
+
 #endif
