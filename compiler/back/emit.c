@@ -964,7 +964,6 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
   if (emit_rows_shared(f, L)) cx->failed = 1;
   /* its blocks, one per pair of bodies, are independent (emit_rows.c) */
   eval_split_mark_lines(&sp, shared_from, "  /* relative rotation", "the relative rotations of a pair of bodies");
-  static const char *prim[] = {"", "sph", "dot1", "dot2", "dist", "rot", "trans"};
   for (int r = 0; r < m->nrow; r++) {
     const mb_rowdef *R = &L->row[r];
     eval_split_mark(&sp, "row %d (%s)", r, L->row_desc[r]);
@@ -990,7 +989,6 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
     case MB_PRIM_TRANS:
       fprintf(f, "  mb_profile_eval(&profiles[%d], t, x);\n  mb_prim_dot2(&k%d, &k%d, 2, x, &r);\n", R->profile, R->m0, R->m1);
       break;
-    default: fprintf(f, "  /* unknown primitive %s */\n", prim[0]); break;
     }
     fprintf(f, "  phi[%d] = r.phi;\n  phid[%d] = mb_row_phidot(&r, &k%d, &k%d);\n"
                "  rhs[%d] = mb_row_gamma(&r, &k%d, &k%d);\n", r, r, R->m0, R->m1,
