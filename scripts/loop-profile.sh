@@ -11,17 +11,15 @@
 # table.  Not part of make test.
 # Environment: MBCC (build/mbcc), CC (cc), LOOP_PROFILE_LINKS ("8 16 24 32 64"),
 # LOOP_PROFILE_DIR (build/loop-profile).
-set -eu
-export LC_ALL=C
-cd "$(dirname "$0")/.."
-here=$(pwd)
-mbcc=${MBCC:-build/mbcc}
-case $mbcc in /*) ;; *) mbcc=$here/$mbcc ;; esac
+TOOL=loop-profile
+. "$(dirname "$0")/lib.sh"
+need_mbcc
+here=$ROOT
+mbcc=$MBCC
 out=${LOOP_PROFILE_DIR:-$here/build/loop-profile}
 cc=${CC:-cc}
-[ -x "$mbcc" ] || { echo "loop-profile: $mbcc not found: run 'make all' first" >&2; exit 1; }
-command -v valgrind >/dev/null || { echo "loop-profile: valgrind is needed (instruction counts)" >&2; exit 1; }
-rm -rf "$out" && mkdir -p "$out"
+command -v valgrind >/dev/null || die "valgrind is needed (instruction counts)"
+fresh_dir "$out"
 flags="-std=c11 -O2 -I$here/runtime/core -I$here/runtime/hosted"
 libs="$(dirname "$mbcc")/libmbrt.a -lamd -lklu -lcolamd -lbtf -lsuitesparseconfig -llapack -lblas -lm"
 
