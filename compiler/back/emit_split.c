@@ -43,6 +43,12 @@ long emit_size_setting(const char *env, long fallback) {
     char *end;
     long v = strtol(e, &end, 10);
     if (*end == 0 && v >= 0) return v;
+    /* a tuning knob, so the code stays right either way; but say so (once) */
+    static char warned[256];
+    if (strstr(warned, env) == NULL) {
+      fprintf(stderr, "mbcc: warning: %s=%s is not a whole number >= 0; using %ld\n", env, e, fallback);
+      if (strlen(warned) + strlen(env) + 2 < sizeof warned) strcat(strcat(warned, env), " ");
+    }
   }
   return fallback;
 }
