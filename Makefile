@@ -1,8 +1,19 @@
 # mbcc: build, test, demo.  `make` builds build/mbcc and the runtime library.
 CC      ?= cc
+# The simulators mbcc builds run on the machine that builds them, so their runtime
+# (libmbrt.a) and the generated code are compiled for its processor when the C compiler
+# can (NATIVE = -march=native): AVX's three-operand instructions make straight-line code
+# a quarter smaller, and its speed is set by how fast it streams through the instruction
+# cache (docs/architecture.md, "Compiled for the machine").  mbcc itself links a portable
+# build of the runtime (libmbrt_portable.a), so what it computes and emits does not depend
+# on the processor.  `make NATIVE=`: simulators that run on any x86-64.
 CFLAGS  ?= -O2 -g
+NATIVE  ?= $(shell $(CC) -march=native -x c -c /dev/null -o /dev/null 2>/dev/null && echo -march=native)
+RT_CFLAGS := $(CFLAGS) $(NATIVE)
 WARN    := -Wall -Wextra -Werror
-STD     := -std=c11
+# no fused multiply-adds the source does not write (clang contracts by default):
+# the generic path and the generated code give the same numbers, whatever the flags
+STD     := -std=c11 -ffp-contract=off
 ROOT    := $(CURDIR)
 LIBS    := -lyaml -lcholmod -larpack -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig -llapack -lblas -lm
 
@@ -22,44 +33,57 @@ CC_SRC  := $(wildcard compiler/*.c) $(foreach d,$(CC_DIRS),$(wildcard $(d)/*.c))
 B       ?= build
 DEPFLAGS = -MMD -MP
 
-.PHONY: all test demo clean sanitize docs bench peers ldl-profile trade extremes web test-browser embedded man release-check  install scaling chassis vehicle sweeps slurm-check
+.PHONY: FORCE all test demo clean sanitize docs bench peers ldl-profile trade extremes web test-browser embedded man release-check  install scaling chassis vehicle sweeps slurm-check
 all: $(B)/mbcc $(B)/libmbrt.a $(B)/libmbrt_float.a
 
+# every object depends on the compiler and flags it was built with: a change of CC or
+# CFLAGS (say, a portable build after a native one) rebuilds everything
+BUILD_FLAGS := $(CC) $(STD) $(WARN) $(CFLAGS) / $(NATIVE)
+$(B)/flags: FORCE
+	@mkdir -p $(B)
+	@echo '$(BUILD_FLAGS)' | cmp -s - $@ || echo '$(BUILD_FLAGS)' > $@
+FORCE:
+
 # objects keep the source's folders: $(B)/rt/core/x.o, $(B)/cc/front/x.o
-$(B)/rt/%.o: runtime/%.c
+$(B)/rt/%.o: runtime/%.c $(B)/flags
+	@mkdir -p $(@D)
+	$(CC) $(STD) $(WARN) $(RT_CFLAGS) $(DEPFLAGS) $(RT_INC) -c $< -o $@
+$(B)/rt-portable/%.o: runtime/%.c $(B)/flags
 	@mkdir -p $(@D)
 	$(CC) $(STD) $(WARN) $(CFLAGS) $(DEPFLAGS) $(RT_INC) -c $< -o $@
 
 # SUNDIALS' KLU header includes <klu.h>, which Debian keeps in suitesparse/
-$(B)/rt/hosted/ida.o: RT_INC += -I/usr/include/suitesparse
+$(B)/rt/hosted/ida.o $(B)/rt-portable/hosted/ida.o: RT_INC += -I/usr/include/suitesparse
 
 $(B)/libmbrt.a: $(patsubst runtime/%.c,$(B)/rt/%.o,$(RT_SRC))
+	rm -f $@ && ar rcs $@ $^
+$(B)/libmbrt_portable.a: $(patsubst runtime/%.c,$(B)/rt-portable/%.o,$(RT_SRC))
 	rm -f $@ && ar rcs $@ $^
 
 # the single-precision runtime (mbcc compile --real float): the emitted LDL^T
 # only, since KLU, LAPACK and SUNDIALS work in double
 RT_FLOAT_SRC := runtime/core/model_generic.c runtime/core/mb_step.c \
                 $(addprefix runtime/hosted/,solver_select.c solver_ldl.c integrate.c equilibrium.c reassemble.c genalpha.c driver.c)
-$(B)/rt-float/%.o: runtime/%.c
+$(B)/rt-float/%.o: runtime/%.c $(B)/flags
 	@mkdir -p $(@D)
-	$(CC) $(STD) $(WARN) $(CFLAGS) $(DEPFLAGS) -DMB_REAL_FLOAT $(RT_INC) -c $< -o $@
+	$(CC) $(STD) $(WARN) $(RT_CFLAGS) $(DEPFLAGS) -DMB_REAL_FLOAT $(RT_INC) -c $< -o $@
 
 $(B)/libmbrt_float.a: $(patsubst runtime/%.c,$(B)/rt-float/%.o,$(RT_FLOAT_SRC))
 	rm -f $@ && ar rcs $@ $^
 
 # where the built mbcc finds its templates, runtime headers and library
-CC_DEFS := -DMBCC_ROOT='"$(ROOT)"' -DMBCC_RTLIB='"$(ROOT)/$(B)/libmbrt.a"' -DMBCC_GEN_CFLAGS='"$(CFLAGS)"' \
-           -DMBCC_PLAYER_JS='"$(ROOT)/$(B)/web/player.js"'
-$(B)/cc/%.o: compiler/%.c
+CC_DEFS := -DMBCC_ROOT='"$(ROOT)"' -DMBCC_RTLIB='"$(abspath $(B))/libmbrt.a"' -DMBCC_GEN_CFLAGS='"$(RT_CFLAGS)"' \
+           -DMBCC_PLAYER_JS='"$(abspath $(B))/web/player.js"'
+$(B)/cc/%.o: compiler/%.c $(B)/flags
 	@mkdir -p $(@D)
 	$(CC) $(STD) $(WARN) $(CFLAGS) $(DEPFLAGS) $(CC_INC) $(CC_DEFS) -c $< -o $@
 
 CC_OBJ := $(patsubst compiler/%.c,$(B)/cc/%.o,$(CC_SRC))
 # the assembly analysis (compiler/lower/assemble.c) uses SuiteSparseQR and CHOLMOD
-$(B)/mbcc: $(CC_OBJ) $(B)/libmbrt.a
-	$(CC) $(CFLAGS) $(CC_OBJ) $(B)/libmbrt.a -lspqr $(LIBS) -lcamd -o $@
+$(B)/mbcc: $(CC_OBJ) $(B)/libmbrt_portable.a
+	$(CC) $(CFLAGS) $(CC_OBJ) $(B)/libmbrt_portable.a -lspqr $(LIBS) -lcamd -o $@
 
--include $(CC_OBJ:.o=.d) $(patsubst runtime/%.c,$(B)/rt/%.d,$(RT_SRC)) \
+-include $(CC_OBJ:.o=.d) $(patsubst runtime/%.c,$(B)/rt/%.d,$(RT_SRC)) $(patsubst runtime/%.c,$(B)/rt-portable/%.d,$(RT_SRC)) \
          $(patsubst runtime/%.c,$(B)/rt-float/%.d,$(RT_FLOAT_SRC))
 
 demo: all
@@ -72,16 +96,16 @@ chassis:
 
 # the timing comparison of every path (scripts/bench.sh): writes docs/benchmarks.md
 bench: all
-	MBCC=$(B)/mbcc sh scripts/bench.sh
+	MBCC=$(B)/mbcc GEN_CFLAGS="$(filter-out -g,$(RT_CFLAGS))" sh scripts/bench.sh
 
 # only the MuJoCo peer of make bench (scripts/peers.sh): writes docs/peers.md
 peers: all
-	MBCC=$(B)/mbcc PEER_DOC=docs/peers.md sh scripts/peers.sh
+	MBCC=$(B)/mbcc GEN_CFLAGS="$(filter-out -g,$(RT_CFLAGS))" PEER_DOC=docs/peers.md sh scripts/peers.sh
 
 # the emitted LDL^T's factor and solve alone, straight-line against looped
 # (scripts/ldl-profile.sh; docs/architecture.md): prints a Markdown table
 ldl-profile: all
-	MBCC=$(B)/mbcc sh scripts/ldl-profile.sh
+	MBCC=$(B)/mbcc GEN_CFLAGS="$(filter-out -g,$(RT_CFLAGS))" sh scripts/ldl-profile.sh
 
 # build and run time against model size on pendulum chains (scripts/scaling.sh):
 # writes docs/scaling.md; SIZES="5 10 20" for a quick one

@@ -2,7 +2,7 @@
 # ldl-profile.sh: the emitted LDL^T's factor + solve alone, in each code form,
 # on a few models (bench/ldl/ldl_harness.c): for every model and form
 # (straight-line: MBCC_LDL_BUDGET=1e12; looped: MBCC_LDL_BUDGET=0; default:
-# the compiler's choice) the C compile time of the generated model (cc -O2,
+# the compiler's choice) the C compile time of the generated model (cc $GEN_CFLAGS,
 # user + system CPU), cachegrind's instructions and I1 misses per call
 # ((1200 calls - 200 calls) / 1000, simulated 32 kB 8-way I1), and the
 # median and fastest per-call times of 31 rounds, the forms' harnesses run in
@@ -11,11 +11,14 @@
 # sets on the same pattern.  Prints a Markdown table.  Not part of make test.
 # Environment: MBCC (build/mbcc), CC (cc), LDL_PROFILE_MODELS ("MODEL.yaml[:SCENE] ..."),
 # LDL_PROFILE_FORMS ("straight looped"), LDL_PROFILE_ROUNDS (3), LDL_PROFILE_DIR
-# (build/ldl-profile), LDL_PROFILE_CACHEGRIND (1).
+# (build/ldl-profile), LDL_PROFILE_CACHEGRIND (1), GEN_CFLAGS (-O2; make ldl-profile:
+# the Makefile's CFLAGS less -g, as mbcc builds generated code).
 TOOL=ldl-profile
 . "$(dirname "$0")/lib.sh"
 RTLIB=$(dirname "$MBCC")/libmbrt.a
 CC=${CC:-cc}
+# the flags mbcc builds generated code with (make passes them)
+GEN_FLAGS="${GEN_CFLAGS:--O2} -ffp-contract=off"
 MODELS=${LDL_PROFILE_MODELS:-"models/sports_car.yaml:rigid models/sports_car.yaml:flexible models/sports_car.yaml:flexible_virtual models/slider_crank.yaml tests/models/hinged_chain20_rigid.yaml"}
 FORMS=${LDL_PROFILE_FORMS:-"straight looped"}
 ROUNDS=${LDL_PROFILE_ROUNDS:-3}
@@ -49,13 +52,13 @@ build() {
   for c in "$d"/g/*.c; do
     case $c in */main.c) continue ;; esac
     o=$d/$(basename "$c" .c).o
-    /usr/bin/time -f "%U %S" -a -o "$d/cctime" "$CC" -std=c11 -O2 -Iruntime/core -Iruntime/hosted -I"$d/g" \
+    /usr/bin/time -f "%U %S" -a -o "$d/cctime" "$CC" -std=c11 $GEN_FLAGS -Iruntime/core -Iruntime/hosted -I"$d/g" \
       -c "$c" -o "$o" || die "cc failed on $c"
     objs="$objs $o"
   done
   awk '{ u += $1; s += $2 } END { print u, s }' "$d/cctime" >"$d/cctime.sum" && mv "$d/cctime.sum" "$d/cctime"
   # shellcheck disable=SC2086
-  "$CC" -std=c11 -O2 -Iruntime/core -Iruntime/hosted -I/usr/include/suitesparse -I"$d/g" bench/ldl/ldl_harness.c \
+  "$CC" -std=c11 $GEN_FLAGS -Iruntime/core -Iruntime/hosted -I/usr/include/suitesparse -I"$d/g" bench/ldl/ldl_harness.c \
     $objs "$d/ldl_model.c" "$RTLIB" $LIBS -o "$d/harness" || die "building the harness of $d failed"
   grep -q 'define [A-Z_0-9]*_LDL_STRAIGHT 1' "$d"/g/"$nm".h && echo straight-line >"$d/form" || echo looped >"$d/form"
 }

@@ -39,7 +39,8 @@ if [ "$CG" = 1 ] && ! command -v valgrind >/dev/null; then
 fi
 
 LIBS="-lmujoco -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig -llapack -lblas -lm"
-CFLAGS_GEN="-O2"
+# the flags mbcc builds generated code with (make passes them; the Makefile's CFLAGS less -g)
+CFLAGS_GEN="${GEN_CFLAGS:--O2} -ffp-contract=off"
 
 # cachegrind NAME SIDE N: "Ir I1mr" of N calls of SIDE (mbcc or forward)
 cachegrind() {

@@ -5,7 +5,7 @@
 # about 30 s: not part of make test; .ci/run runs it after make test).
 .PHONY: test sanitize test-browser
 test: all $(WEB)/player.js
-	B=$(B) CFLAGS="$(CFLAGS)" bash tests/run_tests.sh
+	B=$(B) CFLAGS="$(RT_CFLAGS)" bash tests/run_tests.sh
 
 # SHOTS=docs/img writes the screenshots of the documentation
 test-browser: all $(WEB)/player.js

@@ -228,6 +228,9 @@ int compile_generated_into(const char *dir, const char *name, const char *main_s
   int nc = 0;
   ccargs[nc++] = (char *)(cc && *cc ? cc : "cc");
   ccargs[nc++] = "-std=c99";
+  /* no contraction into fused multiply-adds (clang's default): the generated code gives
+     the generic path's numbers to the last bit, whatever the flags or the compiler */
+  ccargs[nc++] = "-ffp-contract=off";
   if (real_float) ccargs[nc++] = "-DMB_REAL_FLOAT";
   for (char *tok = strtok(flags, " "); tok && nc < 40; tok = strtok(NULL, " "))
     if (keep_debug_info || strncmp(tok, "-g", 2) != 0) ccargs[nc++] = tok;
