@@ -107,8 +107,9 @@ peers: all
 ldl-profile: all
 	MBCC=$(B)/mbcc GEN_CFLAGS="$(filter-out -g,$(RT_CFLAGS))" sh scripts/ldl-profile.sh
 
-# build and run time against model size on pendulum chains (scripts/scaling.sh):
-# writes docs/scaling.md; SIZES="5 10 20" for a quick one
+# build and run time against model size on pendulum chains and fleets of the
+# sports car (scripts/scaling.sh): writes docs/scaling.md; SIZES="5 10 20"
+# FLEET_SIZES="1 2" for a quick one
 scaling: all
 	MBCC=$(B)/mbcc bash scripts/scaling.sh
 

@@ -1,5 +1,6 @@
 # lib.sh: the preamble shared by the measuring scripts (bench.sh, peers.sh,
-# ldl-profile.sh, loop-profile.sh, results.sh, trade.sh, vehicle.sh, sweeps.sh).  Each sets TOOL (its name in
+# ldl-profile.sh, loop-profile.sh, results.sh, trade.sh, vehicle.sh, sweeps.sh, scaling.sh,
+# rigid_chassis.sh).  Each sets TOOL (its name in
 # messages) and sources this file first:
 #   TOOL=bench; . "$(dirname "$0")/lib.sh"
 # Then: strict mode, the C locale (awk's numbers), the repository as the
