@@ -22,19 +22,22 @@ model_path() {
 
 declare -A compiled
 # "model" or "model@scene", optionally with "+looped" (the emitted LDL^T as
-# loops over tables whatever its size: MBCC_LDL_BUDGET=0) or "+loops" (the
-# evaluation in the loop form whatever its groups' sizes: MBCC_LOOP_MIN=0);
+# loops over tables whatever its size: MBCC_LDL_BUDGET=0), "+loops" (the
+# evaluation in the loop form whatever its groups' sizes: MBCC_LOOP_MIN=0) or
+# "+tail" (the straight-line LDL^T with a dense tail of 12 rows: MBCC_LDL_TAIL=12);
 # the generated code is named model or model_scene, in
 # $B/gen/<that name>[_looped|_loops]
-gen_name() { local m=${1%+looped}; m=${m%+loops}; if [[ $m == *@* ]]; then echo "${m%@*}_${m#*@}"; else echo "$m"; fi; }
+gen_name() { local m=${1%+looped}; m=${m%+loops}; m=${m%+tail}; if [[ $m == *@* ]]; then echo "${m%@*}_${m#*@}"; else echo "$m"; fi; }
 gen_dir() {
   if [[ $1 == *+looped ]]; then echo "$B/gen/$(gen_name "$1")_looped"
   elif [[ $1 == *+loops ]]; then echo "$B/gen/$(gen_name "$1")_loops"
+  elif [[ $1 == *+tail ]]; then echo "$B/gen/$(gen_name "$1")_tail"
   else echo "$B/gen/$(gen_name "$1")"; fi
 }
 compile_model() {
   local m=${1%+looped} base d budget=()
   m=${m%+loops}
+  m=${m%+tail}
   base=${m%@*}
   d=$(gen_dir "$1")
   [ -n "${compiled[$d]:-}" ] && return 0
@@ -42,6 +45,7 @@ compile_model() {
   [[ $m == *@* ]] && scene=(--scene "${m#*@}")
   [[ $1 == *+looped ]] && budget=(env MBCC_LDL_BUDGET=0)
   [[ $1 == *+loops ]] && budget=(env MBCC_LOOP_MIN=0)
+  [[ $1 == *+tail ]] && budget=(env MBCC_LDL_TAIL=12)
   "${budget[@]}" "$B/mbcc" compile "$(model_path "$base")" "${scene[@]}" -o "$d" >/dev/null || return 1
   compiled[$d]=1
 }

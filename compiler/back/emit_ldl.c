@@ -93,7 +93,13 @@ static long ml_base(const ldl_plan *p) {
   return w;
 }
 
-static long work_size(const ldl_plan *p) {
+typedef struct ldl_tail ldl_tail;
+static int tail_plan(const ldl_plan *p, long base, ldl_tail *t);
+static long work_size_tail(const ldl_plan *p, long base);
+static int tail_rows(const ldl_plan *p, long base);
+
+/* the workspace before the dense tail's blocks */
+static long work_size_base(const ldl_plan *p) {
   long w = ml_base(p);
   if (p->nml) {
     int rmax;
@@ -103,6 +109,11 @@ static long work_size(const ldl_plan *p) {
     for (int e = 0; e < p->nml; e++) w += ml_work(p, e);
   }
   return w;
+}
+
+static long work_size(const ldl_plan *p) {
+  long w = work_size_base(p);
+  return w + work_size_tail(p, w);
 }
 
 void emit_ldl_header(emit_ctx *cx) {
@@ -118,6 +129,8 @@ void emit_ldl_header(emit_ctx *cx) {
   fprintf(f, "#define %s_LDL_WORK %ld      /* mb_real elements of the workspace */\n", U, work_size(p));
   fprintf(f, "#define %s_LDL_EXACT %d      /* 1: the factors are those of K (no weighted rows) */\n", U,
           p->nw == 0);
+  int tail_nt = tail_rows(p, work_size_base(p));
+  if (tail_nt) fprintf(f, "#define %s_LDL_TAIL %d       /* the last rows of L, formed as a dense block */\n", U, tail_nt);
   fprintf(f, "int %s_ldl_factor(const mb_real *Kx, mb_real *work);\n", nm);
   fprintf(f, "int %s_ldl_solve(const mb_real *Kx, mb_real *work, mb_real *b, mb_real *residual);\n", nm);
 }
@@ -398,6 +411,367 @@ static const char *factor_part_params(const emit_ctx *cx, const ldl_plan *p) {
   return v[(p->nelim ? 1 : 0) + (cx->ldl.k1_direct ? 2 : 0)];
 }
 
+/* ------------------------------------------------------------ dense tail */
+
+/* The last rows of L of a model with a hub (a flexible body's modal block, a
+ * chassis that every corner joins, and the loop rows ordered last) are nearly
+ * dense: on the flexible car the last 28 of its 200 rows hold 86 % of the
+ * factorization's multiply-adds.  Written straight-line, every one of them is an
+ * instruction of its own that streams through the instruction cache at every
+ * call; as a dense block they are a few short loops over vectors.  The tail's
+ * rows T..n-1 are then formed in two steps:
+ *   - straight-line, as every other row: their entries in the columns C < T
+ *     they touch (a sparse triangular solve with the rows before T), kept as
+ *     W = y_c, row a = k - T after row a - 1 (the row's own entries only), and
+ *     LcT(c, a) = L(k, c), and the entries of K_aug in the tail's block,
+ *     Kt(a, b) = K_aug(T + b, k);
+ *   - ldl_tail, dense: row a's unscaled entries S(b) = Kt(a, b) -
+ *     sum_c W(a, c) LcT(c, b) (c over the row's entries, b over the whole
+ *     tail), then the tail's own triangular solve column by
+ *     column (an axpy per column: no reductions, so the C compiler vectorizes
+ *     the loops without reordering a sum), the pivot with the straight-line
+ *     form's test, and the tail's entries scattered into Lx for the solves.
+ * The blocks are padded to multiples of 8 with zeros (cleared at every
+ * factorization: the structurally zero entries are never written), so every
+ * inner loop has a constant trip count.  The sums run in another order than
+ * the straight-line form's: the factors agree to roundoff, not to the bit. */
+struct ldl_tail {
+  int T, nt, nc, ntp, ncp; /* first row of the tail, its rows, the columns before it, padded */
+  int *cidx;               /* T: column j < T -> its place in C, else -1 */
+  long nw;                 /* the tail rows' entries in C (W holds them row by row) */
+  long tw, tl, tk, tt, size; /* workspace: W (nw), LcT (ncp x ntp), Kt and LtT (nt x ntp) */
+};
+
+/* largest tail tried, smallest worth a dense block */
+#define LDL_TAIL_MAX 96
+#define LDL_TAIL_MIN 8
+/* the cost of a multiply-subtract on 8 lanes against a straight-line
+ * multiply-add (two AVX or one AVX-512 instruction from a short loop, against
+ * an instruction and its constant address streamed from the cache), and the
+ * least gain in multiply-adds for which the tail is used */
+#define LDL_TAIL_VECTOR_COST 1.0
+#define LDL_TAIL_MIN_GAIN 1000.0
+
+static int pad8(int x) { return (x + 7) / 8 * 8; }
+
+/* the columns before T in the rows from T on: their number (cidx: their places) */
+static int tail_columns(const ldl_plan *p, int T, int *cidx) {
+  int nc = 0;
+  for (int j = 0; j < T; j++) cidx[j] = -1;
+  for (int k = T; k < p->n; k++)
+    for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++)
+      if (p->Rj[r] < T) cidx[p->Rj[r]] = 0;
+  for (int j = 0; j < T; j++)
+    if (cidx[j] == 0) cidx[j] = nc++;
+  return nc;
+}
+
+static void tail_layout(ldl_tail *t, long base) {
+  t->ntp = pad8(t->nt);
+  t->ncp = pad8(t->nc > 0 ? t->nc : 1);
+  t->tw = base;
+  t->tl = t->tw + (t->nw > 0 ? t->nw : 1);
+  t->tk = t->tl + (long)t->ncp * t->ntp;
+  t->tt = t->tk + (long)t->nt * t->ntp;
+  t->size = t->tt + (long)t->nt * t->ntp - base;
+}
+
+/* Whether the straight-line factorization takes a dense tail, and which
+ * (*t, with t->cidx allocated: tail_free).  MBCC_LDL_TAIL=0: never; =N: the
+ * last N rows; else the tail whose estimated cost (straight-line multiply-adds
+ * moved out, against the dense loops' vector operations, the extra stores and
+ * the scatter) gains most, if it gains at least LDL_TAIL_MIN_GAIN.  Only the
+ * plain form (no block pivots, no massless bodies) has one. */
+static int tail_plan(const ldl_plan *p, long base, ldl_tail *t) {
+  memset(t, 0, sizeof *t);
+  int n = p->n;
+  if (!p->straight || p->nelim || p->nml || n < 2 * LDL_TAIL_MIN) return 0;
+  const char *env = getenv("MBCC_LDL_TAIL");
+  int forced = -1;
+  if (env && *env) {
+    char *end;
+    long v = strtol(env, &end, 10);
+    if (*end == 0 && v >= 0) forced = v >= n ? n - 1 : (int)v;
+  }
+  if (forced == 0 || forced == 1) return 0;
+  int *inrow = calloc((size_t)n + 1, sizeof(int)), *cidx = malloc(sizeof(int) * ((size_t)n + 1));
+  long *cnt = calloc((size_t)p->nnzL + 1, sizeof(long)); /* terms of y_j in row k, at Rpos order r */
+  if (!inrow || !cidx || !cnt) { free(inrow); free(cidx); free(cnt); return 0; }
+  int lo = forced > 0 ? n - forced : (n - LDL_TAIL_MAX > 0 ? n - LDL_TAIL_MAX : 1);
+  for (int k = lo; k < n; k++) {
+    for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) inrow[p->Rj[r]] = 1;
+    for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) {
+      int j = p->Rj[r];
+      for (int rr = p->Rp[j]; rr < p->Rp[j + 1]; rr++) cnt[r] += inrow[p->Rj[rr]];
+    }
+    for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) inrow[p->Rj[r]] = 0;
+  }
+  double best = LDL_TAIL_MIN_GAIN;
+  int bestT = -1;
+  for (int T = lo; T <= n - LDL_TAIL_MIN; T++) {
+    if (forced > 0 && T != n - forced) continue;
+    int nt = n - T, nc = tail_columns(p, T, cidx), ntp = pad8(nt);
+    double moved = 0, extra = 0, dense = ((double)pad8(nc > 0 ? nc : 1) + nt) * ntp / 8; /* the clearing */
+    for (int b = 0; b < nt; b++) dense += (double)(nt - b - 1) * (ntp - (b + 1) / 8 * 8) / 8 + 4; /* elimination */
+    for (int k = T; k < n; k++) {
+      int nck = 0;
+      moved += p->Rp[k + 1] - p->Rp[k]; /* the pivot's sum */
+      for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) {
+        if (p->Rj[r] >= T) moved += (double)cnt[r] + 1, extra += 1; /* its term, scale; the scatter */
+        else extra += 2, nck++; /* W and LcT */
+      }
+      for (int e = p->Up[k]; e < p->Up[k + 1]; e++) extra += p->Ui[e] >= T; /* Kt */
+      dense += (double)nck * ntp / 8 * LDL_TAIL_VECTOR_COST + nck + 10; /* S's row, the scale */
+    }
+    double gain = moved - dense - extra;
+    if (forced > 0 || gain > best) best = gain, bestT = T;
+  }
+  free(inrow);
+  free(cnt);
+  if (bestT < 0) { free(cidx); return 0; }
+  t->T = bestT;
+  t->nt = n - bestT;
+  t->nc = tail_columns(p, bestT, cidx);
+  t->cidx = cidx;
+  for (int k = bestT; k < n; k++)
+    for (int r = p->Rp[k]; r < p->Rp[k + 1] && p->Rj[r] < bestT; r++) t->nw++;
+  tail_layout(t, base);
+  return 1;
+}
+
+static void tail_free(ldl_tail *t) {
+  free(t->cidx);
+  t->cidx = NULL;
+}
+
+/* the dense tail's rows (0: none) */
+static int tail_rows(const ldl_plan *p, long base) {
+  ldl_tail t;
+  if (!tail_plan(p, base, &t)) return 0;
+  tail_free(&t);
+  return t.nt;
+}
+
+/* the dense tail's part of the workspace (0: none) */
+static long work_size_tail(const ldl_plan *p, long base) {
+  ldl_tail t;
+  if (!tail_plan(p, base, &t)) return 0;
+  tail_free(&t);
+  return t.size;
+}
+
+/* the dense tail's functions (see above): ldl_tail_clear before the parts,
+ * ldl_tail after them */
+static void emit_tail_kernel(emit_ctx *cx, const lmodel *L, const ldl_plan *p, const ldl_tail *t) {
+  FILE *f = cx->f;
+  char name[512];
+  long nl = 0;
+  for (int k = t->T; k < p->n; k++)
+    for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) nl += p->Rj[r] >= t->T;
+  int *lx = malloc(sizeof(int) * (size_t)(nl + 1)), *at = malloc(sizeof(int) * (size_t)(nl + 1));
+  int *fail = malloc(sizeof(int) * (size_t)(t->nt + 1)), *wp = malloc(sizeof(int) * (size_t)(t->nt + 1));
+  int *wc = malloc(sizeof(int) * (size_t)(t->nw + 1));
+  if (!lx || !at || !fail || !wp || !wc) {
+    free(lx); free(at); free(fail); free(wp); free(wc);
+    cx->failed = 1;
+    return;
+  }
+  nl = 0;
+  int nw = 0;
+  for (int k = t->T; k < p->n; k++) {
+    fail[k - t->T] = p->perm[k] + 1;
+    wp[k - t->T] = nw;
+    for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++)
+      if (p->Rj[r] >= t->T) {
+        lx[nl] = p->Rpos[r];
+        at[nl++] = (p->Rj[r] - t->T) * t->ntp + (k - t->T);
+      } else {
+        wc[nw++] = t->cidx[p->Rj[r]] * t->ntp; /* where its column of LcT starts */
+      }
+  }
+  wp[t->nt] = nw;
+  ldl_unknown_name(L, p->perm[t->T], name, sizeof name);
+  fprintf(f, "/* the dense tail: rows %d..%d of L (from %s on), which touch %d columns\n"
+             " * before it; see emit_ldl.c.  Workspace: W (y of those columns), LcT (their L,\n"
+             " * transposed), Kt (K_aug in the tail), LtT (the tail's L, by columns), padded to 8 */\n",
+          t->T, p->n - 1, name, t->nc);
+  fprintf(f, "#define LDL_TAIL_T %d\n#define LDL_TAIL_NT %d\n#define LDL_TAIL_NC %d\n"
+             "#define LDL_TAIL_NTP %d\n#define LDL_TAIL_NCP %d\n"
+             "#define LDL_TW %ld\n#define LDL_TL %ld\n#define LDL_TK %ld\n#define LDL_TT %ld\n"
+             "#define LDL_TAIL_NL %ld\n",
+          t->T, t->nt, t->nc, t->ntp, t->ncp, t->tw, t->tl, t->tk, t->tt, nl);
+  fputs("/* 1 + the unknown of each tail pivot (the code of a failed pivot) */\n", f);
+  idx_array(f, "ldl_tail_fail", fail, t->nt);
+  fputs("/* row a's entries in the columns before the tail: W[ldl_tail_wp[a] ..\n"
+        " * ldl_tail_wp[a + 1]), and where each one's column of LcT starts */\n", f);
+  idx_array(f, "ldl_tail_wp", wp, t->nt + 1);
+  idx_array(f, "ldl_tail_wc", wc, t->nw);
+  fputs("/* the tail's entries of L: their Lx positions and their places in LtT */\n", f);
+  idx_array(f, "ldl_tail_lx", lx, nl);
+  idx_array(f, "ldl_tail_at", at, nl);
+  fputs("\n/* LcT and Kt are zero where nothing writes them */\n"
+        "static void ldl_tail_clear(mb_real *work) {\n"
+        "  for (int i = LDL_TL; i < LDL_TT; i++) work[i] = 0;\n}\n\n", f);
+  /* GNU C's vector types let the compiler keep a row of the tail in registers
+   * (a loop over an array would go through memory at every step); other
+   * compilers get the same loops on scalars */
+  fputs("#if defined(__GNUC__)\n"
+        "/* 8 reals, aligned as one (rows start anywhere) and read through any pointer;\n"
+        "   macros, not functions: a vector argument's ABI depends on the flags */\n"
+        "typedef mb_real ldl_vec __attribute__((vector_size(8 * sizeof(mb_real)), aligned(sizeof(mb_real)), may_alias));\n"
+        "#define ldl_vload(p) (*(const ldl_vec *)(const void *)(p))\n"
+        "#define ldl_vstore(p, v) (*(ldl_vec *)(void *)(p) = (v))\n"
+        "#endif\n\n"
+        "/* column b of the tail's L from V (its entries from row b on, before the\n"
+        " * division by the pivot), and what it adds to the later rows' pivot scales */\n"
+        "static int ldl_tail_pivot(int b, const mb_real *V, mb_real *scale, mb_real *Y, mb_real *LtT, mb_real *Dinv) {\n"
+        "  const mb_real d = V[b];\n"
+        "  if (!(fabs(d) > LDL_PIVTOL * scale[b]) || !isfinite(scale[b])) return ldl_tail_fail[b];\n"
+        "  Dinv[b] = 1 / d;\n"
+        "  for (int a = b + 1; a < LDL_TAIL_NT; a++) {\n"
+        "    const mb_real l = V[a] * Dinv[b];\n"
+        "    Y[b * LDL_TAIL_NTP + a] = V[a];\n"
+        "    LtT[b * LDL_TAIL_NTP + a] = l;\n"
+        "    scale[a] += fabs(l * V[a]);\n"
+        "  }\n"
+        "  /* zeros where later columns' vectors read past the entries: the padding, and\n"
+        "     this column's block of 8 up to the diagonal */\n"
+        "  for (int a = b / 8 * 8; a <= b; a++) Y[b * LDL_TAIL_NTP + a] = LtT[b * LDL_TAIL_NTP + a] = 0;\n"
+        "  for (int a = LDL_TAIL_NT; a < LDL_TAIL_NTP; a++) Y[b * LDL_TAIL_NTP + a] = LtT[b * LDL_TAIL_NTP + a] = 0;\n"
+        "  return 0;\n}\n\n"
+        "static int ldl_tail(mb_real *work) {\n"
+        "  mb_real *Lx = work, *Dinv = work + LDL_DINV + LDL_TAIL_T, *S = work + LDL_TT;\n"
+        "  const mb_real *W = work + LDL_TW, *LcT = work + LDL_TL, *Kt = work + LDL_TK;\n"
+        "  mb_real scale[LDL_TAIL_NT], LtT[LDL_TAIL_NT * LDL_TAIL_NTP], Y[LDL_TAIL_NT * LDL_TAIL_NTP], V[LDL_TAIL_NTP];\n"
+        "  int rc;\n"
+        "#if defined(__GNUC__)\n"
+        "  const ldl_vec zero = {0};\n"
+        "#endif\n"
+        "  /* S = Kt - W LcT^T, the tail's block after the columns before it (whole rows: S is\n"
+        "     symmetric), and each pivot's scale: |K_aug(k, k)| + sum_j |L(k, j) y_j| */\n"
+        "  for (int a = 0; a < LDL_TAIL_NT; a++) {\n"
+        "    mb_real sc = 0;\n"
+        "#if defined(__GNUC__)\n"
+        "    /* the row in registers: one variable per 8 columns */\n", f);
+  /* two sets of sums, the row's entries taken in pairs: a subtraction's latency
+     would otherwise set the pace */
+  int nv = t->ntp / 8;
+  fputs("    ldl_vec", f);
+  for (int v = 0; v < nv; v++)
+    fprintf(f, "%s s%d = ldl_vload(Kt + a * LDL_TAIL_NTP + %d), u%d = zero", v ? "," : "", v, 8 * v, v);
+  fputs(";\n    mb_real sd = 0;\n    int q = ldl_tail_wp[a];\n"
+        "    for (; q + 1 < ldl_tail_wp[a + 1]; q += 2) {\n"
+        "      const mb_real wc = W[q], *l = LcT + ldl_tail_wc[q], wd = W[q + 1], *m = LcT + ldl_tail_wc[q + 1];\n", f);
+  for (int v = 0; v < nv; v++) fprintf(f, "      s%d -= wc * ldl_vload(l + %d);\n      u%d -= wd * ldl_vload(m + %d);\n", v, 8 * v, v, 8 * v);
+  fputs("      sc += fabs(wc * l[a]);\n      sd += fabs(wd * m[a]);\n    }\n"
+        "    if (q < ldl_tail_wp[a + 1]) {\n"
+        "      const mb_real wc = W[q], *l = LcT + ldl_tail_wc[q];\n", f);
+  for (int v = 0; v < nv; v++) fprintf(f, "      s%d -= wc * ldl_vload(l + %d);\n", v, 8 * v);
+  fputs("      sc += fabs(wc * l[a]);\n    }\n    sc += sd;\n", f);
+  for (int v = 0; v < nv; v++) fprintf(f, "    ldl_vstore(S + a * LDL_TAIL_NTP + %d, s%d + u%d);\n", 8 * v, v, v);
+  fputs("#else\n"
+        "    mb_real *s = S + a * LDL_TAIL_NTP;\n"
+        "    for (int c = 0; c < LDL_TAIL_NTP; c++) s[c] = Kt[a * LDL_TAIL_NTP + c];\n"
+        "    for (int q = ldl_tail_wp[a]; q < ldl_tail_wp[a + 1]; q++) {\n"
+        "      const mb_real wc = W[q], *l = LcT + ldl_tail_wc[q];\n"
+        "      for (int c = 0; c < LDL_TAIL_NTP; c++) s[c] -= wc * l[c];\n"
+        "      sc += fabs(wc * l[a]);\n"
+        "    }\n"
+        "#endif\n"
+        "    scale[a] = fabs(Kt[a * LDL_TAIL_NTP + a]) + sc;\n"
+        "  }\n"
+        "  /* L D L^T of S, left-looking by columns: column b (rows b.., row b of S by\n"
+        "     symmetry) less sum_{b' < b} y(b', b) L(:, b'), with y(b', b) = L(b, b') d_b' */\n", f);
+  fputs("#if defined(__GNUC__)\n", f);
+  /* one loop per block of 8 columns, each with the vectors from its block on in
+   * registers, the earlier columns taken in pairs */
+  for (int v0 = 0; v0 < nv; v0++) {
+    fprintf(f, "  for (int b = %d; b < %d && b < LDL_TAIL_NT; b++) {\n", 8 * v0, 8 * v0 + 8);
+    fputs("    ldl_vec", f);
+    for (int v = v0; v < nv; v++)
+      fprintf(f, "%s x%d = ldl_vload(S + b * LDL_TAIL_NTP + %d), z%d = zero", v > v0 ? "," : "", v, 8 * v, v);
+    fputs(";\n    int bp = 0;\n    for (; bp + 1 < b; bp += 2) {\n"
+          "      const mb_real y = Y[bp * LDL_TAIL_NTP + b], *l = LtT + bp * LDL_TAIL_NTP;\n"
+          "      const mb_real yy = Y[(bp + 1) * LDL_TAIL_NTP + b], *ll = LtT + (bp + 1) * LDL_TAIL_NTP;\n", f);
+    for (int v = v0; v < nv; v++)
+      fprintf(f, "      x%d -= y * ldl_vload(l + %d);\n      z%d -= yy * ldl_vload(ll + %d);\n", v, 8 * v, v, 8 * v);
+    fputs("    }\n    if (bp < b) {\n"
+          "      const mb_real y = Y[bp * LDL_TAIL_NTP + b], *l = LtT + bp * LDL_TAIL_NTP;\n", f);
+    for (int v = v0; v < nv; v++) fprintf(f, "      x%d -= y * ldl_vload(l + %d);\n", v, 8 * v);
+    fputs("    }\n", f);
+    for (int v = v0; v < nv; v++) fprintf(f, "    ldl_vstore(V + %d, x%d + z%d);\n", 8 * v, v, v);
+    fputs("    if ((rc = ldl_tail_pivot(b, V, scale, Y, LtT, Dinv)) != 0) return rc;\n  }\n", f);
+  }
+  fputs("#else\n"
+        "  for (int b = 0; b < LDL_TAIL_NT; b++) {\n"
+        "    for (int a = b; a < LDL_TAIL_NTP; a++) V[a] = S[b * LDL_TAIL_NTP + a];\n"
+        "    for (int bp = 0; bp < b; bp++) {\n"
+        "      const mb_real y = Y[bp * LDL_TAIL_NTP + b], *l = LtT + bp * LDL_TAIL_NTP;\n"
+        "      for (int a = b; a < LDL_TAIL_NTP; a++) V[a] -= y * l[a];\n"
+        "    }\n"
+        "    if ((rc = ldl_tail_pivot(b, V, scale, Y, LtT, Dinv)) != 0) return rc;\n"
+        "  }\n"
+        "#endif\n"
+        "  for (int q = 0; q < LDL_TAIL_NL; q++) Lx[ldl_tail_lx[q]] = LtT[ldl_tail_at[q]];\n"
+        "  return 0;\n}\n\n", f);
+  free(lx);
+  free(at);
+  free(fail);
+  free(wp);
+  free(wc);
+}
+
+/* row k of the dense tail, straight-line: its entries in the columns before the
+ * tail (into Lx, W and LcT) and its entries of K_aug in the tail (into Kt) */
+static void emit_tail_row(emit_ctx *cx, const ldl_plan *p, const ldl_tail *t, int k, int *inrow, int *kent,
+                          double *chunk_flops) {
+  FILE *f = cx->f;
+  int a = k - t->T, any_y = 0;
+  long q = 0; /* row k's first place in W: the entries in C of the tail rows before it */
+  for (int kk = t->T; kk < k; kk++)
+    for (int r = p->Rp[kk]; r < p->Rp[kk + 1] && p->Rj[r] < t->T; r++) q++;
+  for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) {
+    inrow[p->Rj[r]] = 1;
+    any_y |= p->Rj[r] < t->T;
+  }
+  fputs("  {\n", f);
+  if (any_y) {
+    fputs("    mb_real", f);
+    int first = 1;
+    for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++)
+      if (p->Rj[r] < t->T) fprintf(f, "%s y%d", first ? "" : ",", p->Rj[r]), first = 0;
+    fputs(";\n", f);
+  }
+  for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) {
+    int j = p->Rj[r], any = 0;
+    if (j >= t->T) break; /* the row's columns ascend */
+    fprintf(f, "    y%d = ", j);
+    if (kent[j] >= 0) { aug_value(cx, p, kent[j]); any = 1; }
+    for (int rr = p->Rp[j]; rr < p->Rp[j + 1]; rr++)
+      if (inrow[p->Rj[rr]]) {
+        fprintf(f, "%sLx[%d] * y%d", any ? " - " : "-", p->Rpos[rr], p->Rj[rr]);
+        any = 1;
+      }
+    if (!any) fputs("0", f);
+    fprintf(f, ";\n    Lx[%d] = y%d * Dinv[%d];\n", p->Rpos[r], j, j);
+    fprintf(f, "    Lx[%ld] = y%d;\n    Lx[%ld] = Lx[%d];\n", t->tw + q++, j,
+            t->tl + (long)t->cidx[j] * t->ntp + a, p->Rpos[r]);
+    *chunk_flops += 2.0 * (p->Rpos[r] - p->Lp[j]) + 5;
+  }
+  for (int e = p->Up[k]; e < p->Up[k + 1]; e++)
+    if (p->Ui[e] >= t->T) {
+      long at = t->tk + (long)a * t->ntp + (p->Ui[e] - t->T), mirror = t->tk + (long)(p->Ui[e] - t->T) * t->ntp + a;
+      fprintf(f, "    Lx[%ld] = ", at);
+      aug_value(cx, p, e);
+      fputs(";\n", f);
+      if (mirror != at) fprintf(f, "    Lx[%ld] = Lx[%ld];\n", mirror, at);
+      *chunk_flops += 1;
+    }
+  fputs("  }\n", f);
+  for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) inrow[p->Rj[r]] = 0;
+  for (int e = p->Up[k]; e < p->Up[k + 1]; e++) kent[p->Ui[e]] = -1;
+}
+
 static void emit_factor_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *p, const char *nm) {
   FILE *f = cx->f;
   int n = p->n;
@@ -411,6 +785,8 @@ static void emit_factor_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *
   int *inrow = malloc(sizeof(int) * (size_t)(n + 1)); /* column j in row k: 1 */
   int *kent = malloc(sizeof(int) * (size_t)(n + 1));  /* row i of column k of K_aug: entry e */
   if (!inrow || !kent) { free(inrow); free(kent); cx->failed = 1; return; }
+  ldl_tail tl;
+  int tail = tail_plan(p, work_size_base(p), &tl), T = tail ? tl.T : n;
   for (int j = 0; j < n; j++) inrow[j] = 0, kent[j] = -1;
   int nchunk = 0;
   double chunk_flops = 0;
@@ -434,6 +810,10 @@ static void emit_factor_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *
     for (int e = p->Up[k]; e < p->Up[k + 1]; e++) {
       if (p->Ui[e] == k) diag = e;
       else kent[p->Ui[e]] = e;
+    }
+    if (k >= T) {
+      emit_tail_row(cx, p, &tl, k, inrow, kent, &chunk_flops);
+      continue;
     }
     int dc = ldl_const_pivot(cx, p, k);
     if (dc) {
@@ -482,6 +862,10 @@ static void emit_factor_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *
   if (n) fputs("  return 0;\n}\n\n", f);
   f = part_close(cx);
   (void)nm;
+  if (tail) {
+    emit_tail_kernel(cx, L, p, &tl);
+    tail_free(&tl);
+  }
   if (cx->ldl.part_file)
     for (int c = 0; c < nchunk; c++) {
       part_name(cx, name, sizeof name, "factor_part", c);
@@ -490,12 +874,14 @@ static void emit_factor_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *
   fputs("/* L D L^T of K_aug, whose entries come from Kx (K, or K' after the block pivots) */\n", f);
   fprintf(f, "static int ldl_factor_aug(const mb_real *Kx,%s mb_real *work) {\n", p->nelim ? " const mb_real *Kc," : "");
   fputs("  mb_real *Lx = work, *Dinv = work + LDL_DINV;\n  int rc;\n", f);
+  if (tail) fputs("  ldl_tail_clear(work);\n", f);
   fputs("  /* the pivots in order, in parts */\n", f);
   for (int c = 0; c < nchunk; c++) {
     part_name(cx, name, sizeof name, "factor_part", c);
     fprintf(f, "  if ((rc = %s(Kx,%s%s Lx, Dinv)) != 0) return rc;\n", name, p->nelim ? " Kc," : "",
             cx->ldl.k1_direct ? " work + LDL_K1," : "");
   }
+  if (tail) fputs("  if ((rc = ldl_tail(work)) != 0) return rc;\n", f);
   fputs("  (void)Lx;\n  (void)Dinv;\n  (void)rc;\n  return 0;\n}\n\n", f);
 }
 
