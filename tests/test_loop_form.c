@@ -6,10 +6,10 @@
  * axes with a time scale and a torque, a virtual body (fd_all), and a
  * hinged chain.  Mixed models, whose elements without a loop form are
  * written straight-line in the same evaluation: four tyres on a table road
- * (tyre_cart), a flexible rod between looped bodies
+ * (tyre_cart: the tyres looped), a flexible rod between looped bodies
  * (slider_crank_flexible), springs on flexible nodes (fd_node_twins), a
  * superelement (tangent_forces), the flexible car (sports_car: flexible
- * chassis, tyres).  test_fd checks the straight-line form against
+ * chassis, its tyres looped).  test_fd checks the straight-line form against
  * the same generic path and against finite differences;
  * tests/test_loop_form.sh the two forms' simulations against each other. */
 // models: fd_all+loops hinged_chain10_rigid+loops tyre_cart+loops slider_crank_flexible+loops fd_node_twins+loops tangent_forces+loops sports_car+loops

@@ -100,15 +100,15 @@ static int same_block(const lmodel *L, const row_block *x, const row_block *y) {
 }
 
 /* the force kinds with a loop form: those whose kernel reads everything
- * from the pools and two markers at most (the superelement's nodes are a
- * list; the tyre has none yet) */
+ * from the pools (the tyre's road too: force_tyre.c copies it there) and two
+ * markers at most (the superelement's nodes are a list) */
 static int force_has_loop(const mb_forcedef *d) {
   switch (d->kind) {
   case MB_FORCE_POINT:
   case MB_FORCE_TORQUE:
   case MB_FORCE_SPRING:
-  case MB_FORCE_FIELD: return 1;
-  case MB_FORCE_TYRE:
+  case MB_FORCE_FIELD:
+  case MB_FORCE_TYRE: return 1;
   case MB_FORCE_SUPERELEMENT: return 0;
   }
   return 0;
@@ -372,7 +372,11 @@ static void write_forces(FILE *t, FILE *f, const lmodel *L, const loop_plan *p) 
         add_wrench(f, 0, "mk[E->m1].P", "mF", "mT"); /* the reaction at the same point */
       }
       break;
-    case MB_FORCE_TYRE:
+    case MB_FORCE_TYRE: /* one marker, the wheel centre: force and torque on the wheel */
+      if (ground0) { fputs("    (void)E; /* on the ground: no effect */\n  }\n", f); continue; }
+      fputs("    mb_real Fv[3], Tv[3];\n    mb_tyre(&mk[E->m0], force_prm + E->padr, Fv, Tv, 0, 0);\n", f);
+      add_wrench(f, 0, "mk[E->m0].P", "Fv", "Tv");
+      break;
     case MB_FORCE_SUPERELEMENT: break; /* no loop form (force_has_loop) */
     }
     fputs("  }\n", f);
