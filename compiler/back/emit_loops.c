@@ -15,7 +15,10 @@
  * generic path's (runtime/core/mb_kernels.h): one physics, two drivers.
  *
  * Frames and markers are arrays on the evaluation's stack, fr[] and mk[] (a
- * straight-line evaluation keeps the same values in named locals). */
+ * straight-line evaluation keeps the same values in named locals).  The
+ * elements without a loop form (flexible bodies and what sits on them,
+ * superelements: loop_choice) are left to emit.c, which writes them
+ * straight-line after the loops, reading fr[] and mk[] (a mixed model). */
 #include <stdlib.h>
 #include <string.h>
 
