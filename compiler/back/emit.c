@@ -832,24 +832,31 @@ static void emit_markers_of(emit_ctx *cx, FILE *f, const char *use, const char *
   }
 }
 
+/* the body of marker k, when looped, is read by the straight-line code */
+static void frame_read_through(const lmodel *L, const loop_choice *lc, int k, char *read) {
+  int b = L->marker[k].body;
+  if (b >= 0 && lc->body[b]) read[b] = 1;
+}
+
 /* a mixed loop form: the looped frames the straight-line elements read (the
  * bodies of their markers) as const locals f<b> from fr[] */
 static int emit_frame_bridges(FILE *f, const lmodel *L, const loop_choice *lc) {
   const mb_model *m = &L->m;
   char *read = calloc((size_t)m->nbody + 1, 1);
   if (!read) return -1;
-#define READS(k) do { int b_ = L->marker[k].body; if (b_ >= 0 && lc->body[b_]) read[b_] = 1; } while (0)
   for (int i = 0; i < m->nforce; i++) {
     const mb_forcedef *d = &L->force[i];
     if (lc->force[i]) continue;
-    READS(d->m0);
-    if (d->m1 >= 0) READS(d->m1);
+    frame_read_through(L, lc, d->m0, read);
+    if (d->m1 >= 0) frame_read_through(L, lc, d->m1, read);
     if (d->kind == MB_FORCE_SUPERELEMENT) /* its nodes 2.. follow marker m1 */
-      for (int j = 1; j < (int)L->force_prm[d->padr + MB_SUPER_N]; j++) READS(d->m1 + j);
+      for (int j = 1; j < (int)L->force_prm[d->padr + MB_SUPER_N]; j++) frame_read_through(L, lc, d->m1 + j, read);
   }
   for (int r = 0; r < m->nrow; r++)
-    if (!lc->row[r]) { READS(L->row[r].m0); READS(L->row[r].m1); }
-#undef READS
+    if (!lc->row[r]) {
+      frame_read_through(L, lc, L->row[r].m0, read);
+      frame_read_through(L, lc, L->row[r].m1, read);
+    }
   for (int b = 0; b < m->nbody; b++)
     if (read[b]) /* (void): a reader may need only the marker */
       fprintf(f, "  const mb_frame f%d = fr[%d]; (void)f%d; /* body '%s', looped */\n", b, b, b, L->body[b].name);
