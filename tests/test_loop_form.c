@@ -4,10 +4,15 @@
  * tables) at random states and times: every joint type, every driver
  * profile, springs (power and table laws), a bushing, a point force in body
  * axes with a time scale and a torque, a virtual body (fd_all), and a
- * hinged chain.  test_fd checks the straight-line form against the same
- * generic path and against finite differences; tests/test_loop_form.sh the
- * two forms' simulations of a 50-link chain against each other. */
-// models: fd_all+loops hinged_chain10_rigid+loops
+ * hinged chain.  Mixed models, whose elements without a loop form are
+ * written straight-line in the same evaluation: four tyres on a table road
+ * (tyre_cart: the tyres looped), a flexible rod between looped bodies
+ * (slider_crank_flexible), springs on flexible nodes (fd_node_twins), a
+ * superelement (tangent_forces), the flexible car (sports_car: flexible
+ * chassis, its tyres looped).  test_fd checks the straight-line form against
+ * the same generic path and against finite differences;
+ * tests/test_loop_form.sh the two forms' simulations against each other. */
+// models: fd_all+loops hinged_chain10_rigid+loops tyre_cart+loops slider_crank_flexible+loops fd_node_twins+loops tangent_forces+loops sports_car+loops
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,6 +20,11 @@
 #include "support.h"
 #include "fd_all.h"
 #include "hinged_chain10_rigid.h"
+#include "tyre_cart.h"
+#include "slider_crank_flexible.h"
+#include "fd_node_twins.h"
+#include "tangent_forces.h"
+#include "sports_car.h"
 
 typedef struct {
   double *Kx, *rhs, *phi, *nu;
@@ -34,13 +44,16 @@ static void outputs_free(outputs *o) {
   free(o->Kx); free(o->rhs); free(o->phi); free(o->nu); free(o->work);
 }
 
-/* rigid bodies anywhere in [-1, 1]^3, turned at random, moving at random */
+/* bodies anywhere in [-1, 1]^3, turned at random, moving at random; a
+ * flexible body's modal coordinates small (after its 7 frame coordinates) */
 static void scatter_state(const mb_model *m, double *q, double *v) {
   for (int b = 0; b < m->nbody; b++) {
     double *p = q + m->body[b].qadr, len = 0;
     for (int j = 0; j < 7; j++) p[j] = urand(-1, 1);
     for (int j = 3; j < 7; j++) len += p[j] * p[j];
     for (int j = 3; j < 7; j++) p[j] /= sqrt(len);
+    if (m->body[b].kind == MB_BODY_FLEXIBLE)
+      for (int j = 0; j < m->body[b].nm; j++) p[7 + j] = urand(-0.01, 0.01);
   }
   for (int j = 0; j < m->nv; j++) v[j] = urand(-2, 2);
 }
@@ -84,10 +97,35 @@ static void test_chain(void **state) {
   loop_form_equals_generic(&hinged_chain10_rigid_model);
 }
 
+static void test_mixed_tyres(void **state) {
+  (void)state;
+  loop_form_equals_generic(&tyre_cart_model);
+}
+
+static void test_mixed_flexible(void **state) {
+  (void)state;
+  loop_form_equals_generic(&slider_crank_flexible_model);
+  loop_form_equals_generic(&fd_node_twins_model);
+}
+
+static void test_mixed_superelement(void **state) {
+  (void)state;
+  loop_form_equals_generic(&tangent_forces_model);
+}
+
+static void test_mixed_car(void **state) {
+  (void)state;
+  loop_form_equals_generic(&sports_car_model);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_all_joints_and_forces),
       cmocka_unit_test(test_chain),
+      cmocka_unit_test(test_mixed_tyres),
+      cmocka_unit_test(test_mixed_flexible),
+      cmocka_unit_test(test_mixed_superelement),
+      cmocka_unit_test(test_mixed_car),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

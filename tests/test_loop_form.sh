@@ -12,6 +12,12 @@
 #     1e-6 J while its tip falls by more than 4 cm (free fall: 4.9 cm);
 #   - the loop form's C file compiles as C++11 (g++, clang++ when installed)
 #     and, in single precision, freestanding.
+# And a mixed model: a 40-link chain with a flexible beam (10 elements, 4
+# modes) hinged at its tip.  The rods and hinges are loops, the beam, its
+# hinge and its node markers straight-line in the same function; its
+# simulation equals the straight-line form's to 17 digits (1e-15 of each
+# column's range) and the generic path's to the integrator's tolerance, and
+# its C file compiles as C++11 and, in single precision, freestanding.
 # Environment: MBCC (set by tests/run_tests.sh; default build/mbcc).
 set -u
 cd "$(dirname "$0")/.."
@@ -62,4 +68,47 @@ grep -q "loop_joints" gen_float/chain50.c || err "the float model is not in the 
 cc -std=c11 -ffreestanding -fno-math-errno -Wall -Wextra -Wdouble-promotion -Wconversion -Werror -DMB_REAL_FLOAT \
   -I"$root/runtime/core" -Igen_float -c gen_float/chain50.c -o /dev/null || err "freestanding float build of the loop form"
 [ $fail = 0 ] && echo "50-link chain: loop form = straight-line to $d, = generic to $e; energy conserved; C++ and freestanding"
+
+# the mixed model: chain.sh's 40 rods, the beam after them, its hinge after theirs
+mkdir mixed mixed/straight mixed/generic && cd mixed
+bash "$root/scripts/chain.sh" 40 chain40flex | awk '
+  $0 == "joints:" { print "  beam:"
+    print "    type: flexible"
+    print "    line: {from: [20, 0, 0], to: [21, 0, 0], elements: 10}"
+    print "    section: {area: 0.0002, Iy: 6.666666666666668e-09, Iz: 1.666666666666667e-09, J: 4.577604166666668e-09}"
+    print "    material: {E: 70000000000.0, nu: 0.33, density: 2700.0}"
+    print "    reference: [0]"
+    print "    modes: {count: 4}"
+    print "    damping: none" }
+  $0 == "outputs:" { print "  hinge_beam: {type: revolute, bodies: [rod40, beam], node: 0, axis: [0, 0, 1]}" }
+  { print }
+  $0 == "outputs:" { print "  - {name: beam_tip, type: position, body: beam, node: 10}" }' > chain40flex.yaml
+cp chain40flex.yaml straight/ && cp chain40flex.yaml generic/
+runm() { "$MBCC" run chain40flex.yaml --end 0.1 --precision 17 --plot none -o out.csv "$@"; }
+runm > loop.log 2>&1 || err "run (mixed loop form): $(tail -5 loop.log)"
+g=generated/chain40flex
+grep -q "static const loop_body loop_bodies0\[40\]" "$g/chain40flex.c" || err "the mixed model's 40 rods are not one group"
+grep -q "the elements without a loop form, straight-line" "$g/chain40flex.c" || err "the mixed model is not in the mixed loop form"
+grep -q "mb_flex_forces(&flex40" "$g/chain40flex.c" || err "the mixed model's beam is not written straight-line"
+[ "$(grep -c '^void chain40flex_eval' "$g/chain40flex.c")" = 1 ] || err "the mixed loop form's evaluation is not one function"
+(cd straight && MBCC_LOOP_MIN=1000000000 runm > log 2>&1) || err "run (mixed, straight-line): $(tail -5 straight/log)"
+grep -q "loop_bodies" straight/$g/chain40flex*.c && err "MBCC_LOOP_MIN=1000000000 still wrote the mixed loop form"
+(cd generic && runm --path generic > log 2>&1) || err "run (mixed, generic): $(tail -5 generic/log)"
+dm=$(compare out.csv straight/out.csv) || err "mixed loop form against straight-line: $dm"
+awk -v d="$dm" 'BEGIN { exit !(d <= 1e-15) }' || err "mixed loop form against straight-line: largest relative difference $dm > 1e-15"
+em=$(compare out.csv generic/out.csv) || err "mixed loop form against generic: $em"
+awk -v d="$em" 'BEGIN { exit !(d <= 1e-6) }' || err "mixed loop form against the generic path: largest relative difference $em > 1e-6"
+# the beam's tip (columns 2-4) fell: the flexible body took part
+awk -F, 'NR == 2 { y0 = $3 } NR > 1 { y = $3 } END { if (!(y0 - y > 0.04)) { printf "beam tip fell %g m\n", y0 - y; exit 1 } }' out.csv ||
+  err "the mixed model's beam did not fall"
+for cxx in g++ clang++; do
+  command -v $cxx > /dev/null || continue
+  $cxx -x c++ -std=c++11 -fsyntax-only -Wall -Wextra -Werror -Wno-missing-field-initializers \
+    -I"$root/runtime/core" -I"$root/runtime/hosted" "$g/chain40flex.c" > cxx.log 2>&1 || err "$cxx rejects the mixed loop form: $(head -5 cxx.log)"
+done
+MBCC_LOOP_MIN=0 "$MBCC" compile chain40flex.yaml --real float -o gen_float > /dev/null || err "compile --real float (mixed)"
+grep -q "the elements without a loop form" gen_float/chain40flex.c || err "the float mixed model is not in the mixed loop form"
+cc -std=c11 -ffreestanding -fno-math-errno -Wall -Wextra -Wdouble-promotion -Wconversion -Werror -DMB_REAL_FLOAT \
+  -I"$root/runtime/core" -Igen_float -c gen_float/chain40flex.c -o /dev/null || err "freestanding float build of the mixed loop form"
+[ $fail = 0 ] && echo "40-link chain + flexible beam: mixed loop form = straight-line to $dm, = generic to $em; C++ and freestanding"
 exit $fail

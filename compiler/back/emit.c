@@ -793,7 +793,7 @@ static void mark_reader(char *use, char *springs_only, int *first, int k, char u
 /* the markers whose first reader is `reader`, at the top level of the
    evaluation (later readers in other parts of the split find them there) */
 static void emit_markers_of(emit_ctx *cx, FILE *f, const char *use, const char *springs_only, const int *first,
-                            char *computed, int reader) {
+                            char *computed, int reader, const loop_choice *lc) {
   const lmodel *L = cx->L;
   for (int k = 0; k < L->m.nmarker; k++) {
     if (first[k] != reader) continue;
@@ -801,6 +801,10 @@ static void emit_markers_of(emit_ctx *cx, FILE *f, const char *use, const char *
     fprintf(f, "  /* %s */\n", L->marker_desc[k]);
     if (use[k] == 1 && d->body >= 0 && emit_marker_is_frame(L, k)) {
       fprintf(f, "  /* the frame of body '%s' itself: the rows read f%d */\n", L->body[d->body].name, d->body);
+      continue;
+    }
+    if (lc && lc->marker[k]) { /* a mixed loop form's marker: the loops computed it */
+      fprintf(f, "  const mb_marker k%d = mk[%d]; /* looped */\n", k, k);
       continue;
     }
     int twin = emit_marker_node_twin(L, k, computed);
@@ -828,37 +832,59 @@ static void emit_markers_of(emit_ctx *cx, FILE *f, const char *use, const char *
   }
 }
 
-static void emit_eval(emit_ctx *cx, emit_files *EF) {
-  FILE *out = cx->f;
-  eval_split sp;
-  if (eval_split_begin(&sp)) { cx->failed = 1; return; }
-  FILE *f = sp.body;
-  const lmodel *L = cx->L;
-  const char *nm = cx->nm;
+/* the body of marker k, when looped, is read by the straight-line code */
+static void frame_read_through(const lmodel *L, const loop_choice *lc, int k, char *read) {
+  int b = L->marker[k].body;
+  if (b >= 0 && lc->body[b]) read[b] = 1;
+}
+
+/* a mixed loop form: the looped frames the straight-line elements read (the
+ * bodies of their markers) as const locals f<b> from fr[] */
+static int emit_frame_bridges(FILE *f, const lmodel *L, const loop_choice *lc) {
   const mb_model *m = &L->m;
-  char head[1024];
-  snprintf(head, sizeof head,
-          "\n/* Fill the varying entries of K, rhs = [f; gamma], phi and phid = D v - nu at (t, q, v). */\n"
-          "void %s_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,\n"
-          "    mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *phid, void *work) {\n"
-          "  static const mb_real zero3[3] = {0, 0, 0};\n"
-          "  mb_row r;\n  mb_real c[6 + MB_MAX_MODES], x[3];\n"
-          "  (void)m; (void)work; (void)t; (void)x; (void)c; (void)r; (void)zero3;\n"
-          "  (void)Kx; (void)phi; (void)phid;\n",
-          nm);
-  if (emit_loops_chosen(L)) { /* identical elements as loops over tables: one function */
-    if (emit_loops_eval(out, f, L)) cx->failed = 1;
-    if (eval_split_finish(&sp, out, nm, head, NULL) < 0) cx->failed = 1;
-    return;
+  char *read = calloc((size_t)m->nbody + 1, 1);
+  if (!read) return -1;
+  for (int i = 0; i < m->nforce; i++) {
+    const mb_forcedef *d = &L->force[i];
+    if (lc->force[i]) continue;
+    frame_read_through(L, lc, d->m0, read);
+    if (d->m1 >= 0) frame_read_through(L, lc, d->m1, read);
+    if (d->kind == MB_FORCE_SUPERELEMENT) /* its nodes 2.. follow marker m1 */
+      for (int j = 1; j < (int)L->force_prm[d->padr + MB_SUPER_N]; j++) frame_read_through(L, lc, d->m1 + j, read);
   }
-  eval_split_mark(&sp, "the body frames");
+  for (int r = 0; r < m->nrow; r++)
+    if (!lc->row[r]) {
+      frame_read_through(L, lc, L->row[r].m0, read);
+      frame_read_through(L, lc, L->row[r].m1, read);
+    }
+  for (int b = 0; b < m->nbody; b++)
+    if (read[b]) /* (void): a reader may need only the marker */
+      fprintf(f, "  const mb_frame f%d = fr[%d]; (void)f%d; /* body '%s', looped */\n", b, b, b, L->body[b].name);
+  free(read);
+  return 0;
+}
+
+/* the straight-line evaluation of the elements into sp: all of them (lc
+ * NULL) or, in a mixed loop form, those lc does not loop; 0, or -1 out of
+ * memory */
+static int emit_eval_straight(emit_ctx *cx, eval_split *sp, const loop_choice *lc) {
+  FILE *f = sp->body;
+  const lmodel *L = cx->L;
+  const mb_model *m = &L->m;
+  /* the elements written here (a section's heading only when it has some) */
+  int nbody = 0, nforce = 0, nrow = 0;
+  for (int b = 0; b < m->nbody; b++) nbody += !lc || !lc->body[b];
+  for (int i = 0; i < m->nforce; i++) nforce += !lc || !lc->force[i];
+  for (int r = 0; r < m->nrow; r++) nrow += !lc || !lc->row[r];
+  eval_split_mark(sp, "the body frames");
   /* frames and markers are separate variables, not arrays: the C compiler
      then drops the fields no row reads and keeps the rest compact, where an
      array of markers had to live whole in the stack frame (about a kilobyte
      more of L1 per evaluation on the flexible slider-crank) */
-  fprintf(f, "\n  /* body frames */\n");
+  if (nbody) fprintf(f, "\n  /* body frames */\n");
   for (int b = 0; b < m->nbody; b++) {
-    if (b) eval_split_mark(&sp, "the frame of body '%s'", L->body[b].name);
+    if (lc && lc->body[b]) continue;
+    if (b) eval_split_mark(sp, "the frame of body '%s'", L->body[b].name);
     fprintf(f, "  mb_frame f%d;\n  mb_frame_rigid(q + %d, v + %d, &f%d); /* body '%s' */\n", b,
             L->body[b].qadr, L->body[b].vadr, b, L->body[b].name);
   }
@@ -878,12 +904,11 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
   int *first = malloc(sizeof *first * (size_t)(m->nmarker ? m->nmarker : 1));
   if (!use || !computed || !springs_only || !first) {
     free(use), free(computed), free(springs_only), free(first);
-    cx->failed = 1;
-    eval_split_finish(&sp, NULL, nm, head, NULL);
-    return;
+    return -1;
   }
   for (int k = 0; k < m->nmarker; k++) first[k] = nreader, springs_only[k] = 1;
   for (int i = 0; i < m->nforce; i++) {
+    if (lc && lc->force[i]) continue;
     int spring = L->force[i].kind == MB_FORCE_SPRING;
     mark_reader(use, springs_only, first, L->force[i].m0, 2, i, spring);
     if (L->force[i].m1 >= 0) mark_reader(use, springs_only, first, L->force[i].m1, 2, i, spring);
@@ -892,15 +917,17 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
         mark_reader(use, springs_only, first, L->force[i].m1 + j, 2, i, 0);
   }
   for (int r = 0; r < m->nrow; r++) {
+    if (lc && lc->row[r]) continue;
     char u = emit_row_is_special(&L->row[r]) ? 1 : 2;
     mark_reader(use, springs_only, first, L->row[r].m0, u, m->nforce + r, 0);
     mark_reader(use, springs_only, first, L->row[r].m1, u, m->nforce + r, 0);
   }
-  eval_split_mark(&sp, "the body forces");
-  fprintf(f, "\n  /* body forces: gravity and the quadratic-velocity (gyroscopic) terms */\n");
+  eval_split_mark(sp, "the body forces");
+  if (nbody) fprintf(f, "\n  /* body forces: gravity and the quadratic-velocity (gyroscopic) terms */\n");
   for (int b = 0; b < m->nbody; b++) {
     const mb_body *B = &L->body[b];
-    if (b) eval_split_mark(&sp, "the forces of body '%s'", B->name);
+    if (lc && lc->body[b]) continue;
+    if (b) eval_split_mark(sp, "the forces of body '%s'", B->name);
     fprintf(f, "  /* body '%s' */\n", B->name);
     if (B->kind == MB_BODY_FLEXIBLE) {
       int nbk = 6 + B->nm;
@@ -945,29 +972,31 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
       fprintf(f, ", f%d.wl, rhs + %d);\n", b, B->vadr + 3);
     }
   }
-  if (m->nforce) eval_split_mark(&sp, "the force elements");
-  if (m->nforce) fprintf(f, "\n  /* force elements */\n");
+  if (nforce) eval_split_mark(sp, "the force elements");
+  if (nforce) fprintf(f, "\n  /* force elements */\n");
   for (int k = 0; k < m->nforce; k++) {
     const ir_force *F = &L->ir->forces[L->force_ir[k]];
-    if (k) eval_split_mark(&sp, "force '%s'", F->name);
-    emit_markers_of(cx, f, use, springs_only, first, computed, k);
+    if (lc && lc->force[k]) continue;
+    if (k) eval_split_mark(sp, "force '%s'", F->name);
+    emit_markers_of(cx, f, use, springs_only, first, computed, k, lc);
     fprintf(f, "  { /* force '%s' (", F->name);
     loc_comment(f, L, F->loc);
     fputs(") */\n", f);
     if (force_element(F->kind)->emit_eval(f, L, k)) cx->failed = 1;
     fputs("  }\n", f);
   }
-  eval_split_mark(&sp, "the constraint rows");
-  fprintf(f, "\n  /* constraint rows: D in both triangles of K, gamma, phi, phid */\n");
+  eval_split_mark(sp, "the constraint rows");
+  if (nrow || !lc) fprintf(f, "\n  /* constraint rows: D in both triangles of K, gamma, phi, phid */\n");
   fflush(f);
   long shared_from = ftell(f);
-  if (emit_rows_shared(f, L)) cx->failed = 1;
+  if (emit_rows_shared(f, L, lc ? lc->row : NULL)) cx->failed = 1;
   /* its blocks, one per pair of bodies, are independent (emit_rows.c) */
-  eval_split_mark_lines(&sp, shared_from, "  /* relative rotation", "the relative rotations of a pair of bodies");
+  eval_split_mark_lines(sp, shared_from, "  /* relative rotation", "the relative rotations of a pair of bodies");
   for (int r = 0; r < m->nrow; r++) {
     const mb_rowdef *R = &L->row[r];
-    eval_split_mark(&sp, "row %d (%s)", r, L->row_desc[r]);
-    emit_markers_of(cx, f, use, springs_only, first, computed, m->nforce + r);
+    if (lc && lc->row[r]) continue;
+    eval_split_mark(sp, "row %d (%s)", r, L->row_desc[r]);
+    emit_markers_of(cx, f, use, springs_only, first, computed, m->nforce + r, lc);
     fprintf(f, "  /* row %d: %s (", r, L->row_desc[r]);
     loc_comment(f, L, L->row_loc[r]);
     fputs(") */\n", f);
@@ -1008,6 +1037,42 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
   free(computed);
   free(springs_only);
   free(first);
+  return 0;
+}
+
+static void emit_eval(emit_ctx *cx, emit_files *EF) {
+  FILE *out = cx->f;
+  eval_split sp;
+  if (eval_split_begin(&sp)) { cx->failed = 1; return; }
+  FILE *f = sp.body;
+  const lmodel *L = cx->L;
+  const char *nm = cx->nm;
+  char head[1024];
+  snprintf(head, sizeof head,
+          "\n/* Fill the varying entries of K, rhs = [f; gamma], phi and phid = D v - nu at (t, q, v). */\n"
+          "void %s_eval(const mb_model *m, mb_real t, const mb_real *q, const mb_real *v,\n"
+          "    mb_real *Kx, mb_real *rhs, mb_real *phi, mb_real *phid, void *work) {\n"
+          "  static const mb_real zero3[3] = {0, 0, 0};\n"
+          "  mb_row r;\n  mb_real c[6 + MB_MAX_MODES], x[3];\n"
+          "  (void)m; (void)work; (void)t; (void)x; (void)c; (void)r; (void)zero3;\n"
+          "  (void)Kx; (void)phi; (void)phid;\n",
+          nm);
+  loop_choice lc;
+  int looped = emit_loops_choose(L, &lc);
+  if (looped < 0) cx->failed = 1;
+  if (looped > 0) { /* identical elements as loops over tables: one function */
+    if (emit_loops_eval(out, f, L, &lc)) cx->failed = 1;
+    if (lc.mixed) { /* the elements without a loop form follow, straight-line */
+      sp.one_function = 1;
+      fputs("\n  /* the elements without a loop form, straight-line (emit.c); the looped frames and\n"
+            "     markers they read, from fr[] and mk[] */\n", f);
+      if (emit_frame_bridges(f, L, &lc) || emit_eval_straight(cx, &sp, &lc)) cx->failed = 1;
+    }
+    loop_choice_free(&lc);
+    if (eval_split_finish(&sp, out, nm, head, NULL) < 0) cx->failed = 1;
+    return;
+  }
+  if (emit_eval_straight(cx, &sp, NULL)) cx->failed = 1;
   if (eval_split_finish(&sp, out, nm, head, emit_files_eval_hooks(EF)) < 0) cx->failed = 1;
 }
 
@@ -1044,9 +1109,18 @@ static void add_init_mark(FILE *f, char *const *text, init_mark *mark, int *nmar
 static void emit_init_body(emit_ctx *cx, FILE *f, init_mark *mark, int *nmark, char **text) {
   const lmodel *L = cx->L;
   const mb_model *m = &L->m;
-  if (emit_loops_chosen(L)) { emit_loops_init(f, L); return; } /* loops over the tables: no marks */
+  loop_choice lc;
+  int looped = emit_loops_choose(L, &lc);
+  if (looped < 0) cx->failed = 1;
+  if (looped > 0) { /* loops over the tables (no marks); a mixed form's flexible bodies below */
+    int mixed = lc.mixed;
+    loop_choice_free(&lc);
+    emit_loops_init(f, L);
+    if (!mixed) return;
+  }
   for (int b = 0; b < m->nbody; b++) {
     const mb_body *B = &L->body[b];
+    if (looped > 0 && B->kind != MB_BODY_FLEXIBLE) continue;
     add_init_mark(f, text, mark, nmark);
     if (B->kind == MB_BODY_FLEXIBLE) {
       /* the constant entries of the mass block: computed by the kernel at rest */
@@ -1072,6 +1146,7 @@ static void emit_init_body(emit_ctx *cx, FILE *f, init_mark *mark, int *nmark, c
         fputs(";\n", f);
       }
   }
+  if (looped > 0) { fflush(f); return; } /* the rows' constant entries: in emit_loops_init's loop */
   for (int r = 0; r < m->nrow; r++) {
     const mb_rowdef *R = &L->row[r];
     add_init_mark(f, text, mark, nmark);

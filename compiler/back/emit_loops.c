@@ -15,7 +15,10 @@
  * generic path's (runtime/core/mb_kernels.h): one physics, two drivers.
  *
  * Frames and markers are arrays on the evaluation's stack, fr[] and mk[] (a
- * straight-line evaluation keeps the same values in named locals). */
+ * straight-line evaluation keeps the same values in named locals).  The
+ * elements without a loop form (flexible bodies and what sits on them,
+ * superelements: loop_choice) are left to emit.c, which writes them
+ * straight-line after the loops, reading fr[] and mk[] (a mixed model). */
 #include <stdlib.h>
 #include <string.h>
 
@@ -99,16 +102,16 @@ static int same_block(const lmodel *L, const row_block *x, const row_block *y) {
   return 1;
 }
 
-/* the force kinds with a loop form: those whose markers are on rigid bodies
- * and whose kernel reads everything from the pools (the tyre's road and the
- * superelement's nodes are not) */
+/* the force kinds with a loop form: those whose kernel reads everything
+ * from the pools (the tyre's road too: force_tyre.c copies it there) and two
+ * markers at most (the superelement's nodes are a list) */
 static int force_has_loop(const mb_forcedef *d) {
   switch (d->kind) {
   case MB_FORCE_POINT:
   case MB_FORCE_TORQUE:
   case MB_FORCE_SPRING:
-  case MB_FORCE_FIELD: return 1;
-  case MB_FORCE_TYRE:
+  case MB_FORCE_FIELD:
+  case MB_FORCE_TYRE: return 1;
   case MB_FORCE_SUPERELEMENT: return 0;
   }
   return 0;
@@ -121,23 +124,55 @@ static int same_force(const lmodel *L, const mb_forcedef *x, const mb_forcedef *
   return 1;
 }
 
-/* every element has a loop form */
-static int loop_form_exists(const lmodel *L) {
-  const mb_model *m = &L->m;
-  if (m->nbody < 1 || m->nmarker < 1) return 0;
-  for (int i = 0; i < m->nforce; i++)
-    if (!force_has_loop(&L->force[i])) return 0;
-  for (int b = 0; b < m->nbody; b++)
-    if (L->body[b].kind == MB_BODY_FLEXIBLE) return 0;
-  for (int k = 0; k < m->nmarker; k++)
-    if (L->marker[k].node >= 0) return 0;
-  for (int r = 0; r < m->nrow; r++)
-    if (L->row[r].mslot[0] >= 0 || L->row[r].mslot[1] >= 0) return 0;
-  return 1;
+/* a marker with a loop form: on the ground or a rigid (or virtual) body's
+ * frame, not on a flexible body */
+static int marker_has_loop(const lmodel *L, int k) {
+  const mb_markerdef *d = &L->marker[k];
+  return d->node < 0 && (d->body < 0 || L->body[d->body].kind != MB_BODY_FLEXIBLE);
 }
 
-/* the groups of L; 0, or -1 out of memory */
-static int plan_groups(const lmodel *L, loop_plan *p) {
+void loop_choice_free(loop_choice *c) {
+  free(c->body);
+  free(c->marker);
+  free(c->force);
+  free(c->row);
+  memset(c, 0, sizeof *c);
+}
+
+/* which elements have a loop form (c->mixed: not all); 0, or -1 out of memory */
+static int mark_loopable(const lmodel *L, loop_choice *c) {
+  const mb_model *m = &L->m;
+  memset(c, 0, sizeof *c);
+  c->body = calloc((size_t)m->nbody + 1, 1);
+  c->marker = calloc((size_t)m->nmarker + 1, 1);
+  c->force = calloc((size_t)m->nforce + 1, 1);
+  c->row = calloc((size_t)m->nrow + 1, 1);
+  if (!c->body || !c->marker || !c->force || !c->row) { loop_choice_free(c); return -1; }
+  for (int b = 0; b < m->nbody; b++) c->body[b] = L->body[b].kind != MB_BODY_FLEXIBLE;
+  for (int k = 0; k < m->nmarker; k++) c->marker[k] = (unsigned char)marker_has_loop(L, k);
+  for (int i = 0; i < m->nforce; i++) {
+    const mb_forcedef *d = &L->force[i];
+    c->force[i] = force_has_loop(d) && c->marker[d->m0] && (d->m1 < 0 || c->marker[d->m1]);
+  }
+  /* a joint (its block of rows) has one when every row does: no modal columns */
+  for (int r = 0; r < m->nrow;) {
+    int n = 0, all = 1;
+    for (; r + n < m->nrow && L->row[r + n].m0 == L->row[r].m0 && L->row[r + n].m1 == L->row[r].m1; n++)
+      all &= L->row[r + n].mslot[0] < 0 && L->row[r + n].mslot[1] < 0;
+    all &= c->marker[L->row[r].m0] && c->marker[L->row[r].m1];
+    for (int i = 0; i < n; i++) c->row[r + i] = (unsigned char)all;
+    r += n;
+  }
+  for (int b = 0; b < m->nbody; b++) c->mixed |= !c->body[b];
+  for (int k = 0; k < m->nmarker; k++) c->mixed |= !c->marker[k];
+  for (int i = 0; i < m->nforce; i++) c->mixed |= !c->force[i];
+  for (int r = 0; r < m->nrow; r++) c->mixed |= !c->row[r];
+  return 0;
+}
+
+/* the groups of the elements of L that c loops (the others: group -1); 0,
+ * or -1 out of memory */
+static int plan_groups(const lmodel *L, const loop_choice *c, loop_plan *p) {
   const mb_model *m = &L->m;
   memset(p, 0, sizeof *p);
   p->body_group = malloc(sizeof *p->body_group * (size_t)m->nbody);
@@ -155,6 +190,8 @@ static int plan_groups(const lmodel *L, loop_plan *p) {
     return -1;
   }
   for (int b = 0; b < m->nbody; b++) {
+    p->body_group[b] = -1;
+    if (!c->body[b]) continue;
     int g = 0;
     while (g < p->nbody_group && !same_body(&L->body[b], &L->body[p->body_first[g]])) g++;
     if (g == p->nbody_group) p->body_first[p->nbody_group++] = b;
@@ -168,14 +205,18 @@ static int plan_groups(const lmodel *L, loop_plan *p) {
     row_block *B = &p->block[p->nblock++];
     B->r0 = r;
     B->n = n;
+    B->group = -1;
+    r += n;
+    if (!c->row[B->r0]) continue;
     int g = 0;
     while (g < p->njoint_group && !same_block(L, B, &p->block[p->joint_first[g]])) g++;
     if (g == p->njoint_group) p->joint_first[p->njoint_group++] = p->nblock - 1;
     B->group = g;
     p->joint_count[g]++;
-    r += n;
   }
   for (int i = 0; i < m->nforce; i++) {
+    p->force_group[i] = -1;
+    if (!c->force[i]) continue;
     int g = 0;
     while (g < p->nforce_group && !same_force(L, &L->force[i], &L->force[p->force_first[g]])) g++;
     if (g == p->nforce_group) p->force_first[p->nforce_group++] = i;
@@ -191,12 +232,14 @@ static int plan_groups(const lmodel *L, loop_plan *p) {
   return 0;
 }
 
-int emit_loops_chosen(const lmodel *L) {
-  if (!loop_form_exists(L)) return 0;
+int emit_loops_choose(const lmodel *L, loop_choice *c) {
+  if (L->m.nbody < 1 || L->m.nmarker < 1) { memset(c, 0, sizeof *c); return 0; }
+  if (mark_loopable(L, c)) return -1;
   loop_plan p;
-  if (plan_groups(L, &p)) return 0; /* out of memory: the straight-line form */
-  int chosen = p.largest >= loop_min_group();
+  if (plan_groups(L, c, &p)) { loop_choice_free(c); return -1; }
+  int chosen = p.largest >= loop_min_group() && p.largest > 0;
   plan_free(&p);
+  if (!chosen) loop_choice_free(c);
   return chosen;
 }
 
@@ -246,15 +289,17 @@ static void write_bodies(FILE *t, FILE *f, const lmodel *L, const loop_plan *p) 
   }
 }
 
-static void write_markers(FILE *t, FILE *f, const lmodel *L) {
+static void write_markers(FILE *t, FILE *f, const lmodel *L, const loop_choice *c) {
   const mb_model *m = &L->m;
-  int nground = 0;
-  for (int k = 0; k < m->nmarker; k++) nground += L->marker[k].body < 0;
-  int nrigid = m->nmarker - nground;
+  int nground = 0, nrigid = 0;
+  for (int k = 0; k < m->nmarker; k++) {
+    nground += c->marker[k] && L->marker[k].body < 0;
+    nrigid += c->marker[k] && L->marker[k].body >= 0;
+  }
   if (nground) {
     fprintf(t, "/* the loop form's markers on the ground */\nstatic const int loop_ground_markers[%d] = {", nground);
     for (int k = 0, i = 0; k < m->nmarker; k++)
-      if (L->marker[k].body < 0) {
+      if (c->marker[k] && L->marker[k].body < 0) {
         fprintf(t, "%s%s%d", i ? "," : "", i % 16 == 0 ? "\n  " : " ", k);
         i++;
       }
@@ -269,7 +314,7 @@ static void write_markers(FILE *t, FILE *f, const lmodel *L) {
                "typedef struct {\n  int marker, body;\n} loop_marker;\n"
                "static const loop_marker loop_markers[%d] = {\n", nrigid);
     for (int k = 0; k < m->nmarker; k++)
-      if (L->marker[k].body >= 0) fprintf(t, "  {.marker = %d, .body = %d},\n", k, L->marker[k].body);
+      if (c->marker[k] && L->marker[k].body >= 0) fprintf(t, "  {.marker = %d, .body = %d},\n", k, L->marker[k].body);
     fputs("};\n", t);
     fprintf(f, "  /* %d markers on rigid bodies (their offsets and axes: markers[]) */\n"
                "  for (int e = 0; e < %d; e++) {\n    const loop_marker *M = &loop_markers[e];\n"
@@ -330,7 +375,11 @@ static void write_forces(FILE *t, FILE *f, const lmodel *L, const loop_plan *p) 
         add_wrench(f, 0, "mk[E->m1].P", "mF", "mT"); /* the reaction at the same point */
       }
       break;
-    case MB_FORCE_TYRE:
+    case MB_FORCE_TYRE: /* one marker, the wheel centre: force and torque on the wheel */
+      if (ground0) { fputs("    (void)E; /* on the ground: no effect */\n  }\n", f); continue; }
+      fputs("    mb_real Fv[3], Tv[3];\n    mb_tyre(&mk[E->m0], force_prm + E->padr, Fv, Tv, 0, 0);\n", f);
+      add_wrench(f, 0, "mk[E->m0].P", "Fv", "Tv");
+      break;
     case MB_FORCE_SUPERELEMENT: break; /* no loop form (force_has_loop) */
     }
     fputs("  }\n", f);
@@ -425,15 +474,15 @@ static int write_joints(FILE *t, FILE *f, const lmodel *L, const loop_plan *p) {
   return 0;
 }
 
-int emit_loops_eval(FILE *tables, FILE *body, const lmodel *L) {
+int emit_loops_eval(FILE *tables, FILE *body, const lmodel *L, const loop_choice *c) {
   loop_plan p;
-  if (plan_groups(L, &p)) return -1;
+  if (plan_groups(L, c, &p)) return -1;
   const mb_model *m = &L->m;
   fprintf(body, "\n  /* the loop form (emit_loops.c): frames and markers in arrays */\n"
                 "  mb_frame fr[%d];\n  mb_marker mk[%d];\n",
           m->nbody, m->nmarker);
   write_bodies(tables, body, L, &p);
-  write_markers(tables, body, L);
+  write_markers(tables, body, L, c);
   write_forces(tables, body, L, &p);
   int failed = write_joints(tables, body, L, &p);
   plan_free(&p);

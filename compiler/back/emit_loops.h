@@ -19,16 +19,28 @@
  * tests: 0 takes the loop form whenever the model has one) */
 int loop_min_group(void);
 
-/* 1 when the evaluation of L is written in the loop form: every element has
- * a loop form (rigid bodies, their markers and the ground's, constraint rows
- * of rigid bodies, no force elements) and its largest group has at least
- * loop_min_group() members */
-int emit_loops_chosen(const lmodel *L);
+/* The elements the loop form writes (1) and those it leaves to the
+ * straight-line code (0): a flexible body, a marker on one, a force element
+ * without a loop form (a superelement) or on such a marker, a joint with a
+ * row on such a marker.  Frames and markers of the looped elements are in
+ * the arrays fr[] and mk[]; the straight-line code reads the ones it needs
+ * from there (emit.c). */
+typedef struct {
+  unsigned char *body, *marker, *force, *row;
+  int mixed; /* some element is written straight-line */
+} loop_choice;
 
-/* the loop form: the groups' tables to 'tables' (file scope, before the
- * evaluation), the evaluation's body (its loops) to 'body'.  0, or -1 out
- * of memory. */
-int emit_loops_eval(FILE *tables, FILE *body, const lmodel *L);
+/* 1 when the evaluation of L takes the loop form: the largest group of its
+ * elements that have one has at least loop_min_group() members (c says
+ * which; loop_choice_free releases it); 0: straight-line as a whole (c
+ * empty); -1 out of memory */
+int emit_loops_choose(const lmodel *L, loop_choice *c);
+void loop_choice_free(loop_choice *c);
+
+/* the loop form of the elements c loops: the groups' tables to 'tables'
+ * (file scope, before the evaluation), the evaluation's body (its loops) to
+ * 'body'.  0, or -1 out of memory. */
+int emit_loops_eval(FILE *tables, FILE *body, const lmodel *L, const loop_choice *c);
 
 /* init's statements after K is zeroed, when the evaluation is in the loop
  * form: the mass blocks and the rows' constant entries as loops over the

@@ -579,7 +579,7 @@ static int frame_pair_cmp(const void *x, const void *y) {
   return a->r < b->r ? -1 : a->r > b->r;
 }
 
-int emit_rows_shared(FILE *f, const lmodel *L) {
+int emit_rows_shared(FILE *f, const lmodel *L, const unsigned char *skip) {
   const mb_model *m = &L->m;
   /* the rows grouped by pair, pairs in (b0, b1) order: one pass and a sort,
      not a pass over the rows for every pair of bodies (cubic in a chain) */
@@ -588,6 +588,7 @@ int emit_rows_shared(FILE *f, const lmodel *L) {
   if (!pr) return -1; /* the caller reports it (no exit in library code) */
   for (int r = 0; r < m->nrow; r++) {
     int x0, x1;
+    if (skip && skip[r]) continue;
     if (dot1_frames(L, r, &x0, &x1)) pr[npr++] = (frame_pair_row){x0, x1, r};
   }
   qsort(pr, (size_t)npr, sizeof *pr, frame_pair_cmp);

@@ -20,9 +20,10 @@ int emit_marker_point_velocity(FILE *f, const lmodel *L, int k);
  * s = 0, C = I): the rows of emit_row_special read the frame, not the marker */
 int emit_marker_is_frame(const lmodel *L, int k);
 /* the values shared by the dot-1 rows between two bodies' own axes (entries
- * of their relative rotation, |w0 - w1|^2), as locals before the rows; -1 out
- * of memory (the caller discards the output) */
-int emit_rows_shared(FILE *f, const lmodel *L);
+ * of their relative rotation, |w0 - w1|^2), as locals before the rows, for
+ * the rows r with no skip[r] (skip NULL: all; a mixed loop form skips the
+ * looped rows); -1 out of memory (the caller discards the output) */
+int emit_rows_shared(FILE *f, const lmodel *L, const unsigned char *skip);
 /* 1 if emit_row_special writes row R (spherical and dot-1 rows): it reads
  * its markers' fields (or their frames), never a marker's address */
 int emit_row_is_special(const mb_rowdef *R);

@@ -98,7 +98,7 @@ static int room_for_mark(eval_split *s) {
 }
 
 void eval_split_mark(eval_split *s, const char *fmt, ...) {
-  if (s->failed) return;
+  if (s->failed || s->one_function) return;
   if (room_for_mark(s)) return;
   char buf[256];
   va_list ap;
@@ -115,7 +115,7 @@ void eval_split_mark(eval_split *s, const char *fmt, ...) {
 }
 
 void eval_split_mark_lines(eval_split *s, long from, const char *prefix, const char *label) {
-  if (s->failed || fflush(s->body)) return;
+  if (s->failed || s->one_function || fflush(s->body)) return;
   size_t n = strlen(prefix);
   long end = ftell(s->body);
   /* the stream's buffer is valid after fflush, up to ftell */

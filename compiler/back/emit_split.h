@@ -17,6 +17,8 @@ typedef struct {
   char **label; /* what starts there (a comment text) */
   int nmark, cap;
   int failed;
+  int one_function; /* marks are ignored: the body stays one function (a mixed
+                       loop form's arrays fr[] and mk[] cross any cut) */
 } eval_split;
 
 /* open the body stream; 0, or -1 out of memory */
