@@ -329,6 +329,25 @@ done
 # the step's instruction counts: measured apart (cachegrind), not by this script
 cat <<'EOF'
 
+**Where the flexible step stands, and why 10× is out of reach here.** The
+simulators are now built for the machine (`-march=native`: straight-line code
+a quarter smaller, docs/architecture.md "Compiled for the machine") and the
+flexible car's LDLᵀ forms its last 32 rows as a dense block (the chassis's
+16 unknowns and the loop rows: "The dense tail").  Measured apart, the two
+simulators run in turn four times (`mbcc bench --scene flexible --end 0.5`,
+generated + LDLᵀ per step): 180–275 µs portable, 141–182 µs native; 134–144 µs
+native without the dense tail, 120–126 µs with it.  Where the step goes now
+(`perf record` of the bench, 20 kHz): the LDLᵀ factor 33 % (its straight-line
+rows 16 %, the dense tail 18 %), the solves 16 %, the evaluation 37 % (the
+straight-line parts 20 %, the chassis's invariant contraction 4 %, node
+markers 5 %, tyres 3 %, springs 2 %), outputs, integrator and the rest 14 %.
+The generic path's step is 0.73–0.80 ms, so 10× asks for at most about 75 µs:
+less than the evaluations alone take in 10 calls a step (about 45 µs) plus
+8 factorizations of 30 862 flops.  The aim would need a step with fewer
+evaluations and factorizations (both paths share the integrator, so that
+moves both) or an evaluation several times cheaper; dense LU (LAPACK, 2.7 M
+flops a factorization) stays about 50× slower.
+
 ### Where a step goes (instruction counts)
 
 Cachegrind on `mbcc bench --end 0.5 --reps 1 --paths P` (502, 521 and 517

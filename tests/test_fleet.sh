@@ -18,7 +18,10 @@
 #      not reached in 0.05 s (checked), so both roads are flat under the cars;
 #   3. models/sports_car/rigid_chassis.modal.yaml is what scripts/rigid_chassis.sh
 #      writes from the FE model now;
-#   4. fleet.sh refuses N that is not a whole number from 1 to 500 (exit 2).
+#   4. fleet.sh refuses N that is not a whole number from 1 to 500 (exit 2);
+#   5. a fleet of 30 cars (510 bodies, 210 subsystem instances: each one a file
+#      of the diagnostics' table) is read whole, its counts 30 times the single
+#      car's; a model file of 2^20 lines gets the reader's line limit (exit 2).
 # Generic path (no C compile): a few seconds.
 set -u
 cd "$(dirname "$0")/.."
@@ -89,5 +92,16 @@ for n in 0 -1 1.5 abc '' 007 501 99999999999999999999; do
   [ "$rc" = 2 ] && grep -q 'error' out.err || err "fleet.sh '$n': exit $rc (expected 2 with an error): $(cat out.err)"
 done
 bash "$root/scripts/fleet.sh" > /dev/null 2>&1; [ $? = 2 ] || err "fleet.sh without N: not exit 2"
+
+# 5. many instances; the line limit that keeps file:line:col exact
+bash "$root/scripts/fleet.sh" 30 > fleet30.yaml || err "scripts/fleet.sh 30 failed"
+thirty=$(counts fleet30.yaml | awk '{ $1 = $1; print }')
+times30=$(echo "$one" | awk '{ for (i = 1; i <= NF; i++) $i = 30 * $i; print }')
+[ "$thirty" = "$times30" ] || err "30-car fleet counts '$thirty', expected 30 x the single car's: '$times30'"
+{ head -c 1048576 /dev/zero | tr '\0' '\n'; cat fleet2.yaml; } > long.yaml
+"$MBCC" check long.yaml > long.out 2>&1
+rc=$?
+[ "$rc" = 2 ] && grep -q 'long.yaml: error: more than 1048575 lines' long.out ||
+  err "a model of 2^20 lines: exit $rc, expected 2 and the line limit: $(head -3 long.out)"
 
 exit $fail

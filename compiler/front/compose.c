@@ -214,6 +214,10 @@ static bool load_file(const char *path, ir_loc at, const char *at_file, int inst
   char *data = xcalloc((size_t)size + 1, 1);
   size_t got = fread(data, 1, (size_t)size, f);
   fclose(f);
+  if (!diag_check_lines(path, data, got)) {
+    free(data);
+    return false;
+  }
   size_t deep_at = 0;
   if (yaml_flow_depth(data, got, LIMIT_YAML_DEPTH, &deep_at) > LIMIT_YAML_DEPTH) {
     diag_error(path, (ir_loc){1, 1}, "brackets nested more than %d deep (the limit of the model reader)",

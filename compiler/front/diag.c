@@ -68,6 +68,14 @@ const char *diag_instance_prefix(int k) {
 
 int diag_instance_parent(int k) { return k >= 1 && k <= nregistered ? instance[k].parent : 0; }
 
+bool diag_check_lines(const char *path, const char *data, size_t size) {
+  size_t lines = 1;
+  for (size_t i = 0; i < size; i++) lines += data[i] == '\n';
+  if (lines < DIAG_FILE_LINES) return true;
+  diag_error(path, (ir_loc){0, 0}, "more than %d lines (the limit of the model reader)", DIAG_FILE_LINES - 1);
+  return false;
+}
+
 int diag_register_file(const char *path) {
   for (int k = 1; k <= nregistered; k++)
     if (instance[k].name == NULL && strcmp(registered[k], path) == 0) return k;

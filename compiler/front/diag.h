@@ -4,6 +4,7 @@
 #define MBCC_DIAG_H
 
 #include <stdarg.h>
+#include <stddef.h>
 
 #include "ir.h"
 
@@ -29,12 +30,15 @@ void diag_verror(const char *file, ir_loc loc, const char *fmt, va_list ap) DIAG
 void diag_vwarning(const char *file, ir_loc loc, const char *fmt, va_list ap) DIAG_PRINTF(3, 0);
 void diag_vnote(const char *file, ir_loc loc, const char *fmt, va_list ap) DIAG_PRINTF(3, 0);
 
-/* Elements of included files (include:) keep their file in the line number:
- * line = DIAG_FILE_LINES * k + line for the k-th registered file, so that an
- * ir_loc stays two ints.  A file is at most LIMIT_INPUT_BYTES long (fewer
- * lines than DIAG_FILE_LINES); up to DIAG_MAX_FILES files. */
-#define DIAG_FILE_LINES (1 << 24)
-#define DIAG_MAX_FILES 100
+/* Elements of included files (include:, subsystem instances) keep their file
+ * in the line number: line = DIAG_FILE_LINES * k + line for the k-th
+ * registered file, so that an ir_loc stays two ints.  Every file the reader
+ * reads has fewer lines than DIAG_FILE_LINES (diag_check_lines); up to
+ * DIAG_MAX_FILES files (k * DIAG_FILE_LINES stays below 2^31). */
+#define DIAG_FILE_LINES (1 << 20)
+#define DIAG_MAX_FILES 2000
+/* false (after an error at 'path') when data has DIAG_FILE_LINES lines or more */
+bool diag_check_lines(const char *path, const char *data, size_t size);
 /* the number k of 'path' (registered once; a copy is kept), or 0 when the
  * table is full */
 int diag_register_file(const char *path);

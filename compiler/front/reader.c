@@ -732,7 +732,8 @@ bool load_named_yaml(const char *path, yaml_document_t *doc, bool *unreadable) {
   if (data == NULL) return false;
   bool loaded = false;
   size_t deep_at = 0;
-  if (yaml_flow_depth(data, size, LIMIT_YAML_DEPTH, &deep_at) > LIMIT_YAML_DEPTH) {
+  if (!diag_check_lines(path, data, size)) {
+  } else if (yaml_flow_depth(data, size, LIMIT_YAML_DEPTH, &deep_at) > LIMIT_YAML_DEPTH) {
     diag_error(path, loc_of_offset(data, size, deep_at),
                "brackets nested more than %d deep (the limit of the model reader)", LIMIT_YAML_DEPTH);
   } else {
@@ -759,6 +760,10 @@ static ir_model *read_model(const char *path, const char *scene) {
                  "(MBCC_MAX_INPUT=BYTES lifts it)", max_input);
     else
       diag_error(path, nowhere, "cannot read the model: %s", strerror(errno));
+    return NULL;
+  }
+  if (!diag_check_lines(path, data, size)) {
+    free(data);
     return NULL;
   }
   size_t deep_at = 0;
