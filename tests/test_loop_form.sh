@@ -10,7 +10,12 @@
 #     generic path (--path generic) to the integrator's tolerance;
 #   - the loop form's run conserves the chain's total energy (no damping) to
 #     1e-6 J while its tip falls by more than 4 cm (free fall: 4.9 cm);
-#   - the loop form's C file compiles as C++11 (g++, clang++ when installed)
+#   - its LDL^T is straight-line: its parts are in files of their own
+#     (chain50_ldl.c, chain50_ldl<k>.c, listed in chain50.sources after
+#     chain50.c, no evaluation part files), compiled in parallel, and the
+#     simulation is byte-identical (--precision 17) to the model written as
+#     one file (MBCC_EVAL_FILE_BYTES=0);
+#   - the loop form's C files compile as C++11 (g++, clang++ when installed)
 #     and, in single precision, freestanding.
 # And a mixed model: a 40-link chain with a flexible beam (10 elements, 4
 # modes) hinged at its tip.  The rods and hinges are loops, the beam, its
@@ -24,9 +29,11 @@ cd "$(dirname "$0")/.."
 # shellcheck source=tests/shell_setup.sh
 . tests/shell_setup.sh
 bash "$root/scripts/chain.sh" 50 > chain50.yaml
-mkdir straight generic
-cp chain50.yaml straight/ && cp chain50.yaml generic/
+mkdir straight generic onefile
+cp chain50.yaml straight/ && cp chain50.yaml generic/ && cp chain50.yaml onefile/
 run() { "$MBCC" run chain50.yaml --end 0.1 --precision 17 --plot none -o out.csv "$@"; }
+# the C files of generated model DIR/NAME: those NAME.sources lists, or NAME.c
+sources() { if [ -f "$1/$2.sources" ]; then sed "s|^|$1/|" "$1/$2.sources"; else echo "$1/$2.c"; fi; }
 
 run > loop.log 2>&1 || err "run (loop form): $(tail -5 loop.log)"
 g=generated/chain50
@@ -34,6 +41,18 @@ grep -q "static const loop_joint1 loop_joints1\[49\]" "$g/chain50.c" || err "the
 grep -q "static const loop_body loop_bodies0\[50\]" "$g/chain50.c" || err "the 50 rods are not one group of the loop form"
 ls "$g"/chain50_eval*.c > /dev/null 2>&1 && err "the loop form's evaluation was split into part files: $(ls "$g")"
 [ "$(grep -c '^void chain50_eval' "$g/chain50.c")" = 1 ] || err "the loop form's evaluation is not one function"
+# its straight-line LDL^T in files of its own, the evaluation in chain50.c
+grep -q "straight-line code" "$g/chain50_ldl.c" 2> /dev/null || err "the loop form's straight-line LDL^T is not in chain50_ldl.c: $(ls "$g")"
+[ "$(head -2 "$g/chain50.sources" 2> /dev/null | tr '\n' ' ')" = "chain50.c chain50_ldl.c " ] ||
+  err "chain50.sources does not list chain50.c, then chain50_ldl.c: $(cat "$g/chain50.sources" 2> /dev/null)"
+grep -qx "chain50_ldl1.c" "$g/chain50.sources" 2> /dev/null || err "the LDL^T's parts are not in several files: $(ls "$g")"
+for f in $(cat "$g/chain50.sources" 2> /dev/null); do [ -s "$g/$f" ] || err "chain50.sources lists $f, which is missing"; done
+[ -e "$g/chain50_parts.h" ] && err "a loop-form model wrote the evaluation parts' header"
+grep -q "ldl_factor_part0(" "$g/chain50.c" && err "the LDL^T's parts are still in chain50.c"
+(cd onefile && MBCC_EVAL_FILE_BYTES=0 run > log 2>&1) || err "run (one file): $(tail -5 onefile/log)"
+[ -e onefile/$g/chain50.sources ] && err "MBCC_EVAL_FILE_BYTES=0 still wrote several files: $(ls onefile/$g)"
+grep -q "ldl_factor_part0(" onefile/$g/chain50.c || err "the one-file loop form has no LDL^T parts in chain50.c"
+cmp -s out.csv onefile/out.csv || err "the LDL^T in files of its own changes the results: $(diff out.csv onefile/out.csv | head -4)"
 (cd straight && MBCC_LOOP_MIN=1000000000 run > log 2>&1) || err "run (straight-line): $(tail -5 straight/log)"
 grep -q "loop_joints" straight/$g/chain50*.c && err "MBCC_LOOP_MIN=1000000000 still wrote the loop form"
 [ -s straight/$g/chain50.sources ] || err "the straight-line 50-link chain is not in parts and files"
@@ -61,13 +80,15 @@ awk -F, 'NR == 2 { e0 = $NF } NR > 1 { d = $NF - e0; if (d < 0) d = -d; if (d > 
 for cxx in g++ clang++; do
   command -v $cxx > /dev/null || continue
   $cxx -x c++ -std=c++11 -fsyntax-only -Wall -Wextra -Werror -Wno-missing-field-initializers \
-    -I"$root/runtime/core" -I"$root/runtime/hosted" "$g/chain50.c" > cxx.log 2>&1 || err "$cxx rejects the loop form: $(head -5 cxx.log)"
+    -I"$root/runtime/core" -I"$root/runtime/hosted" $(sources "$g" chain50) > cxx.log 2>&1 || err "$cxx rejects the loop form: $(head -5 cxx.log)"
 done
 MBCC_LOOP_MIN=0 "$MBCC" compile chain50.yaml --real float -o gen_float > /dev/null || err "compile --real float"
 grep -q "loop_joints" gen_float/chain50.c || err "the float model is not in the loop form"
-cc -std=c11 -ffreestanding -fno-math-errno -Wall -Wextra -Wdouble-promotion -Wconversion -Werror -DMB_REAL_FLOAT \
-  -I"$root/runtime/core" -Igen_float -c gen_float/chain50.c -o /dev/null || err "freestanding float build of the loop form"
-[ $fail = 0 ] && echo "50-link chain: loop form = straight-line to $d, = generic to $e; energy conserved; C++ and freestanding"
+for f in $(sources gen_float chain50); do
+  cc -std=c11 -ffreestanding -fno-math-errno -Wall -Wextra -Wdouble-promotion -Wconversion -Werror -DMB_REAL_FLOAT \
+    -I"$root/runtime/core" -Igen_float -c "$f" -o /dev/null || err "freestanding float build of the loop form: $f"
+done
+[ $fail = 0 ] && echo "50-link chain: loop form = straight-line to $d, = generic to $e, = one file exactly; energy conserved; C++ and freestanding"
 
 # the mixed model: chain.sh's 40 rods, the beam after them, its hinge after theirs
 mkdir mixed mixed/straight mixed/generic && cd mixed
@@ -104,11 +125,13 @@ awk -F, 'NR == 2 { y0 = $3 } NR > 1 { y = $3 } END { if (!(y0 - y > 0.04)) { pri
 for cxx in g++ clang++; do
   command -v $cxx > /dev/null || continue
   $cxx -x c++ -std=c++11 -fsyntax-only -Wall -Wextra -Werror -Wno-missing-field-initializers \
-    -I"$root/runtime/core" -I"$root/runtime/hosted" "$g/chain40flex.c" > cxx.log 2>&1 || err "$cxx rejects the mixed loop form: $(head -5 cxx.log)"
+    -I"$root/runtime/core" -I"$root/runtime/hosted" $(sources "$g" chain40flex) > cxx.log 2>&1 || err "$cxx rejects the mixed loop form: $(head -5 cxx.log)"
 done
 MBCC_LOOP_MIN=0 "$MBCC" compile chain40flex.yaml --real float -o gen_float > /dev/null || err "compile --real float (mixed)"
 grep -q "the elements without a loop form" gen_float/chain40flex.c || err "the float mixed model is not in the mixed loop form"
-cc -std=c11 -ffreestanding -fno-math-errno -Wall -Wextra -Wdouble-promotion -Wconversion -Werror -DMB_REAL_FLOAT \
-  -I"$root/runtime/core" -Igen_float -c gen_float/chain40flex.c -o /dev/null || err "freestanding float build of the mixed loop form"
+for f in $(sources gen_float chain40flex); do
+  cc -std=c11 -ffreestanding -fno-math-errno -Wall -Wextra -Wdouble-promotion -Wconversion -Werror -DMB_REAL_FLOAT \
+    -I"$root/runtime/core" -Igen_float -c "$f" -o /dev/null || err "freestanding float build of the mixed loop form: $f"
+done
 [ $fail = 0 ] && echo "40-link chain + flexible beam: mixed loop form = straight-line to $dm, = generic to $em; C++ and freestanding"
 exit $fail

@@ -1040,10 +1040,12 @@ static int emit_eval_straight(emit_ctx *cx, eval_split *sp, const loop_choice *l
   return 0;
 }
 
-static void emit_eval(emit_ctx *cx, emit_files *EF) {
+/* the evaluation <m>_eval; returns 1 when it is in the loop form (one
+ * function), else 0 (straight-line, into EF's files when it is in parts) */
+static int emit_eval(emit_ctx *cx, emit_files *EF) {
   FILE *out = cx->f;
   eval_split sp;
-  if (eval_split_begin(&sp)) { cx->failed = 1; return; }
+  if (eval_split_begin(&sp)) { cx->failed = 1; return 0; }
   FILE *f = sp.body;
   const lmodel *L = cx->L;
   const char *nm = cx->nm;
@@ -1070,10 +1072,11 @@ static void emit_eval(emit_ctx *cx, emit_files *EF) {
     }
     loop_choice_free(&lc);
     if (eval_split_finish(&sp, out, nm, head, NULL) < 0) cx->failed = 1;
-    return;
+    return 1;
   }
   if (emit_eval_straight(cx, &sp, NULL)) cx->failed = 1;
   if (eval_split_finish(&sp, out, nm, head, emit_files_eval_hooks(EF)) < 0) cx->failed = 1;
+  return 0;
 }
 
 /* init's statements per function when a large model's init is split: gcc's
@@ -1262,8 +1265,10 @@ static void emit_header(emit_ctx *cx) {
 
 /* <m>.c into cx->f, a memory stream whose text is *text (*len bytes) after a
  * flush; with EF->file_bytes > 0 a large model's evaluation parts and LDL^T
- * go to EF's files instead.  1: the parts read a table emit_files cannot
- * point at (the caller writes the model again as one file), else 0. */
+ * go to EF's files instead, and so does a loop-form model's straight-line
+ * LDL^T.  1: the caller writes the model again as one file (the parts read a
+ * table emit_files cannot point at; a loop-form model's LDL^T is small),
+ * else 0. */
 static int emit_source(emit_ctx *cx, emit_files *EF, char **text, size_t *len) {
   FILE *f = cx->f;
   const lmodel *L = cx->L;
@@ -1297,10 +1302,17 @@ static int emit_source(emit_ctx *cx, emit_files *EF, char **text, size_t *len) {
   fputc('\n', f);
   emit_tables(cx);
   emit_init(cx);
-  emit_eval(cx, EF);
+  int loop_form = emit_eval(cx, EF);
+  /* A loop-form evaluation is one function of <m>.c, but its straight-line
+     LDL^T's parts compile in parallel as a model in parts' do: in files of
+     their own when they are larger than an evaluation that is split
+     (two parts' text; emit_split.h) */
+  const ldl_plan *plan = &cx->u->plan;
+  long budget = eval_part_bytes();
+  int ldl_alone = loop_form && EF->file_bytes > 0 && budget > 0 && cx->u->have_plan && plan->straight;
   int ldl;
-  if (EF->active) {
-    if (fflush(f) || emit_files_tables(EF, f, *text, *len)) return 1;
+  if (EF->active && (fflush(f) || emit_files_tables(EF, f, *text, *len))) return 1;
+  if (EF->active || ldl_alone) {
     /* the LDL^T in files of its own; its wrappers for the model record stay */
     ldl_out out;
     FILE *lf = emit_files_ldl(EF, f, &out);
@@ -1308,6 +1320,9 @@ static int emit_source(emit_ctx *cx, emit_files *EF, char **text, size_t *len) {
     cx->f = lf;
     ldl = emit_ldl(cx, &out);
     cx->f = f;
+    long bytes = emit_files_ldl_bytes(EF);
+    if (bytes < 0) { cx->failed = 1; return 0; }
+    if (ldl_alone && bytes <= 2 * budget) return 1;
   } else
     ldl = emit_ldl(cx, NULL);
   fprintf(f, "\nconst mb_model %s_model = {\n", nm);
@@ -1448,9 +1463,13 @@ static int source_text(const mbc_unit *u, emit_files *EF, char **text, size_t *l
 }
 
 /* after a successful emission: the files of an earlier split emission that
- * this one did not write (only names of the split's own pattern) */
+ * this one did not write (only names of the split's own pattern), and the
+ * private header when the evaluation is no longer in files */
 static void remove_stale(const char *dir, const char *nm, char **old, const char *const *now, int nnow) {
-  char path[4400];
+  char path[4400], header[400];
+  snprintf(header, sizeof header, "%s_parts.h", nm);
+  int has_header = 0;
+  for (int k = 0; k < nnow; k++) has_header |= !strcmp(now[k], header);
   for (int i = 0; old && old[i]; i++) {
     int keep = 0;
     for (int k = 0; k < nnow; k++) keep |= !strcmp(old[i], now[k]);
@@ -1461,10 +1480,12 @@ static void remove_stale(const char *dir, const char *nm, char **old, const char
       remove(path);
     }
   }
-  if (old && !nnow) { /* one file now: the list and the private header go */
+  if (old && !nnow) { /* one file now: the list goes */
     snprintf(path, sizeof path, "%s/%s.sources", dir, nm);
     remove(path);
-    snprintf(path, sizeof path, "%s/%s_parts.h", dir, nm);
+  }
+  if (old && !has_header) {
+    snprintf(path, sizeof path, "%s/%s", dir, header);
     remove(path);
   }
 }

@@ -387,7 +387,24 @@ FILE *emit_files_ldl(emit_files *F, FILE *src, ldl_out *out) {
   return F->ldl.f;
 }
 
-int emit_files_count(const emit_files *F) { return F->active ? 2 + F->neval + F->has_ldl + F->nldl_part : 0; }
+long emit_files_ldl_bytes(emit_files *F) {
+  long n = 0;
+  if (text_sync(&F->ldl)) return -1;
+  n += (long)F->ldl.len;
+  for (int k = 0; k < F->nldl_part; k++) {
+    if (text_sync(F->ldl_part[k])) return -1;
+    n += (long)F->ldl_part[k]->len;
+  }
+  return n;
+}
+
+/* the evaluation's files (the private header, then the parts' files): none
+ * when only the LDL^T has files of its own */
+static int eval_file_count(const emit_files *F) { return F->active ? 1 + F->neval : 0; }
+
+int emit_files_count(const emit_files *F) {
+  return F->active || F->has_ldl ? eval_file_count(F) + F->has_ldl + F->nldl_part + 1 : 0;
+}
 
 /* a malloc'ed copy of a + b + c */
 static char *join3(const char *a, const char *b, size_t blen, const char *c, size_t *len) {
@@ -405,7 +422,7 @@ char *emit_files_text(emit_files *F, int i, const char **name, size_t *len) {
   char head[2048], NM[256];
   upper(NM, F->nm, sizeof NM);
   if (text_sync(&F->header) || text_sync(&F->refs)) return NULL;
-  if (i == 0) {
+  if (F->active && i == 0) {
     *name = F->header.name;
     char *refs = F->refs.text ? F->refs.text : "";
     snprintf(head, sizeof head,
@@ -419,7 +436,7 @@ char *emit_files_text(emit_files *F, int i, const char **name, size_t *len) {
     free(a);
     return r;
   }
-  if (i <= F->neval) {
+  if (F->active && i <= F->neval) {
     gen_text *g = &F->eval[i - 1];
     if (text_sync(g)) return NULL;
     *name = g->name;
@@ -433,7 +450,7 @@ char *emit_files_text(emit_files *F, int i, const char **name, size_t *len) {
     free(a);
     return r;
   }
-  int k = i - F->neval - 1 - F->has_ldl; /* an LDL^T part file: k >= 0 */
+  int k = i - eval_file_count(F) - F->has_ldl; /* an LDL^T part file: k >= 0 */
   if (F->has_ldl && k < F->nldl_part) {
     gen_text *g = k < 0 ? &F->ldl : F->ldl_part[k];
     if (text_sync(g)) return NULL;

@@ -7,7 +7,10 @@
  *                  and the parts read (the constant ones are copied)
  *   <m>_eval<k>.c  a group of evaluation parts
  *   <m>_ldl.c      the emitted LDL^T (factor and solve)
+ *   <m>_ldl<k>.c   a straight-line LDL^T's out-of-line parts
  *   <m>.sources    the C files to compile, one a line (<m>.c first)
+ * A model whose evaluation is in the loop form (one function in <m>.c) has
+ * only the LDL^T's files, when its straight-line LDL^T is large.
  * A smaller model stays <m>.c alone, as before (no <m>.sources). */
 #ifndef MBCC_EMIT_FILES_H
 #define MBCC_EMIT_FILES_H
@@ -48,7 +51,7 @@ typedef struct {
   keep_decl *copied;
   int ncopied;
   int active;         /* the evaluation went into files */
-  int has_ldl;
+  int has_ldl;         /* the LDL^T went into files (with or without the evaluation) */
   int failed;
   eval_files hooks;
 } emit_files;
@@ -73,7 +76,11 @@ int emit_files_keep(emit_files *F, FILE *src, const char *text, size_t len);
  * points at to src, the straight-line code's parts to <m>_ldl0.c,
  * <m>_ldl1.c, ... of about file_bytes of text each */
 FILE *emit_files_ldl(emit_files *F, FILE *src, ldl_out *out);
-/* the extra files, each as its text after the origin comment: n of them */
+/* the text the LDL^T's files hold so far, in bytes (-1: out of memory) */
+long emit_files_ldl_bytes(emit_files *F);
+/* the extra files, each as its text after the origin comment: n of them
+ * (the evaluation's when it is in files, the LDL^T's when it has files of its
+ * own, the list) */
 int emit_files_count(const emit_files *F);
 /* file i: its name; its text (the caller frees it) after the comment line */
 char *emit_files_text(emit_files *F, int i, const char **name, size_t *len);
