@@ -474,7 +474,7 @@ cat <<EOF
 
 \`mbcc compile\` (reading, modal analysis of the chassis, lowering,
 emitting C; wall time), then the C build of the simulator that \`mbcc run\`
-does (cc -O2 on the emitted model, and linking), in a fresh directory: its
+does (cc -O2 -march=native on the emitted model, and linking), in a fresh directory: its
 wall time on this shared machine and its CPU time (user + system).
 
 | scene | mbcc compile [s] | C build, wall [s] | C build, CPU [s] | size of the emitted model [kB] | simulation of 2 s, emitted LDLᵀ [s] | steps |
