@@ -133,5 +133,14 @@ for f in $(sources gen_float chain40flex); do
   cc -std=c11 -ffreestanding -fno-math-errno -Wall -Wextra -Wdouble-promotion -Wconversion -Werror -DMB_REAL_FLOAT \
     -I"$root/runtime/core" -Igen_float -c "$f" -o /dev/null || err "freestanding float build of the mixed loop form: $f"
 done
-[ $fail = 0 ] && echo "40-link chain + flexible beam: mixed loop form = straight-line to $dm, = generic to $em; C++ and freestanding"
+# a model mostly without a loop form stays straight-line (in parts) unless
+# MBCC_LOOP_MIN forces it: a fleet of 8 cars (32 tyres: a group of 32), whose
+# chassis, its node markers and the joints on them have none
+bash "$root/scripts/fleet.sh" 8 > fleet8.yaml
+"$MBCC" compile fleet8.yaml -o gen_fleet > /dev/null || err "compile fleet8"
+grep -q "loop_forces" gen_fleet/fleet8*.c && err "the 8-car fleet took the mixed loop form by default"
+[ -f gen_fleet/fleet8.sources ] || err "the 8-car fleet is not written in parts"
+MBCC_LOOP_MIN=32 "$MBCC" compile fleet8.yaml -o gen_fleet_loops > /dev/null || err "compile fleet8 (MBCC_LOOP_MIN=32)"
+grep -q "loop_forces" gen_fleet_loops/fleet8.c || err "MBCC_LOOP_MIN=32 did not force the 8-car fleet's loop form"
+[ $fail = 0 ] && echo "40-link chain + flexible beam: mixed loop form = straight-line to $dm, = generic to $em; C++ and freestanding; the fleet stays straight-line"
 exit $fail

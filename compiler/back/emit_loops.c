@@ -28,6 +28,12 @@
 
 /* measured: docs/architecture.md, "The loop form" */
 #define LOOP_MIN_GROUP 32
+/* a mixed model's elements without a loop form are written straight-line in the
+ * one evaluation function, which is not cut into parts: they may be at most
+ * this share of its elements (a fleet of cars, whose chassis and the joints
+ * on its nodes have none, builds faster straight-line in parts: 16 cars took
+ * 90 s of gcc and 752 MB as one looped file; docs/architecture.md) */
+#define LOOP_MIXED_MAX_SHARE 0.2
 
 int loop_min_group(void) {
   long v = emit_size_setting("MBCC_LOOP_MIN", LOOP_MIN_GROUP);
@@ -232,12 +238,27 @@ static int plan_groups(const lmodel *L, const loop_choice *c, loop_plan *p) {
   return 0;
 }
 
+/* the share of a mixed model's elements (bodies, markers, joints' rows, force
+ * elements) that have no loop form */
+static double straight_share(const lmodel *L, const loop_choice *c) {
+  const mb_model *m = &L->m;
+  long all = (long)m->nbody + m->nmarker + m->nforce + m->nrow, straight = 0;
+  for (int b = 0; b < m->nbody; b++) straight += !c->body[b];
+  for (int k = 0; k < m->nmarker; k++) straight += !c->marker[k];
+  for (int i = 0; i < m->nforce; i++) straight += !c->force[i];
+  for (int r = 0; r < m->nrow; r++) straight += !c->row[r];
+  return all > 0 ? (double)straight / (double)all : 0;
+}
+
 int emit_loops_choose(const lmodel *L, loop_choice *c) {
   if (L->m.nbody < 1 || L->m.nmarker < 1) { memset(c, 0, sizeof *c); return 0; }
   if (mark_loopable(L, c)) return -1;
   loop_plan p;
   if (plan_groups(L, c, &p)) { loop_choice_free(c); return -1; }
   int chosen = p.largest >= loop_min_group() && p.largest > 0;
+  /* MBCC_LOOP_MIN set: the loop form whenever its groups are that large */
+  const char *forced = getenv("MBCC_LOOP_MIN");
+  if (chosen && c->mixed && !(forced && *forced) && straight_share(L, c) > LOOP_MIXED_MAX_SHARE) chosen = 0;
   plan_free(&p);
   if (!chosen) loop_choice_free(c);
   return chosen;
