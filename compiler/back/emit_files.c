@@ -87,9 +87,11 @@ const eval_files *emit_files_eval_hooks(emit_files *F) {
 
 static int ident_char(int c) { return isalnum(c) || c == '_'; }
 
-int c_text_names(const char *text, size_t len, const char *name) {
-  size_t n = strlen(name);
-  const char *p = text, *end = text + len;
+/* the next name of text[*pp, end): an identifier outside comments, strings
+ * and numbers that is not a member (after '.' or '->'); its length in *n, NULL
+ * at the end */
+static const char *next_name(const char *text, const char **pp, const char *end, size_t *n) {
+  const char *p = *pp;
   while (p < end) {
     if (*p == '/' && p + 1 < end && p[1] == '*') {
       const char *e = p + 2;
@@ -111,17 +113,77 @@ int c_text_names(const char *text, size_t len, const char *name) {
     if (ident_char((unsigned char)*p)) {
       const char *s = p;
       while (p < end && ident_char((unsigned char)*p)) p++;
-      if ((size_t)(p - s) == n && !memcmp(s, name, n) && !isdigit((unsigned char)*s)) {
-        const char *b = s - 1;
-        while (b >= text && *b == ' ') b--;
-        int member = b >= text && (*b == '.' || (*b == '>' && b > text && b[-1] == '-'));
-        if (!member) return 1;
-      }
-      continue;
+      if (isdigit((unsigned char)*s)) continue;
+      const char *b = s - 1;
+      while (b >= text && *b == ' ') b--;
+      if (b >= text && (*b == '.' || (*b == '>' && b > text && b[-1] == '-'))) continue;
+      *pp = p;
+      *n = (size_t)(p - s);
+      return s;
     }
     p++;
   }
+  *pp = end;
+  return NULL;
+}
+
+int c_text_names(const char *text, size_t len, const char *name) {
+  size_t n = strlen(name), k;
+  const char *p = text, *s;
+  while ((s = next_name(text, &p, text + len, &k)) != NULL)
+    if (k == n && !memcmp(s, name, n)) return 1;
   return 0;
+}
+
+/* names[0..count) by hash (open addressing): which of them a text names, in
+ * one pass over the text (a scan per name grew with files x statics x text) */
+typedef struct {
+  const char *const *names;
+  int *slot, mask;
+} name_index;
+
+static unsigned name_hash(const char *s, size_t n) {
+  unsigned h = 2166136261u; /* FNV-1a */
+  for (size_t i = 0; i < n; i++) h = (h ^ (unsigned char)s[i]) * 16777619u;
+  return h;
+}
+
+static int index_build(name_index *x, const char *const *names, int count) {
+  int cap = 16;
+  while (cap < 2 * count + 1) cap *= 2;
+  x->names = names;
+  x->mask = cap - 1;
+  x->slot = malloc(sizeof(int) * (size_t)cap);
+  if (!x->slot) return -1;
+  for (int i = 0; i < cap; i++) x->slot[i] = -1;
+  for (int i = 0; i < count; i++) {
+    unsigned h = name_hash(names[i], strlen(names[i])) & (unsigned)x->mask;
+    while (x->slot[h] >= 0) h = (h + 1) & (unsigned)x->mask;
+    x->slot[h] = i;
+  }
+  return 0;
+}
+
+/* the first of the names equal to s[0..n), or -1 */
+static int index_find(const name_index *x, const char *s, size_t n) {
+  unsigned h = name_hash(s, n) & (unsigned)x->mask;
+  for (; x->slot[h] >= 0; h = (h + 1) & (unsigned)x->mask) {
+    const char *c = x->names[x->slot[h]];
+    if (strlen(c) == n && !memcmp(c, s, n)) return x->slot[h];
+  }
+  return -1;
+}
+
+/* count[i] += how often text names names[i] (count may be NULL: mark[i] = 1) */
+static void index_scan(const name_index *x, const char *text, size_t len, int *count, char *mark) {
+  const char *p = text, *s;
+  size_t k;
+  while ((s = next_name(text, &p, text + len, &k)) != NULL) {
+    int i = index_find(x, s, k);
+    if (i < 0) continue;
+    if (count) count[i]++;
+    if (mark && !mark[i]) mark[i] = 1;
+  }
 }
 
 /* --- the tables the parts read ---------------------------------------------- */
@@ -264,18 +326,40 @@ static void write_ref(emit_files *F, FILE *src, int kind, int plen, const char *
 }
 
 int emit_files_keep(emit_files *F, FILE *src, const char *text, size_t len) {
-  int first = 1;
-  for (int i = 0; i < F->ncopied; i++) {
+  int first = 1, nc = F->ncopied;
+  /* how often <m>.c names each copied static, and how often its own text does */
+  const char **names = malloc(sizeof *names * (size_t)(nc + 1));
+  int *all = calloc((size_t)nc + 1, sizeof(int)), *own = calloc((size_t)nc + 1, sizeof(int));
+  name_index x = {0};
+  int ok = names && all && own;
+  for (int i = 0; ok && i < nc; i++) {
+    names[i] = F->copied[i].name;
+    ok = F->copied[i].to <= len;
+  }
+  ok = ok && index_build(&x, names, nc) == 0;
+  if (ok) {
+    index_scan(&x, text, len, all, NULL);
+    for (int i = 0; i < nc; i++) { /* its name in its own declaration */
+      const keep_decl *c = &F->copied[i];
+      const char *p = text + c->from, *e = text + c->to, *t;
+      size_t k, n = strlen(c->name);
+      while ((t = next_name(text, &p, e, &k)) != NULL) own[i] += k == n && !memcmp(t, c->name, n);
+    }
+  }
+  for (int i = 0; ok && i < nc; i++) {
     keep_decl *c = &F->copied[i];
-    if (c->to > len) return -1;
-    if (c_text_names(text, c->from, c->name) || c_text_names(text + c->to, len - c->to, c->name)) continue;
-    if (c->kind == DECL_OTHER) return -1;
+    if (all[i] > own[i]) continue; /* read elsewhere in <m>.c */
+    if (c->kind == DECL_OTHER) { ok = 0; break; }
     if (first) fputs("\n/* tables only the evaluation's parts read (they have copies): kept for them */\n", src);
     first = 0;
     const char *par = c->params ? c->params : "";
     write_ref(F, src, c->kind, (int)strlen(c->decl_head), c->decl_head, (int)strlen(par), par, c->name);
   }
-  return text_sync(&F->refs);
+  free(names);
+  free(all);
+  free(own);
+  free(x.slot);
+  return ok ? text_sync(&F->refs) : -1;
 }
 
 int emit_files_tables(emit_files *F, FILE *src, const char *text, size_t len) {
@@ -286,7 +370,26 @@ int emit_files_tables(emit_files *F, FILE *src, const char *text, size_t len) {
   int n = parse_statics(text, len, &d);
   if (n < 0) return -1;
   char *need = calloc((size_t)n + 1, 1), *pointed = calloc((size_t)n + 1, 1), *copied = calloc((size_t)n + 1, 1);
-  int rc = need && pointed && copied ? 0 : -1;
+  /* the statics each static's text names (refs[rp[i]..rp[i+1])), found once */
+  const char **names = malloc(sizeof *names * (size_t)(n + 1));
+  int *rp = calloc((size_t)n + 2, sizeof(int)), *refs = NULL;
+  char *mark = calloc((size_t)n + 1, 1);
+  name_index x = {0};
+  int rc = need && pointed && copied && names && rp && mark ? 0 : -1;
+  for (int i = 0; !rc && i < n; i++) names[i] = d[i].name;
+  if (!rc) rc = index_build(&x, names, n);
+  for (int i = 0; !rc && i < n; i++) {
+    memset(mark, 0, (size_t)n);
+    index_scan(&x, d[i].block, d[i].blen, NULL, mark);
+    int cnt = 0;
+    for (int j = 0; j < n; j++) cnt += mark[j] && j != i;
+    int *nr = realloc(refs, sizeof(int) * (size_t)(rp[i] + cnt + 1));
+    if (!nr) { rc = -1; break; }
+    refs = nr;
+    rp[i + 1] = rp[i];
+    for (int j = 0; j < n; j++)
+      if (mark[j] && j != i) refs[rp[i + 1]++] = j;
+  }
   /* per file: the statics its parts read, and what the constant ones among
      them read in turn; a constant one is copied into the file (static
      there too, so the C compiler folds its values as in one file), a
@@ -294,14 +397,14 @@ int emit_files_tables(emit_files *F, FILE *src, const char *text, size_t len) {
   for (int k = 0; !rc && k < F->neval; k++) {
     memset(need, 0, (size_t)n);
     if (!F->eval[k].text) continue;
-    for (int i = 0; i < n; i++) need[i] = (char)c_text_names(F->eval[k].text, F->eval[k].len, d[i].name);
+    index_scan(&x, F->eval[k].text, F->eval[k].len, NULL, need);
     for (int changed = 1; changed;) {
       changed = 0;
       for (int i = 0; i < n; i++) {
         if (!need[i] || d[i].mutable_ || need[i] == 2) continue;
-        need[i] = 2; /* its text scanned */
-        for (int j = 0; j < n; j++)
-          if (!need[j] && j != i && c_text_names(d[i].block, d[i].blen, d[j].name)) { need[j] = 1; changed = 1; }
+        need[i] = 2; /* its references followed */
+        for (int r = rp[i]; r < rp[i + 1]; r++)
+          if (!need[refs[r]]) { need[refs[r]] = 1; changed = 1; }
       }
     }
     for (int i = 0; !rc && i < n; i++) {
@@ -347,6 +450,11 @@ int emit_files_tables(emit_files *F, FILE *src, const char *text, size_t len) {
     first = 0;
     write_ref(F, src, d[i].kind, (int)d[i].plen, d[i].pre, (int)d[i].parlen, d[i].params, d[i].name);
   }
+  free(names);
+  free(rp);
+  free(refs);
+  free(mark);
+  free(x.slot);
   free(need);
   free(pointed);
   free(copied);
