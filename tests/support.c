@@ -128,3 +128,46 @@ double max_rel_diff(const mb_model *m, const trajectory *a, const trajectory *b,
   for (int k = 0; k < a->nrows; k++) assert_true(a->t[k] == b->t[k]);
   return worst;
 }
+
+/* r = b - K x; returns ||r||_inf / (||K||_inf ||x||_inf + ||b||_inf) */
+double k_rel_residual(const mb_model *m, const double *Kx, const double *x, const double *b) {
+  int n = m->n;
+  double *r = malloc(sizeof(double) * (size_t)n), *rs = calloc((size_t)n, sizeof(double));
+  assert_non_null(r);
+  assert_non_null(rs);
+  memcpy(r, b, sizeof(double) * (size_t)n);
+  for (int j = 0; j < n; j++)
+    for (int p = m->Kp[j]; p < m->Kp[j + 1]; p++) {
+      r[m->Ki[p]] -= Kx[p] * x[j];
+      rs[m->Ki[p]] += fabs(Kx[p]);
+    }
+  double rn = 0, xn = 0, bn = 0, kn = 0;
+  for (int i = 0; i < n; i++) {
+    rn = fmax(rn, fabs(r[i]));
+    xn = fmax(xn, fabs(x[i]));
+    bn = fmax(bn, fabs(b[i]));
+    kn = fmax(kn, rs[i]);
+  }
+  free(r);
+  free(rs);
+  return rn / (kn * xn + bn);
+}
+
+/* Kx and the right side at a state near q0: positions moved by a random
+ * velocity-space increment (exact rotations), random velocities */
+void k_near_q0(const mb_model *m, int k, double *Kx, double *rhs, void *work) {
+  double *q = malloc(sizeof(double) * (size_t)m->nq), *v = malloc(sizeof(double) * (size_t)m->nv);
+  double *dv = malloc(sizeof(double) * (size_t)m->nv);
+  double *phi = malloc(sizeof(double) * (size_t)(m->nc + 1)), *nu = malloc(sizeof(double) * (size_t)(m->nc + 1));
+  assert_true(q && v && dv && phi && nu);
+  memcpy(q, m->q0, sizeof(double) * (size_t)m->nq);
+  for (int i = 0; i < m->nv; i++) {
+    dv[i] = k ? urand(-0.05, 0.05) : 0;
+    v[i] = urand(-1, 1);
+  }
+  mb_model_qincrement(m, q, dv);
+  mb_model_normalize(m, q);
+  m->init(m, Kx);
+  m->eval(m, 0.01 * k, q, v, Kx, rhs, phi, nu, work);
+  free(q); free(v); free(dv); free(phi); free(nu);
+}

@@ -58,4 +58,10 @@ mb_model generic_twin(const mb_model *m);
 /* uniform random in [a, b) from a fixed-seed generator (reproducible) */
 double urand(double a, double b);
 
+/* ||b - K x||_inf / (||K||_inf ||x||_inf + ||b||_inf) on K's pattern */
+double k_rel_residual(const mb_model *m, const double *Kx, const double *x, const double *b);
+/* Kx and the right side at a state near q0 (k = 0: q0 itself): positions moved
+ * along a random velocity-space increment (exact rotations), random velocities */
+void k_near_q0(const mb_model *m, int k, double *Kx, double *rhs, void *work);
+
 #endif

@@ -49,49 +49,6 @@ static const mb_model *const models[] = {
 };
 #define NMODELS ((int)(sizeof models / sizeof models[0]))
 
-/* r = b - K x; returns ||r||_inf / (||K||_inf ||x||_inf + ||b||_inf) */
-static double rel_residual(const mb_model *m, const double *Kx, const double *x, const double *b) {
-  int n = m->n;
-  double *r = malloc(sizeof(double) * (size_t)n), *rs = calloc((size_t)n, sizeof(double));
-  assert_non_null(r);
-  assert_non_null(rs);
-  memcpy(r, b, sizeof(double) * (size_t)n);
-  for (int j = 0; j < n; j++)
-    for (int p = m->Kp[j]; p < m->Kp[j + 1]; p++) {
-      r[m->Ki[p]] -= Kx[p] * x[j];
-      rs[m->Ki[p]] += fabs(Kx[p]);
-    }
-  double rn = 0, xn = 0, bn = 0, kn = 0;
-  for (int i = 0; i < n; i++) {
-    rn = fmax(rn, fabs(r[i]));
-    xn = fmax(xn, fabs(x[i]));
-    bn = fmax(bn, fabs(b[i]));
-    kn = fmax(kn, rs[i]);
-  }
-  free(r);
-  free(rs);
-  return rn / (kn * xn + bn);
-}
-
-/* Kx and the right side at a state near q0: positions moved by a random
- * velocity-space increment (exact rotations), random velocities */
-static void state_near_q0(const mb_model *m, int k, double *Kx, double *rhs, void *work) {
-  double *q = malloc(sizeof(double) * (size_t)m->nq), *v = malloc(sizeof(double) * (size_t)m->nv);
-  double *dv = malloc(sizeof(double) * (size_t)m->nv);
-  double *phi = malloc(sizeof(double) * (size_t)(m->nc + 1)), *nu = malloc(sizeof(double) * (size_t)(m->nc + 1));
-  assert_true(q && v && dv && phi && nu);
-  memcpy(q, m->q0, sizeof(double) * (size_t)m->nq);
-  for (int i = 0; i < m->nv; i++) {
-    dv[i] = k ? urand(-0.05, 0.05) : 0;
-    v[i] = urand(-1, 1);
-  }
-  mb_model_qincrement(m, q, dv);
-  mb_model_normalize(m, q);
-  m->init(m, Kx);
-  m->eval(m, 0.01 * k, q, v, Kx, rhs, phi, nu, work);
-  free(q); free(v); free(dv); free(phi); free(nu);
-}
-
 static void residual_and_klu(void **state) {
   (void)state;
   for (int im = 0; im < NMODELS; im++) {
@@ -110,7 +67,7 @@ static void residual_and_klu(void **state) {
     ldl->check_every = 1; /* the residual of every solve */
     double worst_res = 0, worst_rep = 0, worst_klu = 0, worst_pass = 0;
     for (int k = 0; k < 4; k++) {
-      state_near_q0(m, k, Kx, rhs, work);
+      k_near_q0(m, k, Kx, rhs, work);
       assert_int_equal(ldl->factor(ldl, Kx), MB_OK);
       assert_int_equal(m->ldl_factor(m, Kx, lwork), 0);
       assert_int_equal(ldl->bad_pivot, -1);
@@ -127,7 +84,7 @@ static void residual_and_klu(void **state) {
         assert_int_equal(ldl->solve(ldl, x), MB_OK);
         assert_int_equal(klu->solve(klu, y), MB_OK);
         assert_int_equal(m->ldl_solve(m, Kx, lwork, z, NULL), MB_OK);
-        double res = rel_residual(m, Kx, x, b), res_pass = rel_residual(m, Kx, z, b);
+        double res = k_rel_residual(m, Kx, x, b), res_pass = k_rel_residual(m, Kx, z, b);
         double xn = 0, d = 0, dz = 0;
         for (int i = 0; i < n; i++) {
           xn = fmax(xn, fabs(y[i]));
@@ -201,7 +158,7 @@ static void sampled_checks(void **state) {
     double *x = malloc(sizeof(double) * (size_t)n), *y = malloc(sizeof(double) * (size_t)n);
     void *work = malloc(mb_model_worksize(m) + 16);
     assert_true(Kx && rhs && x && y && work);
-    state_near_q0(m, 1, Kx, rhs, work);
+    k_near_q0(m, 1, Kx, rhs, work);
     assert_int_equal(ldl->factor(ldl, Kx), MB_OK);
     assert_int_equal(ref->factor(ref, Kx), MB_OK);
     double dmax = 0;
@@ -252,7 +209,7 @@ static void zero_pivot_and_missing(void **state) {
        the emitted code still factors it (the weights are in the code) */
     void *work = malloc(mb_model_worksize(m) + 16);
     double *rhs = calloc((size_t)m->n, sizeof(double));
-    state_near_q0(m, 0, Kx, rhs, work);
+    k_near_q0(m, 0, Kx, rhs, work);
     assert_int_equal(ldl->factor(ldl, Kx), MB_OK);
     assert_int_equal(ldl->bad_pivot, -1);
     ldl->destroy(ldl);
@@ -286,7 +243,7 @@ static void massless_rows_fallback(void **state) {
   void *work = malloc(mb_model_worksize(m) + 16);
   double *lwork = calloc(m->ldl_worksize + 1, sizeof(double));
   assert_true(K0 && Kx && rhs && b && x && y && work && lwork);
-  state_near_q0(m, 1, K0, rhs, work);
+  k_near_q0(m, 1, K0, rhs, work);
   for (int row = nv; row < n; row++) {
     int on_u = 0, off_u = 0;
     for (int j = 0; j < nv; j++)
@@ -312,9 +269,9 @@ static void massless_rows_fallback(void **state) {
       assert_int_equal(klu->solve(klu, y), MB_OK);
       double d = 0, yn = 0;
       for (int i = 0; i < n; i++) { d = fmax(d, fabs(x[i] - y[i])); yn = fmax(yn, fabs(y[i])); }
-      printf("  row %d off the slider: residual %.2g, against KLU %.2g\n", row, rel_residual(m, Kx, x, b),
+      printf("  row %d off the slider: residual %.2g, against KLU %.2g\n", row, k_rel_residual(m, Kx, x, b),
              d / yn);
-      assert_true(rel_residual(m, Kx, x, b) < 1e-12);
+      assert_true(k_rel_residual(m, Kx, x, b) < 1e-12);
       assert_true(d <= 1e-10 * yn);
     }
     klu->destroy(klu);

@@ -25,46 +25,6 @@ static const int tails[] = {FOUR_BAR_LDL_TAIL, SPATIAL_JOINTS_LDL_TAIL, DOUBLE_P
 static const mb_model *const models[] = {&four_bar_model, &spatial_joints_model, &double_pendulum_model};
 #define NMODELS ((int)(sizeof models / sizeof models[0]))
 
-/* ||b - K x||_inf / (||K||_inf ||x||_inf + ||b||_inf) */
-static double rel_residual(const mb_model *m, const double *Kx, const double *x, const double *b) {
-  double rn = 0, xn = 0, bn = 0, kn = 0;
-  double *r = malloc(sizeof(double) * (size_t)m->n), *rs = calloc((size_t)m->n, sizeof(double));
-  assert_true(r && rs);
-  memcpy(r, b, sizeof(double) * (size_t)m->n);
-  for (int j = 0; j < m->n; j++)
-    for (int p = m->Kp[j]; p < m->Kp[j + 1]; p++) {
-      r[m->Ki[p]] -= Kx[p] * x[j];
-      rs[m->Ki[p]] += fabs(Kx[p]);
-    }
-  for (int i = 0; i < m->n; i++) {
-    rn = fmax(rn, fabs(r[i]));
-    xn = fmax(xn, fabs(x[i]));
-    bn = fmax(bn, fabs(b[i]));
-    kn = fmax(kn, rs[i]);
-  }
-  free(r);
-  free(rs);
-  return rn / (kn * xn + bn);
-}
-
-/* K at a state near q0: positions moved along a random velocity-space step */
-static void k_near_q0(const mb_model *m, int k, double *Kx, double *rhs, void *work) {
-  double *q = malloc(sizeof(double) * (size_t)m->nq), *v = malloc(sizeof(double) * (size_t)m->nv);
-  double *dv = malloc(sizeof(double) * (size_t)m->nv), *phi = malloc(sizeof(double) * (size_t)(m->nc + 1));
-  double *nu = malloc(sizeof(double) * (size_t)(m->nc + 1));
-  assert_true(q && v && dv && phi && nu);
-  memcpy(q, m->q0, sizeof(double) * (size_t)m->nq);
-  for (int i = 0; i < m->nv; i++) {
-    dv[i] = k ? urand(-0.05, 0.05) : 0;
-    v[i] = urand(-1, 1);
-  }
-  mb_model_qincrement(m, q, dv);
-  mb_model_normalize(m, q);
-  m->init(m, Kx);
-  m->eval(m, 0.01 * k, q, v, Kx, rhs, phi, nu, work);
-  free(q); free(v); free(dv); free(phi); free(nu);
-}
-
 static void solves_agree_with_klu(void **state) {
   (void)state;
   for (int im = 0; im < NMODELS; im++) {
@@ -95,7 +55,7 @@ static void solves_agree_with_klu(void **state) {
           xn = fmax(xn, fabs(y[i]));
           d = fmax(d, fabs(x[i] - y[i]));
         }
-        worst_res = fmax(worst_res, rel_residual(m, Kx, x, b));
+        worst_res = fmax(worst_res, k_rel_residual(m, Kx, x, b));
         worst_diff = fmax(worst_diff, d / xn);
       }
     }

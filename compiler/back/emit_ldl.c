@@ -721,6 +721,22 @@ static void emit_tail_kernel(emit_ctx *cx, const lmodel *L, const ldl_plan *p, c
   free(wc);
 }
 
+/* entry r of a row of L, straight-line: y_j = K_aug(j, k) - sum L(j, i) y_i over
+ * the earlier columns i of the row (inrow), and L(k, j) = y_j / d_j */
+static void emit_row_entry(emit_ctx *cx, const ldl_plan *p, int r, const int *kent, const int *inrow) {
+  FILE *f = cx->f;
+  int j = p->Rj[r], any = 0;
+  fprintf(f, "    y%d = ", j);
+  if (kent[j] >= 0) { aug_value(cx, p, kent[j]); any = 1; }
+  for (int rr = p->Rp[j]; rr < p->Rp[j + 1]; rr++)
+    if (inrow[p->Rj[rr]]) {
+      fprintf(f, "%sLx[%d] * y%d", any ? " - " : "-", p->Rpos[rr], p->Rj[rr]);
+      any = 1;
+    }
+  if (!any) fputs("0", f);
+  fprintf(f, ";\n    Lx[%d] = y%d * Dinv[%d];\n", p->Rpos[r], j, j);
+}
+
 /* row k of the dense tail, straight-line: its entries in the columns before the
  * tail (into Lx, W and LcT) and its entries of K_aug in the tail (into Kt) */
 static void emit_tail_row(emit_ctx *cx, const ldl_plan *p, const ldl_tail *t, int k, int *inrow, int *kent,
@@ -743,17 +759,9 @@ static void emit_tail_row(emit_ctx *cx, const ldl_plan *p, const ldl_tail *t, in
     fputs(";\n", f);
   }
   for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) {
-    int j = p->Rj[r], any = 0;
+    int j = p->Rj[r];
     if (j >= t->T) break; /* the row's columns ascend */
-    fprintf(f, "    y%d = ", j);
-    if (kent[j] >= 0) { aug_value(cx, p, kent[j]); any = 1; }
-    for (int rr = p->Rp[j]; rr < p->Rp[j + 1]; rr++)
-      if (inrow[p->Rj[rr]]) {
-        fprintf(f, "%sLx[%d] * y%d", any ? " - " : "-", p->Rpos[rr], p->Rj[rr]);
-        any = 1;
-      }
-    if (!any) fputs("0", f);
-    fprintf(f, ";\n    Lx[%d] = y%d * Dinv[%d];\n", p->Rpos[r], j, j);
+    emit_row_entry(cx, p, r, kent, inrow);
     fprintf(f, "    Lx[%ld] = y%d;\n    Lx[%ld] = Lx[%d];\n", t->tw + q++, j,
             t->tl + (long)t->cidx[j] * t->ntp + a, p->Rpos[r]);
     *chunk_flops += 2.0 * (p->Rpos[r] - p->Lp[j]) + 5;
@@ -831,16 +839,8 @@ static void emit_factor_straight(emit_ctx *cx, const lmodel *L, const ldl_plan *
     }
     fputs("    mb_real d, s;\n", f);
     for (int r = p->Rp[k]; r < p->Rp[k + 1]; r++) {
-      int j = p->Rj[r], any = 0;
-      fprintf(f, "    y%d = ", j);
-      if (kent[j] >= 0) { aug_value(cx, p, kent[j]); any = 1; }
-      for (int rr = p->Rp[j]; rr < p->Rp[j + 1]; rr++)
-        if (inrow[p->Rj[rr]]) {
-          fprintf(f, "%sLx[%d] * y%d", any ? " - " : "-", p->Rpos[rr], p->Rj[rr]);
-          any = 1;
-        }
-      if (!any) fputs("0", f);
-      fprintf(f, ";\n    Lx[%d] = y%d * Dinv[%d];\n", p->Rpos[r], j, j);
+      int j = p->Rj[r];
+      emit_row_entry(cx, p, r, kent, inrow);
       chunk_flops += 2.0 * (p->Rpos[r] - p->Lp[j]) + 3;
     }
     fputs("    d = ", f);
