@@ -21,7 +21,8 @@ cc=${CC:-cc}
 command -v valgrind >/dev/null || die "valgrind is needed (instruction counts)"
 fresh_dir "$out"
 flags="-std=c11 -O2 -I$here/runtime/core -I$here/runtime/hosted"
-libs="$(dirname "$mbcc")/libmbrt.a -lamd -lklu -lcolamd -lbtf -lsuitesparseconfig -llapack -lblas -lm"
+# the portable runtime: valgrind (3.19) decodes no AVX-512, which the native one may hold
+libs="$(dirname "$mbcc")/libmbrt_portable.a -lamd -lklu -lcolamd -lbtf -lsuitesparseconfig -llapack -lblas -lm"
 
 # form_dir LINKS FORM: the model compiled in that form with its harness; the
 # C compile's CPU seconds in DIR/cpu

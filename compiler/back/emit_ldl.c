@@ -38,6 +38,7 @@
 #include <string.h>
 
 #include "emit_ldl.h"
+#include "emit_split.h"
 #include "emit_util.h"
 #include "order.h"
 
@@ -486,13 +487,10 @@ static int tail_plan(const ldl_plan *p, long base, ldl_tail *t) {
   memset(t, 0, sizeof *t);
   int n = p->n;
   if (!p->straight || p->nelim || p->nml || n < 2 * LDL_TAIL_MIN) return 0;
-  const char *env = getenv("MBCC_LDL_TAIL");
-  int forced = -1;
-  if (env && *env) {
-    char *end;
-    long v = strtol(env, &end, 10);
-    if (*end == 0 && v >= 0) forced = v >= n ? n - 1 : (int)v;
-  }
+  /* -1: the cost model (unset, or not a whole number: emit_size_setting warns);
+     a forced tail is at most LDL_TAIL_MAX rows (its blocks live on the stack) */
+  long v = emit_size_setting("MBCC_LDL_TAIL", -1);
+  int forced = v < 0 ? -1 : (int)(v < n - 1 ? (v < LDL_TAIL_MAX ? v : LDL_TAIL_MAX) : (n - 1 < LDL_TAIL_MAX ? n - 1 : LDL_TAIL_MAX));
   if (forced == 0 || forced == 1) return 0;
   int *inrow = calloc((size_t)n + 1, sizeof(int)), *cidx = malloc(sizeof(int) * ((size_t)n + 1));
   long *cnt = calloc((size_t)p->nnzL + 1, sizeof(long)); /* terms of y_j in row k, at Rpos order r */

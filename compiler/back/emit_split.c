@@ -46,7 +46,8 @@ long emit_size_setting(const char *env, long fallback) {
     /* a tuning knob, so the code stays right either way; but say so (once) */
     static char warned[256];
     if (strstr(warned, env) == NULL) {
-      fprintf(stderr, "mbcc: warning: %s=%s is not a whole number >= 0; using %ld\n", env, e, fallback);
+      if (fallback >= 0) fprintf(stderr, "mbcc: warning: %s=%s is not a whole number >= 0; using %ld\n", env, e, fallback);
+      else fprintf(stderr, "mbcc: warning: %s=%s is not a whole number >= 0; ignored\n", env, e);
       if (strlen(warned) + strlen(env) + 2 < sizeof warned) strcat(strcat(warned, env), " ");
     }
   }
