@@ -437,10 +437,10 @@ static const char *factor_part_params(const emit_ctx *cx, const ldl_plan *p) {
  * inner loop has a constant trip count.  The sums run in another order than
  * the straight-line form's: the factors agree to roundoff, not to the bit. */
 struct ldl_tail {
-  int T, nt, nc, ntp, ncp; /* first row of the tail, its rows, the columns before it, padded */
+  int T, nt, nc, ntp;      /* first row of the tail, its rows, the columns before it, nt padded to 8 */
   int *cidx;               /* T: column j < T -> its place in C, else -1 */
   long nw;                 /* the tail rows' entries in C (W holds them row by row) */
-  long tw, tl, tk, tt, size; /* workspace: W (nw), LcT (ncp x ntp), Kt and LtT (nt x ntp) */
+  long tw, tl, tk, tt, size; /* workspace: W (nw), LcT (nc x ntp), Kt and S (nt x ntp) */
 };
 
 /* largest tail tried, smallest worth a dense block */
@@ -469,10 +469,9 @@ static int tail_columns(const ldl_plan *p, int T, int *cidx) {
 
 static void tail_layout(ldl_tail *t, long base) {
   t->ntp = pad8(t->nt);
-  t->ncp = pad8(t->nc > 0 ? t->nc : 1);
   t->tw = base;
   t->tl = t->tw + (t->nw > 0 ? t->nw : 1);
-  t->tk = t->tl + (long)t->ncp * t->ntp;
+  t->tk = t->tl + (long)t->nc * t->ntp;
   t->tt = t->tk + (long)t->nt * t->ntp;
   t->size = t->tt + (long)t->nt * t->ntp - base;
 }
@@ -509,7 +508,7 @@ static int tail_plan(const ldl_plan *p, long base, ldl_tail *t) {
   for (int T = lo; T <= n - LDL_TAIL_MIN; T++) {
     if (forced > 0 && T != n - forced) continue;
     int nt = n - T, nc = tail_columns(p, T, cidx), ntp = pad8(nt);
-    double moved = 0, extra = 0, dense = ((double)pad8(nc > 0 ? nc : 1) + nt) * ntp / 8; /* the clearing */
+    double moved = 0, extra = 0, dense = ((double)nc + nt) * ntp / 8; /* the clearing */
     for (int b = 0; b < nt; b++) dense += (double)(nt - b - 1) * (ntp - (b + 1) / 8 * 8) / 8 + 4; /* elimination */
     for (int k = T; k < n; k++) {
       int nck = 0;
@@ -594,10 +593,10 @@ static void emit_tail_kernel(emit_ctx *cx, const lmodel *L, const ldl_plan *p, c
              " * transposed), Kt (K_aug in the tail), LtT (the tail's L, by columns), padded to 8 */\n",
           t->T, p->n - 1, name, t->nc);
   fprintf(f, "#define LDL_TAIL_T %d\n#define LDL_TAIL_NT %d\n#define LDL_TAIL_NC %d\n"
-             "#define LDL_TAIL_NTP %d\n#define LDL_TAIL_NCP %d\n"
+             "#define LDL_TAIL_NTP %d\n"
              "#define LDL_TW %ld\n#define LDL_TL %ld\n#define LDL_TK %ld\n#define LDL_TT %ld\n"
              "#define LDL_TAIL_NL %ld\n",
-          t->T, t->nt, t->nc, t->ntp, t->ncp, t->tw, t->tl, t->tk, t->tt, nl);
+          t->T, t->nt, t->nc, t->ntp, t->tw, t->tl, t->tk, t->tt, nl);
   fputs("/* 1 + the unknown of each tail pivot (the code of a failed pivot) */\n", f);
   idx_array(f, "ldl_tail_fail", fail, t->nt);
   fputs("/* row a's entries in the columns before the tail: W[ldl_tail_wp[a] ..\n"
