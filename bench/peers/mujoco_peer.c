@@ -24,7 +24,9 @@
  * car's difference, 2.6e-3, scales with 1 - impedance) of the largest.  Then the timing: ROUNDS rounds, each
  * timing REPS calls of mbcc's evaluation, of mj_forward and of mj_step (state
  * restored before each), in turn; medians of the per-call times and of the
- * per-round ratios.  With --only mbcc|eval|forward N it runs N calls of one of
+ * per-round ratios.  Then where the time goes, in a pass of its own: mbcc's
+ * eval alone against eval + factor + solve (interleaved rounds), and MuJoCo's
+ * stage timers (mjcb_time) over as many mj_forward calls.  With --only mbcc|eval|forward N it runs N calls of one of
  * them (eval: mbcc's evaluation without the factor and solve) and nothing else (for valgrind --tool=cachegrind's instruction counts). */
 #define _POSIX_C_SOURCE 199309L
 #include <math.h>
@@ -45,6 +47,9 @@ static double now(void) {
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
+
+/* MuJoCo's timer callback: microseconds (its timers' unit is the callback's) */
+static mjtNum mj_clock_us(void) { return 1e6 * now(); }
 
 static int cmp_double(const void *a, const void *b) {
   double x = *(const double *)a, y = *(const double *)b;
@@ -330,14 +335,49 @@ int main(int argc, char **argv) {
          "mj_forward %.3g us, mj_step %.3g us\n", rounds, reps, 1e6 * mm, 1e6 * mf, 1e6 * ms);
   printf("ratio mbcc / mj_forward %.3f (per-round range %.3f-%.3f; fastest rounds %.3f), mbcc / mj_step %.3f\n",
          mrf, rf[0], rf[rounds - 1], fastest, mrs);
+
+  /* where the time goes, apart from the interleaved timing above (the timer
+     callback costs MuJoCo a clock read per stage): mbcc's eval alone against
+     its eval + factor + solve, in turn; MuJoCo's own stage timers over the
+     same number of mj_forward calls */
+  double *te = malloc(sizeof(double) * (size_t)rounds), *ta = malloc(sizeof(double) * (size_t)rounds);
+  for (int r = 0; r < rounds; r++) {
+    double t0 = now();
+    for (int k = 0; k < reps; k++) m->eval(m, 0, q, v, e.Kx, e.rhs, e.phi, e.phid, e.work);
+    double t1 = now();
+    for (int k = 0; k < reps; k++) mbcc_accel(&e, q, v);
+    double t2 = now();
+    te[r] = (t1 - t0) / reps;
+    ta[r] = (t2 - t1) / reps;
+  }
+  double me = median(te, rounds), ma = median(ta, rounds);
+  mjcb_time = mj_clock_us;
+  for (int k = 0; k < mjNTIMER; k++) d->timer[k].duration = 0, d->timer[k].number = 0;
+  for (int k = 0; k < rounds * reps; k++) mj_forward(mj, d);
+  mjcb_time = NULL;
+#define MJ_US(t) (d->timer[t].number ? d->timer[t].duration / d->timer[t].number : 0.0)
+  /* smooth dynamics: the position stage less making the constraints, velocity, actuation, acceleration;
+     constraints: making their rows and the solver */
+  double mj_make = MJ_US(mjTIMER_POS_MAKE) + MJ_US(mjTIMER_POS_PROJECT);
+  double mj_smooth = MJ_US(mjTIMER_POSITION) - mj_make + MJ_US(mjTIMER_VELOCITY) + MJ_US(mjTIMER_ACTUATION) +
+                     MJ_US(mjTIMER_ACCELERATION);
+  double mj_cons = mj_make + MJ_US(mjTIMER_CONSTRAINT);
+  printf("where the time goes (medians of %d rounds, apart from the timing above): mbcc eval %.3g us, "
+         "factor + solve %.3g us; MuJoCo's stage timers (clock reads included: %.3g us a call in all): "
+         "smooth dynamics %.3g us (kinematics %.3g, inertia and its factorization %.3g, velocity %.3g, "
+         "acceleration %.3g), constraints %.3g us (making the %d rows %.3g, solving %.3g)\n",
+         rounds, 1e6 * me, 1e6 * (ma - me), MJ_US(mjTIMER_FORWARD), mj_smooth, MJ_US(mjTIMER_POS_KINEMATICS),
+         MJ_US(mjTIMER_POS_INERTIA), MJ_US(mjTIMER_VELOCITY), MJ_US(mjTIMER_ACCELERATION), mj_cons, d->nefc, mj_make,
+         MJ_US(mjTIMER_CONSTRAINT));
   if (csv) {
     FILE *f = fopen(csv, "w");
     if (!f) { fprintf(stderr, "mujoco_peer: error: cannot write %s\n", csv); return 2; }
     fprintf(f, "model,n,mj_nv,mj_nefc,vel_map_rel,acc_rel_diff_rest,acc_rel_diff,acc_max,mbcc_us,forward_us,step_us,"
-               "ratio_forward,ratio_forward_lo,ratio_forward_hi,ratio_step,rounds,reps,ratio_fastest\n");
-    fprintf(f, "%s,%d,%d,%d,%.2g,%.3g,%.3g,%.4g,%.4g,%.4g,%.4g,%.4f,%.4f,%.4f,%.4f,%d,%d,%.4f\n", m->name, m->n,
-            mj->nv, d->nefc, vrel, arel0, arel, amax, 1e6 * mm, 1e6 * mf, 1e6 * ms, mrf, rf[0], rf[rounds - 1], mrs,
-            rounds, reps, fastest);
+               "ratio_forward,ratio_forward_lo,ratio_forward_hi,ratio_step,rounds,reps,ratio_fastest,mbcc_eval_us,"
+               "mbcc_factor_solve_us,mj_smooth_us,mj_constraint_us\n");
+    fprintf(f, "%s,%d,%d,%d,%.2g,%.3g,%.3g,%.4g,%.4g,%.4g,%.4g,%.4f,%.4f,%.4f,%.4f,%d,%d,%.4f,%.4g,%.4g,%.4g,%.4g\n",
+            m->name, m->n, mj->nv, d->nefc, vrel, arel0, arel, amax, 1e6 * mm, 1e6 * mf, 1e6 * ms, mrf, rf[0],
+            rf[rounds - 1], mrs, rounds, reps, fastest, 1e6 * me, 1e6 * (ma - me), mj_smooth, mj_cons);
     fclose(f);
   }
   mj_deleteData(d);
