@@ -99,7 +99,13 @@ void dgesvd_(const char *jobu, const char *jobvt, const int *m, const int *n, do
 
 /* After a numerical failure: is the configuration where the run stopped a
  * singular one (dead point, change point, lock-up)?  The singular values of
- * the constraint Jacobian D at the last accepted state tell. */
+ * the constraint Jacobian D tell, at the state the failed factorization,
+ * solve or projection was at (a stage or iterate inside the step), else at
+ * the last accepted state.  Bands: below 1e-6 of the largest, singular to
+ * round-off; below 1e-5, ill-conditioned enough that Newton's corrections
+ * stall (generalized-alpha stops there, a few microseconds before the point);
+ * a regular mechanism at its design pose measures 1e-3 to 1e-1 (the
+ * flexible sports car, whose modal columns are small, 7e-4). */
 static void diagnose_configuration(mb_sim *sim, const char *prog) {
   const mb_model *m = sim->m;
   int nc = m->nc, nv = m->nv;
@@ -109,22 +115,30 @@ static void diagnose_configuration(mb_sim *sim, const char *prog) {
   int lwork = 8 * (nc + nv) + 64;
   double *work = malloc(sizeof(double) * (size_t)lwork);
   if (!D || !sv || !work) { free(D); free(sv); free(work); return; }
-  m->eval(m, sim->t, sim->q, sim->v, sim->Kx, sim->rhs, sim->phi, sim->nu, sim->work);
+  int at_failure = sim->fail_state;
+  double t = at_failure ? sim->fail_state_t : sim->t;
+  m->eval(m, t, at_failure ? sim->fail_q : sim->q, at_failure ? sim->fail_v : sim->v, sim->Kx, sim->rhs, sim->phi,
+          sim->nu, sim->work);
   for (int j = 0; j < nv; j++)
     for (int p = m->Kp[j]; p < m->Kp[j + 1]; p++)
       if (m->Ki[p] >= nv) D[(size_t)(m->Ki[p] - nv) + (size_t)nc * (size_t)j] = sim->Kx[p];
   int info = 0, one = 1;
   dgesvd_("N", "N", &nc, &nv, D, &nc, sv, NULL, &one, NULL, &one, work, &lwork, &info);
   int k = nc < nv ? nc : nv;
+  const char *where = at_failure ? " (the state it failed at)" : " (the last accepted state)";
   if (info == 0 && sv[0] > 0) {
     double ratio = sv[k - 1] / sv[0];
     if (ratio < 1e-6)
-      fprintf(stderr, "%s: note: at t = %.9g the constraint Jacobian is nearly singular (smallest/largest "
+      fprintf(stderr, "%s: note: at t = %.9g%s the constraint Jacobian is nearly singular (smallest/largest "
               "singular value %.2g): a singular configuration (dead point, change point or lock-up)\n",
-              prog, sim->t, ratio);
+              prog, t, where, ratio);
+    else if (ratio < 1e-5)
+      fprintf(stderr, "%s: note: at t = %.9g%s the constraint Jacobian is ill-conditioned (smallest/largest "
+              "singular value %.2g): near a singular configuration (dead point, change point or lock-up)\n",
+              prog, t, where, ratio);
     else
-      fprintf(stderr, "%s: note: at t = %.9g the constraint Jacobian is regular (smallest/largest singular "
-              "value %.2g)\n", prog, sim->t, ratio);
+      fprintf(stderr, "%s: note: at t = %.9g%s the constraint Jacobian is regular (smallest/largest singular "
+              "value %.2g)\n", prog, t, where, ratio);
   }
   free(D); free(sv); free(work);
 }

@@ -349,7 +349,7 @@ int mb_genalpha_run(mb_sim *s, mb_output_fn out, void *user) {
       double rate = 0;
       int ns = MB_OK;
       int res = ga_newton(s, &g, hh, &ns, &rate);
-      if (res == GA_FAILED) { st = mb_sim_fail(s, s->t + hh, ns, "implicit step"); goto done; }
+      if (res == GA_FAILED) { st = mb_sim_fail_at(s, s->t + hh, g.q1, g.v1, ns, "implicit step"); goto done; }
       if (res == GA_DIVERGED) {
         s->stats.newton_failures++;
         s->stats.rejected++;

@@ -47,6 +47,14 @@ int mb_sim_fail(mb_sim *s, double t, int status, const char *what) {
   return status;
 }
 
+int mb_sim_fail_at(mb_sim *s, double t, const mb_real *q, const mb_real *v, int status, const char *what) {
+  if (s->fail_q && q != s->fail_q) memcpy(s->fail_q, q, sizeof(mb_real) * (size_t)s->m->nq);
+  if (s->fail_v && v != s->fail_v) memcpy(s->fail_v, v, sizeof(mb_real) * (size_t)s->m->nv);
+  s->fail_state = s->fail_q && s->fail_v;
+  s->fail_state_t = t;
+  return mb_sim_fail(s, t, status, what);
+}
+
 int mb_sim_init(mb_sim *s, const mb_model *m, mb_solver *ls, const mb_settings *set) {
   memset(s, 0, sizeof *s);
   s->m = m;
@@ -72,8 +80,10 @@ int mb_sim_init(mb_sim *s, const mb_model *m, mb_solver *ls, const mb_settings *
   s->dv = calloc((size_t)m->n + 1, sizeof(mb_real));
   s->work = malloc(mb_model_worksize(m) + 16);
   s->yout = calloc(ny + 1, sizeof(mb_real));
+  s->fail_q = calloc((size_t)m->nq + 1, sizeof(mb_real));
+  s->fail_v = calloc((size_t)m->nv + 1, sizeof(mb_real));
   s->angle_hmax = INFINITY;
-  if (!s->yout || !s->q || !s->v || !s->Kx || !s->rhs || !s->x || !s->phi || !s->nu || !s->y || !s->ytmp ||
+  if (!s->yout || !s->fail_q || !s->fail_v || !s->q || !s->v || !s->Kx || !s->rhs || !s->x || !s->phi || !s->nu || !s->y || !s->ytmp ||
       !s->qsave || !s->dv || !s->work)
     return MB_ERR_NOMEM;
   for (int i = 0; i < 7; i++)
@@ -89,6 +99,7 @@ int mb_sim_init(mb_sim *s, const mb_model *m, mb_solver *ls, const mb_settings *
 void mb_sim_free(mb_sim *s) {
   free(s->q); free(s->v); free(s->Kx); free(s->rhs); free(s->x); free(s->phi); free(s->nu);
   free(s->y); free(s->ytmp); free(s->qsave); free(s->dv); free(s->work); free(s->yout);
+  free(s->fail_q); free(s->fail_v);
   for (int i = 0; i < 7; i++) free(s->k[i]);
   memset(s, 0, sizeof *s);
 }
@@ -130,7 +141,7 @@ int mb_sim_accel(mb_sim *s, double t, const mb_real *q, const mb_real *v, mb_rea
                  mb_real *lambda) {
   const mb_model *m = s->m;
   int st = assemble_factor(s, t, q, v);
-  if (st) return mb_sim_fail(s, t, st, "factorization of K");
+  if (st) return mb_sim_fail_at(s, t, q, v, st, "factorization of K");
   if (s->set.stabilization == MB_STAB_BAUMGARTE) {
     /* gamma - 2 alpha phidot - beta^2 phi */
     for (int r = 0; r < m->nc; r++)
@@ -138,7 +149,7 @@ int mb_sim_accel(mb_sim *s, double t, const mb_real *q, const mb_real *v, mb_rea
   }
   memcpy(s->x, s->rhs, sizeof(mb_real) * (size_t)m->n);
   st = solve(s, s->x);
-  if (st) return mb_sim_fail(s, t, st, "solution for the accelerations");
+  if (st) return mb_sim_fail_at(s, t, q, v, st, "solution for the accelerations");
   memcpy(vd, s->x, sizeof(mb_real) * (size_t)m->nv);
   if (lambda) memcpy(lambda, s->x + m->nv, sizeof(mb_real) * (size_t)m->nc);
   return MB_OK;
@@ -159,13 +170,13 @@ int mb_sim_project(mb_sim *s, double t, mb_real *q, mb_real *v) {
      K [dq; mu] = [0; -phi] */
   for (int it = 0;; it++) {
     int st = assemble_factor(s, t, q, v);
-    if (st) return mb_sim_fail(s, t, st, "projection");
+    if (st) return mb_sim_fail_at(s, t, q, v, st, "projection");
     if (max_abs(s->phi, m->nc) <= s->set.projection_tol) break;
-    if (it >= 8) return mb_sim_fail(s, t, MB_ERR_PROJECTION, "position projection");
+    if (it >= 8) return mb_sim_fail_at(s, t, q, v, MB_ERR_PROJECTION, "position projection");
     for (int i = 0; i < nv; i++) s->dv[i] = 0;
     for (int r = 0; r < m->nc; r++) s->dv[nv + r] = -s->phi[r];
     st = solve(s, s->dv);
-    if (st) return mb_sim_fail(s, t, st, "position projection");
+    if (st) return mb_sim_fail_at(s, t, q, v, st, "position projection");
     mb_model_qincrement(m, q, s->dv);
     mb_model_normalize(m, q);
     s->stats.projections++;
@@ -174,7 +185,7 @@ int mb_sim_project(mb_sim *s, double t, mb_real *q, mb_real *v) {
   for (int i = 0; i < nv; i++) s->dv[i] = 0;
   for (int r = 0; r < m->nc; r++) s->dv[nv + r] = -s->nu[r];
   int st = solve(s, s->dv);
-  if (st) return mb_sim_fail(s, t, st, "velocity projection");
+  if (st) return mb_sim_fail_at(s, t, q, v, st, "velocity projection");
   for (int i = 0; i < nv; i++) v[i] += s->dv[i];
   (void)n;
   return MB_OK;
@@ -279,6 +290,7 @@ static double dp_error(int ny, const mb_real *y, const mb_real *y5, double h, mb
 }
 
 int mb_sim_step_budget(mb_sim *s, double h) {
+  s->fail_state = 0; /* a new step: what failed in the last one's attempts no longer matters */
   if ((double)(s->stats.steps + s->stats.rejected) < s->set.max_steps) return MB_OK;
   s->fail_time = s->t;
   snprintf(s->fail_detail, sizeof s->fail_detail,

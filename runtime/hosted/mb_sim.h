@@ -51,6 +51,11 @@ typedef struct {
   mb_real *q, *v;            /* current state (nq, nv) */
   double fail_time;         /* time of a failure */
   char fail_detail[160];    /* what failed */
+  /* the state a failed factorization, solve or projection was at (fail_state:
+     1 when recorded in the current step), for the diagnosis of its cause */
+  int fail_state;
+  double fail_state_t;
+  mb_real *fail_q, *fail_v;
   /* workspaces */
   mb_real *Kx, *rhs, *x, *phi, *nu, *y, *ytmp, *k[7], *qsave, *dv; /* nu: phid = D v - nu */
   void *work;
@@ -107,6 +112,8 @@ const char *mb_integrator_name(int integrator);
 
 /* for the integrators (integrate.c, genalpha.c) */
 int mb_sim_fail(mb_sim *s, double t, int status, const char *what);
+/* mb_sim_fail at the state (q, v) the failure happened at, kept in fail_q, fail_v */
+int mb_sim_fail_at(mb_sim *s, double t, const mb_real *q, const mb_real *v, int status, const char *what);
 double mb_sim_clock(void); /* monotonic seconds */
 int mb_sim_finish_step(mb_sim *s, double t);
 /* MB_ERR_STEP_BUDGET (with the detail) once steps + rejections reach max_steps */
