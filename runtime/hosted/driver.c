@@ -116,13 +116,18 @@ static void diagnose_configuration(mb_sim *sim, const char *prog) {
   double *work = malloc(sizeof(double) * (size_t)lwork);
   if (!D || !sv || !work) { free(D); free(sv); free(work); return; }
   int at_failure = sim->fail_state;
+  /* a stage that blew up holds no configuration to judge: the last accepted state then */
+  for (int i = 0; at_failure && i < m->nq; i++) at_failure = isfinite(sim->fail_q[i]);
+  for (int i = 0; at_failure && i < nv; i++) at_failure = isfinite(sim->fail_v[i]);
   double t = at_failure ? sim->fail_state_t : sim->t;
   m->eval(m, t, at_failure ? sim->fail_q : sim->q, at_failure ? sim->fail_v : sim->v, sim->Kx, sim->rhs, sim->phi,
           sim->nu, sim->work);
   for (int j = 0; j < nv; j++)
     for (int p = m->Kp[j]; p < m->Kp[j + 1]; p++)
       if (m->Ki[p] >= nv) D[(size_t)(m->Ki[p] - nv) + (size_t)nc * (size_t)j] = sim->Kx[p];
-  int info = 0, one = 1;
+  int info = 0, one = 1, finite = 1;
+  for (size_t i = 0; i < (size_t)nc * (size_t)nv; i++) finite &= isfinite(D[i]) != 0;
+  if (!finite) { free(D); free(sv); free(work); return; } /* the error already says what is not finite */
   dgesvd_("N", "N", &nc, &nv, D, &nc, sv, NULL, &one, NULL, &one, work, &lwork, &info);
   int k = nc < nv ? nc : nv;
   const char *where = at_failure ? " (the state it failed at)" : " (the last accepted state)";
