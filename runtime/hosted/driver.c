@@ -98,7 +98,8 @@ void dgesvd_(const char *jobu, const char *jobvt, const int *m, const int *n, do
              double *work, const int *lwork, int *info);
 
 /* After a numerical failure: is the configuration where the run stopped a
- * singular one (dead point, change point, lock-up)?  The singular values of
+ * singular one (dead point, change point, lock-up), or did the integration
+ * blow up (the velocities by then)?  The singular values of
  * the constraint Jacobian D tell, at the state the failed factorization,
  * solve or projection was at (a stage or iterate inside the step), else at
  * the last accepted state.  Bands: below 1e-6 of the largest, singular to
@@ -119,6 +120,22 @@ static void diagnose_configuration(mb_sim *sim, const char *prog) {
   /* a stage that blew up holds no configuration to judge: the last accepted state then */
   for (int i = 0; at_failure && i < m->nq; i++) at_failure = isfinite(sim->fail_q[i]);
   for (int i = 0; at_failure && i < nv; i++) at_failure = isfinite(sim->fail_v[i]);
+  /* velocities a million times the start's (or 1, m/s or rad/s) by the
+     failure: the integration blew up (an explicit step too large for the
+     stiffest mode or element, or a force growing without bound), and a
+     singular D there says nothing about the mechanism */
+  double v0 = 1, vnow = 0;
+  for (int i = 0; i < nv; i++) v0 = fmax(v0, fabs((double)m->v0[i]));
+  for (int i = 0; i < nv; i++) vnow = fmax(vnow, fabs((double)sim->v[i]));
+  for (int i = 0; at_failure && i < nv; i++) vnow = fmax(vnow, fabs((double)sim->fail_v[i]));
+  if (!(vnow <= 1e6 * v0)) {
+    fprintf(stderr, "%s: note: by t = %.9g the velocities had grown to %.3g (the largest velocity coordinate; %.3g "
+            "at the start): the integration blew up (a step too large for the stiffest mode or force element, "
+            "or a force growing without bound), not a singular configuration\n",
+            prog, at_failure ? sim->fail_state_t : sim->t, vnow, v0);
+    free(D); free(sv); free(work);
+    return;
+  }
   double t = at_failure ? sim->fail_state_t : sim->t;
   m->eval(m, t, at_failure ? sim->fail_q : sim->q, at_failure ? sim->fail_v : sim->v, sim->Kx, sim->rhs, sim->phi,
           sim->nu, sim->work);
