@@ -5,7 +5,8 @@
 # wide (the car is 1.75 m wide: they never touch, and nothing couples them):
 # the vehicle model of the scaling measurements (make scaling,
 # scripts/scaling.sh).  Each car is one instance of the subsystem, moved into
-# its lane by the parameter y0; the simulation settings are those of
+# its lane by the instance's `position` (its corners and tyres, instances
+# inside it, move with it); the simulation settings are those of
 # models/sports_car.yaml (static equilibrium first, steps of at most 1 ms).
 # The subsystem is named by its absolute path, so the model may be written
 # anywhere.  N: a whole number from 1 to 500.
@@ -30,6 +31,6 @@ roads:
 subsystems:                       # car k in lane k: its centre plane at y = (k - 1) lane_width
 EOS
 for ((k = 1; k <= n; k++)); do
-  echo "  car$k: {file: $car, prefix: car${k}_, parameters: {y0: $((k - 1)) * lane_width}}"
+  echo "  car$k: {file: $car, prefix: car${k}_, position: [0, $((k - 1)) * lane_width, 0]}"
 done
 echo "simulation: {equilibrium: true, end_time: 2.0, output_step: 0.001, max_step: 0.001}   # as models/sports_car.yaml's"

@@ -9,8 +9,9 @@
 #   2. over 0.05 s at 60 km/h each car of the 2-car fleet, the second 3.5 m
 #      to the left, moves as the single car (chassis height and x, pitch, the
 #      four tyre loads, to 1e-9 relative): the chassis from the modal file
-#      is the FE chassis made rigid, the corners moved by y0 are the same
-#      corners.  Both start at the design pose, not at a static equilibrium
+#      is the FE chassis made rigid, and the car moved by its instance's
+#      `position` (its corners and tyres, instances inside it, with it) is
+#      the same car.  Both start at the design pose, not at a static equilibrium
 #      computed first: Newton leaves the free directions (the car's x, the
 #      wheels' spin, ...) where its last step put them, which differs
 #      between one car and two by ~1e-6, and the tyres' slips then differ by

@@ -15,7 +15,19 @@
 #   4. the sports car built from corner and tyre subsystems
 #      (models/sports_car.yaml, models/sports_car/car.yaml, models/subsystems/)
 #      gives the same CSV as tests/compose/sports_car_flat.yaml, the same car
-#      written out by hand, rigid and flexible chassis.
+#      written out by hand, rigid and flexible chassis;
+#   5. moved instances ('position'): tests/compose/subsystem_moved.yaml (the
+#      corner moved, and mirrored and moved; a mirrored, moved rack holding a
+#      moved link and a mirrored, moved link: nested placements compose; a
+#      run-time point moved) emits the same C as subsystem_moved_by_hand.yaml,
+#      the same written out at the moved places; so does a flexible body of
+#      an FE model of its own ('line', global nodes) in a moved instance
+#      against the same written by hand; 'position: [0, 0, 0]' emits the
+#      same C as no 'position';
+#   6. errors at the instance's 'position' (file:line:col, exit status 2): not
+#      a list of 3 numbers or expressions, a run-time parameter in it, a
+#      flexible body of an FE file (global nodes) in a moved instance, also
+#      nested; an unknown instance key lists 'position'.
 set -u
 cd "$(dirname "$0")/.."
 # shellcheck source=tests/shell_setup.sh
@@ -142,6 +154,131 @@ for scene in rigid base; do
   cmp -s car_sub_$scene.csv car_hand_$scene.csv ||
     err "the car with subsystem corners ($scene) moves otherwise than the car written out: $(diff car_sub_$scene.csv car_hand_$scene.csv | head -4)"
 done
+
+# 5. moved instances: the same C as written out by hand
+same_code() { # same_code A.yaml B.yaml WHAT: A and B emit the same C (apart from origin and locations)
+  local a=gen_${1##*/} b=gen_${2##*/}
+  a=${a%.yaml} b=${b%.yaml}
+  "$MBCC" compile "$1" -o "$a" > log 2>&1 || { err "compile $1: $(head -5 log)"; return; }
+  "$MBCC" compile "$2" -o "$b" > log 2>&1 || { err "compile $2: $(head -5 log)"; return; }
+  strip_origin "$a"
+  strip_origin "$b"
+  [ "$(ls "$a.stripped" | wc -l)" -ge 3 ] || err "$1 emitted fewer than 3 files"
+  [ "$(cd "$a.stripped" && sha256sum -- * | sha256sum)" = "$(cd "$b.stripped" && sha256sum -- * | sha256sum)" ] ||
+    err "$3: $(diff -r "$a.stripped" "$b.stripped" | head -20)"
+}
+same_code "$root/tests/compose/subsystem_moved.yaml" "$root/tests/compose/subsystem_moved_by_hand.yaml" \
+  "the moved (and nested, mirrored) instances emit other code than the same written out at the moved places"
+# a position of all zeros moves nothing: the code of subsystem_pair.yaml
+mkdir -p zero/subsystems
+cp "$root/tests/compose/subsystems/corner.yaml" zero/subsystems/
+cp "$root/tests/compose/subsystem_pair.yaml" zero/
+sed 's|^  left:  {file: subsystems/corner.yaml, |  left:  {file: subsystems/corner.yaml, position: [0, 0.0, -0], |' \
+  "$root/tests/compose/subsystem_pair.yaml" > zero/pair_at_zero.yaml
+grep -q 'position: \[0, 0.0, -0\]' zero/pair_at_zero.yaml || err "could not add 'position' to subsystem_pair.yaml"
+same_code zero/pair_at_zero.yaml zero/subsystem_pair.yaml "'position: [0, 0, 0]' changes the emitted code"
+# a flexible body of a line of beams (global nodes) moves with its instance
+mkdir -p flex/parts
+cat > flex/parts/blade.yaml <<'YAML'
+subsystem:
+  attachments: [hub]
+bodies:
+  blade:
+    type: flexible
+    line: {from: [0.1, 0, 0], to: [1.1, 0.2, 0], elements: 4}
+    section: {area: 2.0e-4, Iy: 1.6667e-9, Iz: 6.6667e-9, J: 4.57e-9}
+    material: {E: 2.1e11, nu: 0.3, density: 7850}
+    reference: [0]
+joints:
+  root: {type: fixed, bodies: [hub, blade], node: 0, point: [0.1, 0, 0]}
+outputs:
+  - {name: tip, type: position, body: blade, node: 4}
+YAML
+cat > flex/moved.yaml <<'YAML'
+name: blade_moved
+gravity: [0, 0, -9.81]
+bodies:
+  hub: {type: rigid, mass: 5, inertia: [0.1, 0.1, 0.1], position: [0.5, 0.25, 1]}
+joints:
+  spin: {type: revolute, bodies: [ground, hub], point: [0.5, 0.25, 1], axis: [1, 0, 0]}
+subsystems:
+  b: {file: parts/blade.yaml, position: [0.5, 0.25, 1], attach: {hub: hub}}
+YAML
+cat > flex/by_hand.yaml <<'YAML'
+name: blade_moved
+gravity: [0, 0, -9.81]
+bodies:
+  hub: {type: rigid, mass: 5, inertia: [0.1, 0.1, 0.1], position: [0.5, 0.25, 1]}
+  b_blade:
+    type: flexible
+    line: {from: [0.1 + 0.5, 0 + 0.25, 0 + 1], to: [1.1 + 0.5, 0.2 + 0.25, 0 + 1], elements: 4}
+    section: {area: 2.0e-4, Iy: 1.6667e-9, Iz: 6.6667e-9, J: 4.57e-9}
+    material: {E: 2.1e11, nu: 0.3, density: 7850}
+    reference: [0]
+joints:
+  spin: {type: revolute, bodies: [ground, hub], point: [0.5, 0.25, 1], axis: [1, 0, 0]}
+  b_root: {type: fixed, bodies: [hub, b_blade], node: 0, point: [0.1 + 0.5, 0 + 0.25, 0 + 1]}
+outputs:
+  - {name: b_tip, type: position, body: b_blade, node: 4}
+YAML
+same_code flex/moved.yaml flex/by_hand.yaml "a flexible body of a line of beams in a moved instance emits other code than written by hand"
+
+# 6. errors at 'position'
+mkdir -p moved/parts
+cp "$root/tests/compose/subsystems/link.yaml" moved/parts/
+printf 'GRID,1,,0.,0.,0.\n' > moved/parts/beam.bdf
+cat > moved/parts/beam.yaml <<'YAML'
+subsystem:
+  attachments: [base]
+bodies:
+  beam: {type: flexible, fe_file: beam.bdf, reference: [1]}
+joints:
+  clamp: {type: fixed, bodies: [base, beam], node: 1}
+YAML
+cat > moved/parts/holder.yaml <<'YAML'
+subsystem:
+  attachments: [base]
+subsystems:
+  inner: {file: beam.yaml, attach: {base: base}}
+YAML
+bad_position() { # bad_position 'INSTANCE KEYS' FILE:LINE:COL MESSAGE
+  cat > moved/m.yaml <<YAML
+name: m
+parameters:
+  w: {value: 0.1, runtime: true}
+bodies:
+  rack: {type: rigid, mass: 1, inertia: [1, 1, 1]}
+joints:
+  fix: {type: fixed, bodies: [ground, rack], point: [0, 0, 0]}
+subsystems:
+  a: {file: parts/link.yaml, $1, attach: {rack: rack}}
+YAML
+  "$MBCC" check moved/m.yaml > bad.out 2>&1
+  local rc=$?
+  [ $rc -eq 2 ] && grep -qF "$2: error: $3" bad.out || err "instance {$1}: exit $rc, expected 2 and '$2: error: $3...': $(cat bad.out)"
+}
+bad_position "position: [1, 2]" moved/m.yaml:9:40 "'position' of subsystem instance 'a' must be a list of 3 numbers or expressions"
+bad_position "position: 0.5" moved/m.yaml:9:40 "'position' of subsystem instance 'a' must be a list of 3 numbers or expressions"
+bad_position "position: [1, [2], 3]" moved/m.yaml:9:40 "'position' of subsystem instance 'a' must be a list of 3"
+bad_position "position: [1, q, 3]" moved/m.yaml:9:44 "unknown parameter 'q'"
+bad_position "position: [1, 2 * w, 3]" moved/m.yaml:9:44 "the 'position' of a subsystem instance cannot use a run-time parameter"
+bad_position "positon: [1, 2, 3]" moved/m.yaml:9:30 "unknown key in subsystem instance 'a' (expected file, prefix, mirror, position, attach, parameters)"
+fe_message="this subsystem instance cannot be moved ('position'): its flexible body"
+sed -i 's|^  a: {.*|  a: {file: parts/beam.yaml, position: [0, lane, 0], attach: {base: rack}}|; s|^  w: .*|  lane: 3.5|' moved/m.yaml
+"$MBCC" check moved/m.yaml > bad.out 2>&1
+rc=$?
+[ $rc -eq 2 ] && grep -qF "moved/m.yaml:9:40: error: $fe_message 'a_beam' reads an FE file" bad.out &&
+  grep -qF "moved/parts/beam.yaml:4:35: note: the FE file of 'a_beam' is named here" bad.out &&
+  grep -qF "modal_file" bad.out || err "an FE-file body in a moved instance: exit $rc: $(cat bad.out)"
+sed -i 's|^  a: {.*|  a: {file: parts/holder.yaml, position: [1, 0, 0], attach: {base: rack}}|' moved/m.yaml
+"$MBCC" check moved/m.yaml > bad.out 2>&1
+rc=$?
+[ $rc -eq 2 ] && grep -qF "moved/m.yaml:9:42: error: $fe_message 'a_inner_beam' reads an FE file" bad.out ||
+  err "an FE-file body nested in a moved instance: exit $rc: $(cat bad.out)"
+# not moved (every component 0): the FE file is read as usual
+sed -i 's|position: \[1, 0, 0\]|position: [0, 0, 0]|' moved/m.yaml
+"$MBCC" check moved/m.yaml > bad.out 2>&1
+grep -qF "$fe_message" bad.out && err "an instance at 'position: [0, 0, 0]' is taken as moved: $(cat bad.out)"
 
 [ -n "${KEEP:-}" ] && cp -r . "$KEEP"
 exit $fail

@@ -418,6 +418,28 @@ bool compose_is_mirrored(const yaml_node_t *n) {
 
 double compose_mirror_value(double v) { return v == 0 ? 0.0 : -v; }
 
+bool compose_placement_of(const yaml_node_t *n, compose_placement *p) {
+  memset(p, 0, sizeof *p);
+  if (n->type != YAML_SCALAR_NODE || n->tag == NULL) return false;
+  const char *tag = (const char *)n->tag;
+  if (strcmp(tag, COMPOSE_MIRROR_TAG) == 0) {
+    p->negate = true;
+    return true;
+  }
+  size_t head = strlen(COMPOSE_PLACED_TAG);
+  if (strncmp(tag, COMPOSE_PLACED_TAG, head) != 0) return false;
+  const char *at = tag + head;
+  p->negate = *at == '-';
+  if (*at) at++;
+  while (*at == ';' && p->nterms <= LIMIT_INCLUDE_DEPTH) { /* compose.c wrote it: well formed */
+    p->subtract[p->nterms] = at[1] == '-';
+    char *end = NULL;
+    p->node[p->nterms++] = (int)strtol(at + 2, &end, 10);
+    at = end;
+  }
+  return true;
+}
+
 enum { KIND_BODY, KIND_JOINT, KIND_DRIVER, KIND_FORCE, KIND_PARAM, KIND_COUNT };
 static const char *const kind_section[KIND_COUNT] = {"bodies", "joints", "drivers", "forces", "parameters"};
 static const char *const kind_word[KIND_COUNT] = {"body", "joint", "driver", "force", "parameter"};
@@ -455,6 +477,14 @@ typedef struct scope {
   char *prefix;         /* the full prefix of its names (the enclosing ones' first) */
   size_t own_prefix;    /* the length of the enclosing prefix, where its own begins */
   bool mirror;          /* y -> -y, the enclosing instances' mirrors included */
+  /* the translation of its points, per axis: the offsets (scalars of the
+     composed document) of this instance and the enclosing ones, innermost
+     first, each added or subtracted (COMPOSE_PLACED_TAG) */
+  int offset_node[3][LIMIT_INCLUDE_DEPTH + 1];
+  bool offset_subtract[3][LIMIT_INCLUDE_DEPTH + 1];
+  int noffsets[3];
+  const char *moved_path; /* the 'position' of the nearest instance that moves it, for */
+  ir_loc moved_at;        /* messages; moved_path NULL when nothing moves it */
   name_set local[KIND_COUNT]; /* its own names (and those its inner instances made), unprefixed */
   name_set attach;      /* its attachments (bodies, then the 'nodes' of the header) ... */
   char **attach_to;     /* ... and the model bodies (nodes) they map to */
@@ -635,68 +665,174 @@ static bool value_is(yaml_document_t *doc, int map, const char *key, const char 
   return slot != NULL && scalar_equals(yaml_document_get_node(doc, *slot), text);
 }
 
-/* y -> -y on element 'e' of section 'kind' (a reflection: positions flip
- * y; rotation axes, angular velocities and torques are axial vectors and
- * flip x and z, so that a mirrored joint turns by the same angle as its
- * original; inertia products with one y index change sign) */
-static void mirror_element(instancer *g, int kind, int e) {
+static bool scope_moves(const scope *s) { return s->noffsets[0] + s->noffsets[1] + s->noffsets[2] > 0; }
+
+/* coordinate 'axis' of a point of scope 'ctx', *item: a fresh scalar that
+ * says how the instances placed it (mirrored, then moved; compose.h), or as
+ * flip_item mirrors it when nothing moves that coordinate */
+static void place_item(yaml_document_t *doc, int axis, yaml_node_item_t *item, void *ctx) {
+  const scope *s = ctx;
+  yaml_node_t *n = yaml_document_get_node(doc, *item);
+  if (axis >= 3 || n->type != YAML_SCALAR_NODE) return;
+  bool negate = axis == 1 && s->mirror;
+  if (s->noffsets[axis] == 0) {
+    unsigned y_only = POLAR;
+    if (negate) flip_item(doc, axis, item, &y_only);
+    return;
+  }
+  char tag[sizeof COMPOSE_PLACED_TAG + 2 + (LIMIT_INCLUDE_DEPTH + 1) * 16];
+  int length = snprintf(tag, sizeof tag, "%s%c", COMPOSE_PLACED_TAG, negate ? '-' : '+');
+  for (int k = 0; k < s->noffsets[axis]; k++)
+    length += snprintf(tag + length, sizeof tag - (size_t)length, ";%c%d", s->offset_subtract[axis][k] ? '-' : '+',
+                       s->offset_node[axis][k]);
+  char *text = xstrndup((const char *)n->data.scalar.value, n->data.scalar.length);
+  yaml_scalar_style_t style = n->data.scalar.style;
+  int to = add_scalar_like(doc, n, tag, text);
+  yaml_document_get_node(doc, to)->data.scalar.style = style;
+  free(text);
+  *item = to;
+}
+
+/* the point [x, y, z] in *slot as scope s places it (a fresh list: the
+ * original may be shared through anchors) */
+static void place(yaml_document_t *doc, scope *s, yaml_node_item_t *slot) {
+  if (slot == NULL || (!s->mirror && !scope_moves(s))) return;
+  yaml_node_t *v = yaml_document_get_node(doc, *slot);
+  if (v == NULL || v->type != YAML_SEQUENCE_NODE) return;
+  *slot = copy_sequence(doc, slot, place_item, s);
+}
+
+static void place_row(yaml_document_t *doc, int index, yaml_node_item_t *item, void *ctx) {
+  (void)index;
+  place(doc, ctx, item);
+}
+
+/* every point of the list of points in *slot */
+static void place_rows(yaml_document_t *doc, scope *s, yaml_node_item_t *slot) {
+  if (slot == NULL || (!s->mirror && !scope_moves(s))) return;
+  yaml_node_t *v = yaml_document_get_node(doc, *slot);
+  if (v == NULL || v->type != YAML_SEQUENCE_NODE) return;
+  *slot = copy_sequence(doc, slot, place_row, s);
+}
+
+/* a body without 'position' sits at the origin: in a moved instance it gets
+ * the position [0, 0, 0] placed, at the body's mapping */
+static void add_origin(instancer *g, int e) {
   yaml_document_t *doc = g->c->doc;
+  yaml_node_t *body = yaml_document_get_node(doc, e);
+  yaml_node_t like = *body; /* its marks, for the new nodes */
+  int key = add_scalar_like(doc, &like, NULL, "position");
+  int list = yaml_document_add_sequence(doc, NULL, YAML_FLOW_SEQUENCE_STYLE);
+  if (!list) out_of_memory();
+  for (int i = 0; i < 3; i++)
+    if (!yaml_document_append_sequence_item(doc, list, add_scalar_like(doc, &like, NULL, "0"))) out_of_memory();
+  yaml_node_t *l = yaml_document_get_node(doc, list);
+  l->start_mark = like.start_mark;
+  l->end_mark = like.end_mark;
+  if (!yaml_document_append_mapping_pair(doc, e, key, list)) out_of_memory();
+  place(doc, g->s, value_slot(doc, e, "position"));
+}
+
+/* an FE file's nodes are global: they cannot follow a moved instance */
+static bool refuse_fe_file(instancer *g, int e, const char *what, const char *name) {
+  yaml_document_t *doc = g->c->doc;
+  yaml_node_item_t *fe = value_slot(doc, e, "fe_file");
+  if (fe == NULL || !scope_moves(g->s)) return false;
+  diag_error(g->s->moved_path, g->s->moved_at,
+             "this subsystem instance cannot be moved ('position'): its %s '%s' reads an FE file (fe_file), whose "
+             "node positions are global and would stay where they are; read the body from a modal file instead "
+             "(modal_file: its nodes are in body axes and move with the body's 'position')", what, name);
+  diag_note(g->s->path, mark_loc(yaml_document_get_node(doc, *fe)->start_mark), "the FE file of '%s' is named here", name);
+  g->ok = false;
+  return true;
+}
+
+/* element 'e' (named 'name') of section 'kind' as the instance places it:
+ * mirrored (y -> -y, a reflection: positions flip y; rotation axes, angular
+ * velocities and torques are axial vectors and flip x and z, so that a
+ * mirrored joint turns by the same angle as its original; inertia products
+ * with one y index change sign), then moved: its points (global positions)
+ * translated, its directions not */
+static void place_element(instancer *g, int kind, int e, const char *name) {
+  yaml_document_t *doc = g->c->doc;
+  scope *s = g->s;
+  bool mirror = s->mirror;
   static const unsigned frame_axes[3] = {POLAR, AXIAL, POLAR}; /* rows x, y, z of a proper mirrored frame */
   static const unsigned six[1] = {0x2Au}; /* 6-vectors: y, then the x and z rotations */
   if (kind == KIND_BODY) {
-    if (value_is(doc, e, "type", "flexible")) {
+    bool flexible = value_is(doc, e, "type", "flexible");
+    if (flexible && mirror) {
       yaml_node_t *n = yaml_document_get_node(doc, e);
-      diag_error(g->s->path, mark_loc(n->start_mark), "a flexible body cannot be mirrored (mirror: true) yet");
+      diag_error(s->path, mark_loc(n->start_mark), "a flexible body cannot be mirrored (mirror: true) yet");
       g->ok = false;
       return;
     }
-    flip(doc, value_slot(doc, e, "position"), POLAR);
-    flip(doc, value_slot(doc, e, "velocity"), POLAR);
-    flip(doc, value_slot(doc, e, "angular_velocity"), AXIAL);
-    yaml_node_item_t *o = value_slot(doc, e, "orientation");
-    if (o != NULL) {
-      yaml_node_t *on = yaml_document_get_node(doc, *o);
-      if (on->type == YAML_SEQUENCE_NODE) flip(doc, o, 0xAu); /* e1, e3 */
-      else flip(doc, value_slot(doc, *o, "axis"), AXIAL);
+    if (refuse_fe_file(g, e, "flexible body", name)) return;
+    /* an FE model of the body's own ('line', 'nodes') is global: it moves,
+       and the body frame (by default its first reference node) with it */
+    bool own_fe = flexible && value_slot(doc, e, "modal_file") == NULL;
+    if (own_fe) {
+      yaml_node_item_t *line = value_slot(doc, e, "line");
+      if (line != NULL) {
+        place(doc, s, value_slot(doc, *line, "from"));
+        place(doc, s, value_slot(doc, *line, "to"));
+      }
+      place_rows(doc, s, value_slot(doc, e, "nodes"));
     }
-    yaml_node_item_t *in = value_slot(doc, e, "inertia");
-    if (in != NULL) {
-      yaml_node_t *n = yaml_document_get_node(doc, *in);
-      int count = n->type == YAML_SEQUENCE_NODE ? (int)(n->data.sequence.items.top - n->data.sequence.items.start) : 0;
-      bool matrix = count == 3 && yaml_document_get_node(doc, n->data.sequence.items.start[0])->type == YAML_SEQUENCE_NODE;
-      static const unsigned products[3] = {2u, 5u, 2u}; /* Ixy, Iyz (and their transposes) */
-      if (matrix) flip_rows(doc, in, products, 3);
-      else if (count == 6) flip(doc, in, 0x28u); /* [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] */
+    if (value_slot(doc, e, "position") != NULL) place(doc, s, value_slot(doc, e, "position"));
+    else if (scope_moves(s) && !own_fe) add_origin(g, e);
+    if (mirror) {
+      flip(doc, value_slot(doc, e, "velocity"), POLAR);
+      flip(doc, value_slot(doc, e, "angular_velocity"), AXIAL);
+      yaml_node_item_t *o = value_slot(doc, e, "orientation");
+      if (o != NULL) {
+        yaml_node_t *on = yaml_document_get_node(doc, *o);
+        if (on->type == YAML_SEQUENCE_NODE) flip(doc, o, 0xAu); /* e1, e3 */
+        else flip(doc, value_slot(doc, *o, "axis"), AXIAL);
+      }
+      yaml_node_item_t *in = value_slot(doc, e, "inertia");
+      if (in != NULL) {
+        yaml_node_t *n = yaml_document_get_node(doc, *in);
+        int count = n->type == YAML_SEQUENCE_NODE ? (int)(n->data.sequence.items.top - n->data.sequence.items.start) : 0;
+        bool matrix = count == 3 && yaml_document_get_node(doc, n->data.sequence.items.start[0])->type == YAML_SEQUENCE_NODE;
+        static const unsigned products[3] = {2u, 5u, 2u}; /* Ixy, Iyz (and their transposes) */
+        if (matrix) flip_rows(doc, in, products, 3);
+        else if (count == 6) flip(doc, in, 0x28u); /* [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] */
+      }
     }
     yaml_node_item_t *shape = value_slot(doc, e, "shape");
     if (shape != NULL) {
-      flip(doc, value_slot(doc, *shape, "center"), POLAR);
-      flip(doc, value_slot(doc, *shape, "axis"), POLAR);
+      place(doc, s, value_slot(doc, *shape, "center"));
+      if (mirror) flip(doc, value_slot(doc, *shape, "axis"), POLAR);
     }
   } else if (kind == KIND_JOINT) {
-    flip(doc, value_slot(doc, e, "point"), POLAR);
-    static const unsigned polar[1] = {POLAR}, axial[1] = {AXIAL};
-    flip_rows(doc, value_slot(doc, e, "points"), polar, 1);
-    flip(doc, value_slot(doc, e, "axis"), value_is(doc, e, "type", "prismatic") ? POLAR : AXIAL);
-    flip_rows(doc, value_slot(doc, e, "axes"), axial, 1);
-    flip(doc, value_slot(doc, e, "reference"), POLAR);
-  } else if (kind == KIND_FORCE) {
-    static const unsigned polar[1] = {POLAR};
-    flip(doc, value_slot(doc, e, "point"), POLAR);
-    flip_rows(doc, value_slot(doc, e, "points"), polar, 1);
-    flip(doc, value_slot(doc, e, "value"), value_is(doc, e, "type", "torque") ? AXIAL : POLAR);
-    flip(doc, value_slot(doc, e, "axis"), AXIAL); /* a tyre's spin axis */
-    flip_rows(doc, value_slot(doc, e, "axes"), frame_axes, 3);
-    if (value_is(doc, e, "type", "bushing") || value_is(doc, e, "type", "field")) {
-      flip(doc, value_slot(doc, e, "preload"), six[0]);
-      if (value_is(doc, e, "type", "field")) { /* D K D, D = diag(1, -1, 1, -1, 1, -1) */
-        static const unsigned rows[6] = {0x2Au, 0x15u, 0x2Au, 0x15u, 0x2Au, 0x15u};
-        flip_rows(doc, value_slot(doc, e, "stiffness"), rows, 6);
-        flip_rows(doc, value_slot(doc, e, "damping"), rows, 6);
-      }
+    place(doc, s, value_slot(doc, e, "point"));
+    place_rows(doc, s, value_slot(doc, e, "points"));
+    if (mirror) { /* directions: a 'reference' is one too (the joint's x, across its axis) */
+      static const unsigned axial[1] = {AXIAL};
+      flip(doc, value_slot(doc, e, "axis"), value_is(doc, e, "type", "prismatic") ? POLAR : AXIAL);
+      flip_rows(doc, value_slot(doc, e, "axes"), axial, 1);
+      flip(doc, value_slot(doc, e, "reference"), POLAR);
     }
-    yaml_node_item_t *section = value_slot(doc, e, "section");
-    if (section != NULL) flip(doc, value_slot(doc, *section, "yaxis"), AXIAL);
+  } else if (kind == KIND_FORCE) {
+    if (refuse_fe_file(g, e, "superelement", name)) return;
+    place(doc, s, value_slot(doc, e, "point"));
+    place_rows(doc, s, value_slot(doc, e, "points"));
+    if (mirror) {
+      flip(doc, value_slot(doc, e, "value"), value_is(doc, e, "type", "torque") ? AXIAL : POLAR);
+      flip(doc, value_slot(doc, e, "axis"), AXIAL); /* a tyre's spin axis */
+      flip_rows(doc, value_slot(doc, e, "axes"), frame_axes, 3);
+      if (value_is(doc, e, "type", "bushing") || value_is(doc, e, "type", "field")) {
+        flip(doc, value_slot(doc, e, "preload"), six[0]);
+        if (value_is(doc, e, "type", "field")) { /* D K D, D = diag(1, -1, 1, -1, 1, -1) */
+          static const unsigned rows[6] = {0x2Au, 0x15u, 0x2Au, 0x15u, 0x2Au, 0x15u};
+          flip_rows(doc, value_slot(doc, e, "stiffness"), rows, 6);
+          flip_rows(doc, value_slot(doc, e, "damping"), rows, 6);
+        }
+      }
+      yaml_node_item_t *section = value_slot(doc, e, "section");
+      if (section != NULL) flip(doc, value_slot(doc, *section, "yaxis"), AXIAL);
+    }
   }
 }
 
@@ -722,10 +858,11 @@ static void instance_output(instancer *g, int o) {
   rename_key(g, o, "joint", KIND_JOINT);
   rename_key(g, o, "driver", KIND_DRIVER);
   rename_nodes(g, o);
-  if (g->s->mirror) {
-    flip(doc, value_slot(doc, o, "point"), POLAR);
-    flip(doc, value_slot(doc, o, "axis"), AXIAL);
-  }
+  /* points of outputs are global at t = 0 */
+  place(doc, g->s, value_slot(doc, o, "point"));
+  rel = value_slot(doc, o, "relative_to");
+  if (rel != NULL) place(doc, g->s, value_slot(doc, *rel, "point"));
+  if (g->s->mirror) flip(doc, value_slot(doc, o, "axis"), AXIAL);
 }
 
 /* the model's section 'name' (created empty when absent), a node of c->doc */
@@ -824,20 +961,78 @@ static bool read_header(includer *c, scope *s, yaml_document_t *src, ir_loc from
   return ok;
 }
 
+/* 'position' of an instance: [x, y, z] of scalars (numbers or expressions, read by the reader) */
+static bool is_point(yaml_document_t *doc, const yaml_node_t *n) {
+  if (n->type != YAML_SEQUENCE_NODE || n->data.sequence.items.top - n->data.sequence.items.start != 3) return false;
+  for (yaml_node_item_t *it = n->data.sequence.items.start; it < n->data.sequence.items.top; it++) {
+    const yaml_node_t *x = yaml_document_get_node(doc, *it);
+    if (x->type != YAML_SCALAR_NODE || x->data.scalar.length == 0) return false;
+  }
+  return true;
+}
+
+/* a number written 0 (0, 0.0, -0, 0e3): that coordinate does not move */
+static bool written_zero(const yaml_node_t *n) {
+  char *text = xstrndup((const char *)n->data.scalar.value, n->data.scalar.length);
+  char *end = NULL;
+  double v = strtod(text, &end);
+  bool zero = end != text && *end == '\0' && v == 0;
+  free(text);
+  return zero;
+}
+
+/* the translation of scope s, per axis: the components of its own
+ * 'position' (node position_index of from_doc, 0 when none) that are not
+ * written 0, as scalars of the composed document, their y subtracted under
+ * an enclosing mirror; then the enclosing instances' offsets */
+static void take_offsets(includer *c, scope *s, const scope *parent, const char *from_path, yaml_document_t *from_doc,
+                         int position_index) {
+  if (position_index != 0) {
+    int *copied = from_doc == c->doc ? NULL : xcalloc((size_t)(from_doc->nodes.top - from_doc->nodes.start) + 1,
+                                                     sizeof *copied);
+    for (int axis = 0; axis < 3; axis++) {
+      yaml_node_t *p = yaml_document_get_node(from_doc, position_index);
+      int item = p->data.sequence.items.start[axis];
+      if (written_zero(yaml_document_get_node(from_doc, item))) continue;
+      /* the reader reads the composed document: a subsystem file's scalar is copied
+         there, keeping its marks (its messages, the parameters its names mean) */
+      s->offset_node[axis][0] = copied ? copy_node(c, from_doc, item, copied) : item;
+      s->offset_subtract[axis][0] = axis == 1 && parent != NULL && parent->mirror;
+      s->noffsets[axis] = 1;
+      if (s->moved_path == NULL) {
+        s->moved_path = from_path;
+        s->moved_at = mark_loc(yaml_document_get_node(from_doc, position_index)->start_mark);
+      }
+    }
+    free(copied);
+  }
+  if (parent == NULL) return;
+  for (int axis = 0; axis < 3; axis++)
+    for (int k = 0; k < parent->noffsets[axis]; k++) {
+      int n = s->noffsets[axis]++;
+      s->offset_node[axis][n] = parent->offset_node[axis][k];
+      s->offset_subtract[axis][n] = parent->offset_subtract[axis][k];
+    }
+  if (s->moved_path == NULL) {
+    s->moved_path = parent->moved_path;
+    s->moved_at = parent->moved_at;
+  }
+}
+
 static void instantiate(includer *c, scope *parent, const char *from_path, yaml_document_t *from_doc,
                         int key_index, int value_index) {
   yaml_node_t *key = yaml_document_get_node(from_doc, key_index);
   yaml_node_t *inst = yaml_document_get_node(from_doc, value_index);
   ir_loc at = mark_loc(key->start_mark);
   if (key->type != YAML_SCALAR_NODE || inst->type != YAML_MAPPING_NODE) {
-    diag_error(from_path, at, "a subsystem instance is 'name: {file: F, prefix: P, mirror: true|false, attach: "
-                              "{...}, parameters: {...}}'");
+    diag_error(from_path, at, "a subsystem instance is 'name: {file: F, prefix: P, mirror: true|false, position: "
+                              "[x, y, z], attach: {...}, parameters: {...}}'");
     c->ok = false;
     return;
   }
   char *name = scalar_copy(key);
-  yaml_node_t *file = NULL, *prefix = NULL, *mirror = NULL, *attach = NULL, *params = NULL;
-  int params_index = 0;
+  yaml_node_t *file = NULL, *prefix = NULL, *mirror = NULL, *attach = NULL, *params = NULL, *position = NULL;
+  int params_index = 0, position_index = 0;
   bool ok = true;
   for (int i = 0; i < npairs(inst); i++) {
     yaml_node_t *k = yaml_document_get_node(from_doc, inst->data.mapping.pairs.start[i].key);
@@ -846,13 +1041,18 @@ static void instantiate(includer *c, scope *parent, const char *from_path, yaml_
     else if (scalar_equals(k, "prefix")) prefix = v;
     else if (scalar_equals(k, "mirror")) mirror = v;
     else if (scalar_equals(k, "attach")) attach = v;
+    else if (scalar_equals(k, "position")) {
+      position = v;
+      position_index = inst->data.mapping.pairs.start[i].value;
+    }
     else if (scalar_equals(k, "parameters")) {
       params = v;
       params_index = inst->data.mapping.pairs.start[i].value;
     }
     else {
       diag_error(from_path, mark_loc(k->start_mark),
-                 "unknown key in subsystem instance '%s' (expected file, prefix, mirror, attach, parameters)", name);
+                 "unknown key in subsystem instance '%s' (expected file, prefix, mirror, position, attach, "
+                 "parameters)", name);
       ok = false;
     }
   }
@@ -867,6 +1067,11 @@ static void instantiate(includer *c, scope *parent, const char *from_path, yaml_
   }
   if (mirror != NULL && !scalar_equals(mirror, "true") && !scalar_equals(mirror, "false")) {
     diag_error(from_path, mark_loc(mirror->start_mark), "'mirror' must be true or false");
+    ok = false;
+  }
+  if (position != NULL && !is_point(from_doc, position)) {
+    diag_error(from_path, mark_loc(position->start_mark), "'position' of subsystem instance '%s' must be a list of 3 "
+               "numbers or expressions [x, y, z] (the translation of everything the subsystem places)", name);
     ok = false;
   }
   if (attach != NULL && attach->type != YAML_MAPPING_NODE) {
@@ -897,6 +1102,7 @@ static void instantiate(includer *c, scope *parent, const char *from_path, yaml_
     s.own_prefix = ol;
   }
   s.mirror = (parent && parent->mirror) != (mirror != NULL && scalar_equals(mirror, "true"));
+  take_offsets(c, &s, parent, from_path, from_doc, position_index);
   char *canonical = realpath(s.path, NULL);
   bool cycle = false;
   for (int d = 0; canonical && d < c->depth; d++) cycle = cycle || strcmp(c->stack[d], canonical) == 0;
@@ -1066,7 +1272,6 @@ static void instantiate(includer *c, scope *parent, const char *from_path, yaml_
             clash = true; /* one message per instance */
           }
         int keyn = add_scalar_like(c->doc, yaml_document_get_node(&src, q.key), NULL, full);
-        free(full);
         int value = copy_node(c, &src, q.value, copied);
         if (kind == KIND_PARAM && params != NULL) { /* the instance's value wins */
           ek = yaml_document_get_node(&src, q.key);
@@ -1104,9 +1309,10 @@ static void instantiate(includer *c, scope *parent, const char *from_path, yaml_
             }
             if (kind == KIND_FORCE) rename_key(&g, value, "body", KIND_BODY);
             if (kind == KIND_DRIVER) rename_key(&g, value, "joint", KIND_JOINT);
-            if (s.mirror) mirror_element(&g, kind, value);
+            if (s.mirror || scope_moves(&s)) place_element(&g, kind, value, full);
           }
         }
+        free(full);
         if (!yaml_document_append_mapping_pair(c->doc, target, keyn, value)) out_of_memory();
       }
     }

@@ -21,6 +21,23 @@ bool compose_is_mirrored(const yaml_node_t *n);
 /* -v, but +0 for 0 (a mirrored 0 is written 0, not -0) */
 double compose_mirror_value(double v);
 
+/* A coordinate of a point of a moved instance ('position: [x, y, z]', and
+ * the instances around it) carries the tag COMPOSE_PLACED_TAG, then '-' (a
+ * mirrored y) or '+', then per offset ";+N" or ";-N": node N of the composed
+ * document is that offset's component as the instance wrote it, added or
+ * subtracted (an enclosing mirror turns an inner offset's y), innermost
+ * first.  The reader's number is then ((±v) ± t1) ± t2 ..., the composition
+ * outer_translate(outer_mirror(inner_translate(inner_mirror(v)))). */
+#define COMPOSE_PLACED_TAG "tag:mbcc:placed:"
+typedef struct {
+  bool negate;                          /* mirrored: -v first */
+  int nterms;
+  int node[LIMIT_INCLUDE_DEPTH + 1];    /* the offsets' scalars, innermost first */
+  bool subtract[LIMIT_INCLUDE_DEPTH + 1];
+} compose_placement;
+/* false for a scalar as written; else how an instance placed it */
+bool compose_placement_of(const yaml_node_t *n, compose_placement *p);
+
 /* the files included (for the input hash) */
 typedef struct {
   char *path[DIAG_MAX_FILES];

@@ -128,8 +128,7 @@ static void fail(parser *p, size_t pos, bool syntax, const char *fmt, ...) {
   va_end(ap);
 }
 
-static int add_node(parser *p, ir_expr_op op, size_t pos) {
-  ir_expr *e = p->e;
+static int append_node(ir_expr *e, ir_expr_op op, size_t pos) {
   if (e->count % 16 == 0) {
     ir_expr_node *bigger = realloc(e->node, (size_t)(e->count + 16) * sizeof *bigger);
     if (!bigger) out_of_memory();
@@ -142,6 +141,8 @@ static int add_node(parser *p, ir_expr_op op, size_t pos) {
   n->pos = (int)pos;
   return e->count++;
 }
+
+static int add_node(parser *p, ir_expr_op op, size_t pos) { return append_node(p->e, op, pos); }
 
 static void skip_blanks(parser *p) {
   while (p->at < p->length && (p->text[p->at] == ' ' || p->text[p->at] == '\t')) p->at++;
@@ -481,6 +482,9 @@ bool params_rule_holds(ir_value_rule rule, double v) {
   return rule == RULE_NONNEGATIVE ? v >= 0 : rule == RULE_POSITIVE ? v > 0 : true;
 }
 
+static bool place_value(reader *r, const yaml_node_t *n, const char *label, const compose_placement *placed,
+                        double *v, double *offset);
+
 int expr_number(reader *r, yaml_node_t *n, const char *label, double *out) {
   if (n->type != YAML_SCALAR_NODE || scalar_length(n) == 0 || r->model == NULL) return 0;
   ir_expr e;
@@ -499,19 +503,87 @@ int expr_number(reader *r, yaml_node_t *n, const char *label, double *out) {
        number"; with, a parameter it names failed and was reported there */
     return r->params_block ? -1 : 0;
   }
-  if (compose_is_mirrored(n)) {
-    if (runtime) {
+  compose_placement placed;
+  if (compose_placement_of(n, &placed)) {
+    if (placed.negate && runtime) {
       error_at(r, loc_of(n), "%s is mirrored (a subsystem instance with 'mirror: true') and cannot use a run-time "
                "parameter", label);
       free(e.node);
       return -1;
     }
-    value = compose_mirror_value(value);
+    double offset[LIMIT_INCLUDE_DEPTH + 1];
+    if (!place_value(r, n, label, &placed, &value, offset)) {
+      free(e.node);
+      return -1;
+    }
+    /* a run-time value is computed by the generated code from the
+       expression: the offsets (compile-time numbers) join it, in the order
+       they were added */
+    for (int k = 0; runtime && k < placed.nterms; k++) {
+      int number = append_node(&e, EXPR_NUMBER, 0);
+      e.node[number].number = offset[k];
+      int sum = append_node(&e, placed.subtract[k] ? EXPR_SUB : EXPR_ADD, 0);
+      e.node[sum].a = e.root;
+      e.node[sum].b = number;
+      e.root = sum;
+    }
   }
   *out = value;
   if (names_any(&e)) record_use(r, n, &e, value, runtime);
   else free(e.node);
   return 1;
+}
+
+/* the offset of a moved instance (compose.h): node k of the document, a
+ * component of its 'position', read once (an error in it is reported once) */
+static bool offset_value(reader *r, int k, double *out) {
+  size_t count = (size_t)(r->doc->nodes.top - r->doc->nodes.start);
+  if (k < 1 || (size_t)k > count || r->model == NULL) return false;
+  if (r->offset_state == NULL) {
+    r->offset_state = xcalloc(count + 1, sizeof *r->offset_state);
+    r->offset_value = xcalloc(count + 1, sizeof *r->offset_value);
+  }
+  if (r->offset_state[k] != 0) {
+    *out = r->offset_value[k];
+    return r->offset_state[k] == 1;
+  }
+  r->offset_state[k] = 2;
+  yaml_node_t *n = node_at(r, k);
+  int uses = r->model->nuses;
+  double v;
+  if (!to_number(r, n, "a component of the instance's 'position'", &v)) return false;
+  /* an expression naming a run-time parameter was recorded as such */
+  if (r->model->nuses > uses && r->model->uses[r->model->nuses - 1].uses_runtime) {
+    error_at(r, loc_of(n), "the 'position' of a subsystem instance cannot use a run-time parameter (it moves "
+             "the instance's points at compile time)");
+    return false;
+  }
+  r->offset_state[k] = 1;
+  r->offset_value[k] = *out = v;
+  return true;
+}
+
+/* *v as placed: negated, then each offset added or subtracted in order
+ * (their values in offset[]) */
+static bool place_value(reader *r, const yaml_node_t *n, const char *label, const compose_placement *placed,
+                        double *v, double *offset) {
+  if (placed->negate) *v = compose_mirror_value(*v);
+  for (int k = 0; k < placed->nterms; k++) {
+    if (!offset_value(r, placed->node[k], &offset[k])) return false;
+    *v = placed->subtract[k] ? *v - offset[k] : *v + offset[k];
+  }
+  if (fabs(*v) > LIMIT_MAGNITUDE) {
+    error_at(r, loc_of(n), "%s moved by its subsystem instance's 'position' is %g, beyond the limit %g on the size "
+             "of a number", label, *v, LIMIT_MAGNITUDE);
+    return false;
+  }
+  return true;
+}
+
+bool params_place(reader *r, const yaml_node_t *n, const char *label, double *value) {
+  compose_placement placed;
+  double offset[LIMIT_INCLUDE_DEPTH + 1];
+  return !compose_placement_of(n, &placed) || place_value(r, n, label, &placed, value, offset);
 }
 
 /* ---------------------------------------------------------------------------

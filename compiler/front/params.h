@@ -19,6 +19,11 @@ void parse_parameters(reader *r, yaml_node_t *n);
  * which says "must be a number"). */
 int expr_number(reader *r, yaml_node_t *n, const char *label, double *out);
 
+/* *value, the number written in scalar n, as the subsystem instances placed
+ * n (compose.h): negated if mirrored, then moved by the offsets of their
+ * 'position'; false after reporting (at the offset, or at n) */
+bool params_place(reader *r, const yaml_node_t *n, const char *label, double *value);
+
 /* --set NAME=VALUE for the next ir_read: run-time parameters take these
  * values instead of their defaults (the arrays must outlive the reads). */
 void params_set_overrides(const char *const *names, const double *values, int count);

@@ -819,6 +819,8 @@ static ir_model *read_model(const char *path, const char *scene) {
       table_free(&r.names);
       free_chosen_scene(&r.scene, model->nbodies);
       free(r.param_nodes);
+      free(r.offset_state);
+      free(r.offset_value);
     }
     yaml_document_delete(&doc);
   }

@@ -5,7 +5,6 @@
  * compiler (yaml_map.h lists them). */
 #include "yaml_map.h"
 #include "bounds.h"
-#include "compose.h"
 #include "params.h"
 
 #include <errno.h>
@@ -310,8 +309,8 @@ bool to_number(reader *r, yaml_node_t *n, const char *label, double *out) {
     double value = blank_start ? 0 : strtod(text, &end);
     if (!blank_start && end == text + scalar_length(n)) {
       if (isfinite(value) && fabs(value) <= LIMIT_MAGNITUDE) {
-        *out = compose_is_mirrored(n) ? compose_mirror_value(value) : value;
-        return true;
+        *out = value;
+        return params_place(r, n, label, out); /* mirrored or moved by a subsystem instance */
       }
       if (isfinite(value)) {
         error_at(r, loc_of(n), "%s is %s, beyond the limit %g on the size of a number", label,

@@ -77,6 +77,10 @@ typedef struct reader {
   chosen_scene scene;
   /* 'parameters:' (params.c): the value node of each, evaluated on first use */
   yaml_node_t **param_nodes;
+  /* the offsets of moved subsystem instances (compose.h), by node of doc,
+     each read once: state 0 not yet, 1 read (offset_value), 2 failed */
+  unsigned char *offset_state;
+  double *offset_value;
   bool params_block;  /* the model has a 'parameters:' block */
   /* show_*() format user text into these, so a message can quote a few */
   char shown[SHOWN_BUFFERS][SHOWN_SIZE];
