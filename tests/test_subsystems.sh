@@ -40,14 +40,19 @@ strip_origin() { # DIR -> DIR.stripped: without the origin header and location c
     sed -E -e '1,2d' -e 's/[a-z_]+\.yaml:[0-9]+:[0-9]+/LOC/g' "$f" > "$1.stripped/${f##*/}"
   done
 }
-"$MBCC" compile "$root/tests/compose/subsystem_pair.yaml" -o gen_sub > log 2>&1 || err "compile subsystem_pair: $(cat log)"
-"$MBCC" compile "$root/tests/compose/subsystem_pair_by_hand.yaml" -o gen_hand > log 2>&1 || err "compile by hand: $(cat log)"
-strip_origin gen_sub
-strip_origin gen_hand
-[ "$(ls gen_sub.stripped | wc -l)" -ge 3 ] || err "subsystem_pair emitted fewer than 3 files"
-a=$(cd gen_sub.stripped && sha256sum -- * | sha256sum)
-b=$(cd gen_hand.stripped && sha256sum -- * | sha256sum)
-[ "$a" = "$b" ] || err "the instantiated subsystems emit other code than the same written by hand: $(diff -r gen_sub.stripped gen_hand.stripped | head -20)"
+same_code() { # same_code A.yaml B.yaml WHAT: A and B emit the same C (apart from origin and locations)
+  local a=gen_${1##*/} b=gen_${2##*/}
+  a=${a%.yaml} b=${b%.yaml}
+  "$MBCC" compile "$1" -o "$a" > log 2>&1 || { err "compile $1: $(head -5 log)"; return; }
+  "$MBCC" compile "$2" -o "$b" > log 2>&1 || { err "compile $2: $(head -5 log)"; return; }
+  strip_origin "$a"
+  strip_origin "$b"
+  [ "$(ls "$a.stripped" | wc -l)" -ge 3 ] || err "$1 emitted fewer than 3 files"
+  [ "$(cd "$a.stripped" && sha256sum -- * | sha256sum)" = "$(cd "$b.stripped" && sha256sum -- * | sha256sum)" ] ||
+    err "$3: $(diff -r "$a.stripped" "$b.stripped" | head -20)"
+}
+same_code "$root/tests/compose/subsystem_pair.yaml" "$root/tests/compose/subsystem_pair_by_hand.yaml" \
+  "the instantiated subsystems emit other code than the same written by hand"
 
 # 2. mirror symmetry of the motion
 mkdir -p sym/subsystems
@@ -156,17 +161,6 @@ for scene in rigid base; do
 done
 
 # 5. moved instances: the same C as written out by hand
-same_code() { # same_code A.yaml B.yaml WHAT: A and B emit the same C (apart from origin and locations)
-  local a=gen_${1##*/} b=gen_${2##*/}
-  a=${a%.yaml} b=${b%.yaml}
-  "$MBCC" compile "$1" -o "$a" > log 2>&1 || { err "compile $1: $(head -5 log)"; return; }
-  "$MBCC" compile "$2" -o "$b" > log 2>&1 || { err "compile $2: $(head -5 log)"; return; }
-  strip_origin "$a"
-  strip_origin "$b"
-  [ "$(ls "$a.stripped" | wc -l)" -ge 3 ] || err "$1 emitted fewer than 3 files"
-  [ "$(cd "$a.stripped" && sha256sum -- * | sha256sum)" = "$(cd "$b.stripped" && sha256sum -- * | sha256sum)" ] ||
-    err "$3: $(diff -r "$a.stripped" "$b.stripped" | head -20)"
-}
 same_code "$root/tests/compose/subsystem_moved.yaml" "$root/tests/compose/subsystem_moved_by_hand.yaml" \
   "the moved (and nested, mirrored) instances emit other code than the same written out at the moved places"
 # a position of all zeros moves nothing: the code of subsystem_pair.yaml
