@@ -95,7 +95,7 @@ typedef struct {
   int damped_steps;           /* pseudo-transient steps past a turning point, where the tangent
                                  was singular along a loaded direction (a pendulum released
                                  horizontally) */
-  char why[400];              /* the cause of a failure */
+  char why[512];              /* the cause of a failure */
 } mb_equilibrium_info;
 /* Move s->q (from mb_sim_init: the model's initial state) to static
  * equilibrium at t = 0: forces at zero velocity balanced by the constraint
