@@ -69,7 +69,9 @@ cd "$tmp" || exit 1
 # 3. a full disk
 mkdir d && cd d || exit 1
 "$MBCC" compile "$wheel" -o gen > compile.log 2>&1 || err "compile for the full disk: $(cat compile.log)"
-cc_out=$(cd gen && cc -std=c99 -I"$root/runtime/core" -I"$root/runtime/hosted" -o wheel_sim wheel.c main.c \
+# CFLAGS: make sanitize's (its libmbrt.a needs the sanitizer runtime at the link)
+# shellcheck disable=SC2086
+cc_out=$(cd gen && cc -std=c99 ${CFLAGS:-} -I"$root/runtime/core" -I"$root/runtime/hosted" -o wheel_sim wheel.c main.c \
   "$root/${B:-build}/libmbrt.a" -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig -llapack -lblas -lm 2>&1) ||
   err "cannot build the wheel simulator: $cc_out"
 full_disk() { # a command run against a full output directory 'out' holding old.csv and old.png

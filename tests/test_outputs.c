@@ -278,6 +278,7 @@ static void wrench_and_generic_path(void **state) {
   free(out);
   free(zero);
   free(work);
+  trajectory_free(&tr);
   const mb_model *models[3] = {&outputs_free_model, &outputs_driven_model, &outputs_flexible_model};
   for (int i = 0; i < 3; i++) {
     mb_model g = generic_twin(models[i]);
