@@ -16,7 +16,8 @@ if [ ! -e /usr/include/mujoco/mujoco.h ]; then
   exit 0
 fi
 P=$tmp/peers
-PEER_DIR=$P PEER_MODELS=bench/peers/four_bar_4r.yaml PEER_ROUNDS=3 PEER_CACHEGRIND=0 MBCC=$MBCC \
+# GEN_CFLAGS: make sanitize's CFLAGS, which its libmbrt.a needs at the link
+PEER_DIR=$P PEER_MODELS=bench/peers/four_bar_4r.yaml PEER_ROUNDS=3 PEER_CACHEGRIND=0 MBCC=$MBCC GEN_CFLAGS="${CFLAGS:--O2}" \
   sh "$root/scripts/peers.sh" >peers.out 2>&1 || { cat peers.out; err "scripts/peers.sh failed"; }
 T=$P/four_bar_4r.txt
 if [ -s "$T" ]; then
