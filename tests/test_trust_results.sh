@@ -84,7 +84,9 @@ int main(void) {
   return 0;
 }
 EOS
-if cc -I"$root/runtime/core" -I"$root/runtime/hosted" xerbla.c -Wl,--undefined=xerbla_ "$root/${B:-build}/libmbrt.a" \
+# CFLAGS: make sanitize's (its libmbrt.a needs the sanitizer runtime at the link)
+# shellcheck disable=SC2086
+if cc ${CFLAGS:-} -I"$root/runtime/core" -I"$root/runtime/hosted" xerbla.c -Wl,--undefined=xerbla_ "$root/${B:-build}/libmbrt.a" \
      -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig -llapack -lblas -lm -o xerbla 2> cc.log; then
   ./xerbla > xerbla.log 2>&1
   rc=$?
